@@ -358,6 +358,18 @@ class FaultModel:
         """Eigenvalues of ``A``."""
         return scipy.linalg.eigvals(self.A)
 
+    def freqresp(self, omega, group: str | None = None) -> np.ndarray:
+        """Frequency response ``C (zI − A)⁻¹ B + D`` at ``omega`` (rad/s), shape (len(omega), p, k).
+
+        ``z = jω`` in continuous time and ``e^{jω dt}`` in discrete time; ``group``
+        restricts the inputs to one group (``'u'``, ``'d'``, ``'f'``, ``'w'``).
+        """
+        omega = np.atleast_1d(np.asarray(omega, dtype=float))
+        B, D = (self.B, self.D) if group is None else (self.b(group), self.d(group))
+        z = np.exp(1j * omega * self.dt) if self.is_discrete else 1j * omega
+        eye = np.eye(self.n)
+        return np.array([self.C @ np.linalg.solve(zk * eye - self.A, B) + D for zk in z])
+
     # ------------------------------------------------------------------ python-control interop
     def to_control(self):
         """A :class:`control.StateSpace` with all inputs (groups in order u, d, f, w) and names."""

@@ -1,0 +1,77 @@
+"""Discrete LTI responses: a blocked (lifted) batch solver and its one-step twin.
+
+``x[k+1] = A x[k] + B v[k]``, ``y[k] = C x[k] + D v[k]``.
+
+The batch solver lifts the recursion over blocks of ``M`` samples: block-boundary
+states follow ``s[b+1] = A^M s[b] + Γ_M v_b`` (a short loop of ``N/M`` steps), and
+every sample inside a block comes from one matrix product
+``X_b = Φ s[b] + T v_b`` with ``Φ = [I; A; …; A^{M-1}]`` and the block-Toeplitz
+``T`` of Markov parameters.  The result equals the sample-by-sample recursion up
+to rounding, at a fraction of the Python-loop cost of ``scipy.signal.dlsim`` or
+``control.forced_response``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["dlsim_blocked", "lifted_matrices"]
+
+
+def lifted_matrices(A: np.ndarray, B: np.ndarray, M: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``Φ`` (M n x n), ``T`` (M n x M m), ``A^M`` and ``Γ_M`` (n x M m) of the lifted recursion."""
+    n, m = B.shape
+    powers = [np.eye(n)]
+    for _ in range(M):
+        powers.append(A @ powers[-1])
+    Phi = np.vstack(powers[:M])
+    AB = [P @ B for P in powers[:M]]  # A^j B
+    T = np.zeros((M * n, M * m))
+    for j in range(1, M):
+        for i in range(j):
+            T[j * n : (j + 1) * n, i * m : (i + 1) * m] = AB[j - 1 - i]
+    Gamma = np.hstack(AB[::-1]) if M else np.zeros((n, 0))
+    return Phi, T, powers[M], Gamma
+
+
+def dlsim_blocked(
+    A: np.ndarray,
+    B: np.ndarray,
+    C: np.ndarray,
+    D: np.ndarray,
+    v: np.ndarray,
+    x0: np.ndarray | None = None,
+    block: int = 32,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Response of a discrete state space to the input sequence ``v`` (N x m).
+
+    Returns
+    -------
+    y : (N, p) outputs, x : (N, n) states (``x[0] = x0``), x_end : (n,) the state after the last sample.
+    """
+    A, B, C, D = (np.asarray(M_, dtype=float) for M_ in (A, B, C, D))
+    v = np.asarray(v, dtype=float)
+    N = v.shape[0]
+    n, m = B.shape
+    x0 = np.zeros(n) if x0 is None else np.asarray(x0, dtype=float)
+    if n == 0 or N == 0:
+        return v @ D.T, np.zeros((N, n)), x0.copy()
+    M = max(1, min(block, N))
+    nb = -(-N // M)
+    vp = np.zeros((nb * M, m))
+    vp[:N] = v
+    Vb = vp.reshape(nb, M * m)
+    Phi, T, AM, Gamma = lifted_matrices(A, B, M)
+    drive = Vb @ Gamma.T  # (nb, n): input part of each block-end state
+    S = np.empty((nb + 1, n))
+    S[0] = x0
+    AMt = AM.T
+    for b in range(nb):
+        S[b + 1] = S[b] @ AMt + drive[b]
+    X = (S[:nb] @ Phi.T + Vb @ T.T).reshape(nb * M, n)[:N]
+    if nb * M == N:
+        x_end = S[nb]
+    else:
+        x_end = A @ X[N - 1] + B @ v[N - 1]
+    y = X @ C.T + v @ D.T
+    return y, X, x_end
