@@ -309,7 +309,8 @@ def parse_fault(spec: str) -> Fault:
         if m["value"]:
             kw[field_name] = float(m["value"])
         elif cls is not Stuck:
-            raise ModelError(f"fault spec {spec!r} needs a value after the target, e.g. '{m['kind']}:{m['target']}:0.1'")
+            example = f"{m['kind']}:{m['target']}:0.1"
+            raise ModelError(f"fault spec {spec!r} needs a value after the target, e.g. {example!r}")
         if m["onset"]:
             kw["onset"] = float(m["onset"])
         if m["end"]:

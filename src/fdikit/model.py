@@ -274,8 +274,8 @@ class FaultModel:
         out = []
         for name in names:
             if name not in pool:
-                word = _GROUP_WORD.get(kind, kind)
-                raise ModelError(f"no {word[:-1] if word.endswith('s') else word} named {name!r}; the model has {list(pool)}")
+                word = {"states": "state", "outputs": "output"}.get(kind) or f"{_GROUP_WORD[kind]} input"
+                raise ModelError(f"no {word} named {name!r}; the model has {list(pool)}")
             out.append(pool.index(name))
         return out
 

@@ -174,10 +174,11 @@ def simulate(
     x0 = None if x0 is None else np.asarray(x0, dtype=float)
 
     if isinstance(plant, FaultModel):
-        y, x = _simulate_linear(plant, h, t, u_act, d_arr, x0, _covariance("noise_cov", noise_cov, len(plant.noise)), rng)
+        W = _covariance("noise_cov", noise_cov, len(plant.noise))
+        y, x = _simulate_linear(plant, h, t, u_act, d_arr, x0, W, rng)
     else:
-        y, x = _simulate_nonlinear(plant, t, h, u_act, x0, _covariance("noise_cov", noise_cov, len(states)), rng,
-                                   method, substeps)
+        W = _covariance("noise_cov", noise_cov, len(states))
+        y, x = _simulate_nonlinear(plant, t, h, u_act, x0, W, rng, method, substeps)
 
     R = _covariance("measurement_noise", measurement_noise, len(outputs))
     if R is not None:
@@ -231,7 +232,7 @@ def _simulate_nonlinear(plant, t, h, u, x0, W, rng, method, substeps):
                 xk = xk + hs / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
                 tk += hs
         else:
-            sol = solve_ivp(lambda tt, xx: f(tt, xx, uk), (t[k], t[k + 1]), xk, rtol=1e-8, atol=1e-10)
+            sol = solve_ivp(lambda tt, xx, uk=uk: f(tt, xx, uk), (t[k], t[k + 1]), xk, rtol=1e-8, atol=1e-10)
             if not sol.success:
                 raise DataError(f"solve_ivp failed at t={t[k]:g}: {sol.message}")
             xk = sol.y[:, -1]
