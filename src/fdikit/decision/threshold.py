@@ -1,0 +1,202 @@
+"""Fixed thresholds per residual, calibrated on fault-free data, with k-of-n persistence.
+
+The simplest residual processor of Douglas et al. 1996 §1 ("a simple threshold per
+residual, traded between false and missed alarms").  Residual ``i`` fires when
+``|r_i − c_i| > τ_i`` in at least ``k`` of the last ``n`` valid samples; the alarm
+is on when any residual fires, and the fault is isolated when every fired residual
+is tied to the same fault (:func:`fdikit.diagnosis.isolate`).
+
+Calibration for a target false-alarm probability ``α`` per sample (family-wise,
+split evenly over the ``q`` residuals, Bonferroni):
+
+* ``method='gaussian'``: ``c_i`` = mean, ``τ_i = σ_i Φ⁻¹(1 − α/(2q))`` — exact for
+  Gaussian residuals (Kalman innovations), usable for any ``α``;
+* ``method='empirical'``: ``τ_i`` = the ``1 − α/q`` quantile of ``|r_i − c_i|`` —
+  distribution-free, needs at least ``10 q / α`` fault-free samples.
+
+A rate of false alarms per hour converts to ``α = rate · dt / 3600`` (each exceedance
+counted as an alarm; persistence and correlated residuals only lower the rate, so the
+conversion is conservative).
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.stats import norm
+
+from fdikit.diagnosis import Diagnosis, isolate
+from fdikit.errors import DataError, ModelError
+from fdikit.residuals import Residuals
+
+__all__ = ["ThresholdEvaluator", "StepDecision", "alpha_from_rate"]
+
+
+def alpha_from_rate(false_alarms_per_hour: float, dt: float) -> float:
+    """Per-sample false-alarm probability for a target number of false alarms per hour."""
+    if not false_alarms_per_hour > 0 or not dt > 0:
+        raise ModelError(f"need a positive rate and sample time, got {false_alarms_per_hour}/h and dt={dt}")
+    return min(1.0, false_alarms_per_hour * dt / 3600.0)
+
+
+@dataclass(frozen=True)
+class StepDecision:
+    """Decision for one sample from :meth:`ThresholdEvaluator.step`."""
+
+    alarm: bool
+    fault: str
+    fired: np.ndarray
+    valid: bool
+
+
+def _persist(exceed: np.ndarray, k: int, n: int) -> np.ndarray:
+    """``True`` where at least ``k`` of the last ``n`` rows (including this one) exceed."""
+    if k == 1 and n == 1:
+        return exceed
+    c = np.cumsum(np.vstack([np.zeros((1, exceed.shape[1])), exceed.astype(int)]), axis=0)
+    lo = np.maximum(np.arange(1, exceed.shape[0] + 1) - n, 0)
+    return (c[1:] - c[lo]) >= k
+
+
+class ThresholdEvaluator:
+    """Per-residual thresholds with k-of-n persistence.
+
+    Parameters
+    ----------
+    thresholds : array_like, optional
+        Fixed ``τ_i``; otherwise call :meth:`fit` on fault-free residuals.
+    center : array_like, optional
+        ``c_i`` (default 0, or the fault-free mean after :meth:`fit`).
+    persistence : (k, n)
+        Fire when ``k`` of the last ``n`` valid samples exceed (default (1, 1)).
+    isolates : sequence, optional
+        Fault tied to each residual; defaults to the residuals' own ``isolates``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.residuals import Residuals
+    >>> from fdikit.decision import ThresholdEvaluator
+    >>> rng = np.random.default_rng(0)
+    >>> healthy = Residuals(np.arange(10000) * 0.01, rng.standard_normal((10000, 1)), ("r",), ("f",))
+    >>> ev = ThresholdEvaluator().fit(healthy, false_alarm_prob=1e-3)
+    >>> round(float(ev.thresholds[0]), 1)
+    3.3
+    """
+
+    def __init__(self, thresholds=None, center=None, persistence: tuple[int, int] = (1, 1), isolates=None) -> None:
+        k, n = persistence
+        if not (1 <= k <= n):
+            raise ModelError(f"persistence (k, n) needs 1 <= k <= n, got {persistence}")
+        self.persistence = (int(k), int(n))
+        self.thresholds = None if thresholds is None else np.atleast_1d(np.asarray(thresholds, dtype=float))
+        if self.thresholds is not None and not np.all(self.thresholds > 0):
+            raise ModelError(f"thresholds must be positive, got {self.thresholds}")
+        self.center = None if center is None else np.atleast_1d(np.asarray(center, dtype=float))
+        self.isolates = None if isolates is None else tuple(isolates)
+        self.names: tuple[str, ...] | None = None
+        self.alpha: float | None = None
+        self.reset()
+
+    # ------------------------------------------------------------------ calibration
+    def fit(
+        self,
+        residuals: Residuals,
+        false_alarm_prob: float | None = None,
+        false_alarms_per_hour: float | None = None,
+        method: str = "gaussian",
+    ) -> ThresholdEvaluator:
+        """Calibrate centres and thresholds on fault-free residuals; returns ``self``."""
+        if (false_alarm_prob is None) == (false_alarms_per_hour is None):
+            raise ModelError("give exactly one of false_alarm_prob and false_alarms_per_hour")
+        r = residuals.r[residuals.valid]
+        r = r[np.all(np.isfinite(r), axis=1)]
+        q = r.shape[1]
+        if r.shape[0] < 10:
+            raise DataError(f"need at least 10 valid fault-free samples to calibrate, got {r.shape[0]}")
+        if false_alarms_per_hour is not None:
+            dt = float(np.median(np.diff(residuals.t)))
+            alpha = alpha_from_rate(false_alarms_per_hour, dt)
+        else:
+            alpha = float(false_alarm_prob)
+        if not 0 < alpha < 1:
+            raise ModelError(f"false-alarm probability must be in (0, 1), got {alpha}")
+        a_i = alpha / q
+        center = r.mean(axis=0)
+        if method == "gaussian":
+            std = r.std(axis=0, ddof=1)
+            tau = std * norm.isf(a_i / 2)
+        elif method == "empirical":
+            if r.shape[0] * a_i < 10:
+                raise DataError(
+                    f"empirical calibration at α={alpha:g} needs at least {int(np.ceil(10 / a_i))} samples, "
+                    f"got {r.shape[0]}; use method='gaussian' or more fault-free data"
+                )
+            tau = np.quantile(np.abs(r - center), 1 - a_i, axis=0)
+        else:
+            raise ModelError(f"unknown calibration method {method!r}; use 'gaussian' or 'empirical'")
+        if not np.all(tau > 0):
+            bad = [residuals.names[i] for i in np.flatnonzero(~(tau > 0))]
+            raise DataError(f"residual(s) {bad} are constant on the fault-free data; cannot set a threshold")
+        self.center, self.thresholds, self.alpha = center, tau, alpha
+        self.names = residuals.names
+        if self.isolates is None:
+            self.isolates = residuals.isolates
+        self.reset()
+        return self
+
+    def _ready(self, q: int, residuals: Residuals | None = None) -> tuple[np.ndarray, np.ndarray, tuple]:
+        if self.thresholds is None:
+            raise ModelError("the evaluator has no thresholds; pass thresholds= or call fit() on fault-free residuals")
+        tau = np.broadcast_to(self.thresholds, (q,)) if self.thresholds.size in (1, q) else None
+        if tau is None:
+            raise DataError(f"{self.thresholds.size} thresholds for {q} residuals")
+        c = np.zeros(q) if self.center is None else np.broadcast_to(self.center, (q,))
+        iso = self.isolates or (residuals.isolates if residuals is not None else (None,) * q)
+        return np.asarray(tau), np.asarray(c), tuple(iso)
+
+    # ------------------------------------------------------------------ batch
+    def run(self, residuals: Residuals) -> Diagnosis:
+        """Decisions for a whole residual series; identical to stepping through it."""
+        q = len(residuals.names)
+        tau, c, iso = self._ready(q, residuals)
+        r = residuals.r
+        valid = residuals.valid & np.all(np.isfinite(r), axis=1)
+        k, n = self.persistence
+        fired_v = _persist(np.abs(r[valid] - c) > tau, k, n)
+        # invalid samples hold the previous valid decision (as step() does)
+        pos = np.cumsum(valid) - 1
+        fired = np.zeros((len(residuals), q), bool)
+        has = pos >= 0
+        fired[has] = fired_v[pos[has]]
+        isolated = isolate(fired, iso)
+        return Diagnosis(
+            residuals.t, fired.any(axis=1), fired, residuals.names, isolated, valid=valid,
+            meta={"evaluator": "threshold", "thresholds": tau.tolist(), "persistence": list(self.persistence)},
+        )
+
+    # ------------------------------------------------------------------ online
+    def reset(self) -> None:
+        """Forget the persistence window (start of a new run)."""
+        self._window: deque = deque(maxlen=self.persistence[1])
+        self._last = None
+
+    def step(self, r) -> StepDecision:
+        """Decision for one residual sample; a NaN/inf sample holds the previous decision."""
+        r = np.asarray(r, dtype=float).ravel()
+        tau, c, iso = self._ready(r.size)
+        if not np.all(np.isfinite(r)):
+            fired = np.zeros(r.size, bool) if self._last is None else self._last
+            valid = False
+        else:
+            self._window.append(np.abs(r - c) > tau)
+            fired = np.sum(self._window, axis=0) >= self.persistence[0]
+            self._last = fired
+            valid = True
+        fault = str(isolate(fired[None, :], iso)[0])
+        return StepDecision(bool(fired.any()), fault, fired.copy(), valid)
+
+    def __repr__(self) -> str:
+        return f"ThresholdEvaluator(thresholds={self.thresholds}, persistence={self.persistence}, alpha={self.alpha})"

@@ -1,0 +1,84 @@
+"""Benchmark plants as library data.
+
+Each plant is a function returning a :class:`~fdikit.model.FaultModel`; :data:`PLANTS`
+maps a short name to that function and :func:`get_plant` looks one up by name.
+
+=================  ==============================================  ======================
+name               model                                            source
+=================  ==============================================  ======================
+``path12``         PATH vehicle, 12 states, sensor-fault design     Douglas et al. 1996, (d.2)
+``path14``         PATH vehicle, 14 states, actuator-fault design   Douglas et al. 1996, (d.1)
+``single-track``   lateral single-track model with lane errors      van der Ploeg 2018, (B.12)
+=================  ==============================================  ======================
+
+Examples
+--------
+>>> from fdikit.plants import get_plant
+>>> get_plant("single-track", speed=25.0).states
+('lateral_velocity', 'yaw_rate', 'lateral_error', 'heading_error')
+"""
+
+from __future__ import annotations
+
+import inspect
+from collections.abc import Callable
+
+from fdikit.errors import ModelError
+from fdikit.model import FaultModel
+from fdikit.plants.path_vehicle import (
+    TABLE_2_1_EIGENVALUES_12,
+    TABLE_2_1_EIGENVALUES_14,
+    path_vehicle_12,
+    path_vehicle_14,
+    rounding_intervals,
+)
+from fdikit.plants.single_track import PRIUS_2010, SingleTrackParameters, single_track, understeer_gradient
+
+__all__ = [
+    "PLANTS",
+    "get_plant",
+    "path_vehicle_12",
+    "path_vehicle_14",
+    "rounding_intervals",
+    "TABLE_2_1_EIGENVALUES_12",
+    "TABLE_2_1_EIGENVALUES_14",
+    "SingleTrackParameters",
+    "PRIUS_2010",
+    "single_track",
+    "understeer_gradient",
+]
+
+#: Plant constructors by name; call with the plant's own keyword parameters.
+PLANTS: dict[str, Callable[..., FaultModel]] = {
+    "path12": path_vehicle_12,
+    "path14": path_vehicle_14,
+    "single-track": single_track,
+}
+
+
+def get_plant(name: str, **params) -> FaultModel:
+    """Build the benchmark plant called ``name`` with its keyword parameters.
+
+    Parameters
+    ----------
+    name : str
+        One of the keys of :data:`PLANTS` (``"path12"``, ``"path14"``, ``"single-track"``).
+    **params
+        Passed to the plant's constructor, e.g. ``speed=19.44, dt=0.01`` for
+        ``"single-track"``.
+
+    Raises
+    ------
+    ModelError
+        If ``name`` is not a known plant, or the parameters do not fit its constructor.
+    """
+    try:
+        factory = PLANTS[name]
+    except (KeyError, TypeError):
+        raise ModelError(f"unknown plant {name!r}; known plants: {', '.join(sorted(PLANTS))}") from None
+    signature = inspect.signature(factory)
+    try:
+        signature.bind(**params)
+    except TypeError as exc:
+        raise ModelError(f"bad parameters for plant {name!r}: {exc}; its signature is {name}{signature}") from None
+    return factory(**params)

@@ -1,0 +1,187 @@
+"""Linear single-track (bicycle) lateral model with lane-error states (van der Ploeg 2018, App. B).
+
+The lateral/yaw dynamics of a vehicle at constant longitudinal speed ``V_x``, augmented
+with the camera's lateral error ``y_e`` and heading error ``psi_e`` to the lane centre,
+eq. (B.12)::
+
+    d/dt [V_y, r, y_e, psi_e] = A [V_y, r, y_e, psi_e] + B delta + B_d [kappa, sin(phi)]
+    y = [r, y_e, psi_e]
+
+    A = [[(C_f + C_r)/(m V_x),        (C_f l_f - C_r l_r)/(m V_x) - V_x,  0,  0  ],
+         [(l_f C_f - l_r C_r)/(I_z V_x), (l_f² C_f + l_r² C_r)/(I_z V_x),   0,  0  ],
+         [-1,                          0,                                 0,  V_x],
+         [ 0,                         -1,                                 0,  0  ]]
+    B   = [-C_f/m, -l_f C_f/I_z, 0, 0]^T
+    B_d = [[0, g], [0, 0], [0, 0], [V_x, 0]]          (columns: curvature kappa, sin(bank phi))
+
+with ``r = psi'`` the yaw rate, ``delta`` the front-wheel steering angle (rad), ``kappa``
+the road curvature (1/m) and ``phi`` the road bank angle.  The lumped cornering
+stiffnesses ``C_f, C_r`` are **negative** (Table 4-1; the tyre force is ``F_y = -C alpha``
+with physical stiffness ``-C > 0``), which is the sign convention under which (B.8) as
+printed is the standard, stable bicycle model.
+
+Provenance: (B.8)–(B.11) of the thesis; (B.12) itself is garbled in the seed (``B``
+printed with 5 entries and without ``/I_z``, ``B_d`` missing a zero, ``C`` printed 4 x 4
+with a repeated row).  The matrices above are the reconstruction of research note
+§3.9, which agrees with (B.8)–(B.11): heading error ``psi_e' = V_x kappa - r`` (B.9),
+lateral error ``y_e' = -V_y + V_x psi_e`` (B.10), bank force ``m g sin(phi)`` in the
+lateral force balance (B.11).  Steering faults ``delta = f_m delta_set + f_a`` enter along
+``B`` (add them with :meth:`FaultModel.with_actuator_faults`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from fdikit.errors import ModelError
+from fdikit.model import FaultModel
+
+__all__ = [
+    "SingleTrackParameters",
+    "PRIUS_2010",
+    "single_track",
+    "understeer_gradient",
+    "STATES",
+    "OUTPUTS",
+    "CONTROLS",
+    "DISTURBANCES",
+]
+
+STATES: tuple[str, ...] = ("lateral_velocity", "yaw_rate", "lateral_error", "heading_error")
+OUTPUTS: tuple[str, ...] = ("yaw_rate", "lateral_error", "heading_error")
+CONTROLS: tuple[str, ...] = ("steering",)
+#: Road curvature kappa (1/m) and the sine of the road bank angle (sin(phi), dimensionless).
+DISTURBANCES: tuple[str, ...] = ("curvature", "bank")
+
+
+@dataclass(frozen=True)
+class SingleTrackParameters:
+    """Physical parameters of the single-track model (van der Ploeg 2018, Table 4-1).
+
+    Attributes
+    ----------
+    l_f, l_r : float
+        Distances from the centre of gravity to the front and rear axle (m).
+    m : float
+        Vehicle mass (kg).
+    I_z : float
+        Yaw moment of inertia (kg·m²).
+    C_f, C_r : float
+        Lumped front and rear axle cornering stiffnesses (N/rad), **negative** by the
+        thesis' sign convention.
+    g : float
+        Gravitational acceleration (m/s²).
+    """
+
+    l_f: float = 1.108
+    l_r: float = 1.592
+    m: float = 1625.0
+    I_z: float = 2865.61
+    C_f: float = -1.17e5
+    C_r: float = -1.43e5
+    g: float = 9.81
+
+    def __post_init__(self) -> None:
+        for name in ("l_f", "l_r", "m", "I_z", "g"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise ModelError(f"SingleTrackParameters.{name} must be a positive finite number, got {value!r}")
+        for name in ("C_f", "C_r"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value < 0):
+                raise ModelError(
+                    f"SingleTrackParameters.{name} must be negative (thesis convention F_y = -C alpha), got {value!r}; "
+                    f"pass -{abs(value)!r} for a physical stiffness of {abs(value)!r} N/rad"
+                )
+
+    @property
+    def wheelbase(self) -> float:
+        """``l_f + l_r`` (m)."""
+        return self.l_f + self.l_r
+
+
+#: Toyota Prius 2010 as identified by TNO (van der Ploeg 2018, Table 4-1).
+PRIUS_2010 = SingleTrackParameters()
+
+
+def understeer_gradient(params: SingleTrackParameters = PRIUS_2010) -> float:
+    """Understeer gradient ``K_u = m_f/c_f - m_r/c_r`` in rad/(m/s²), with ``c = -C > 0``.
+
+    ``m_f = m l_r / L`` and ``m_r = m l_f / L`` are the static axle loads (kg).  ``K_u > 0``
+    is understeer (stable at every speed; no critical speed).  For :data:`PRIUS_2010`
+    ``K_u = 0.003526`` rad/(m/s²) (research note §5.1; not printed in the thesis).
+    """
+    m_f = params.m * params.l_r / params.wheelbase
+    m_r = params.m * params.l_f / params.wheelbase
+    return m_f / -params.C_f - m_r / -params.C_r
+
+
+def single_track(speed: float, params: SingleTrackParameters = PRIUS_2010, dt: float | None = None) -> FaultModel:
+    """Single-track lateral model with lane errors at a constant speed (van der Ploeg 2018, (B.12)).
+
+    Parameters
+    ----------
+    speed : float
+        Longitudinal speed ``V_x`` in **m/s** (divide km/h by 3.6); must be positive.
+    params : SingleTrackParameters, optional
+        Vehicle parameters; default :data:`PRIUS_2010` (Table 4-1).
+    dt : float, optional
+        If given, the model is sampled with a zero-order hold at this period (s), as the
+        thesis does in (4.5) with ``h = 0.01``; otherwise it is continuous.
+
+    Returns
+    -------
+    FaultModel
+        States ``lateral_velocity`` (m/s), ``yaw_rate`` (rad/s), ``lateral_error`` (m),
+        ``heading_error`` (rad); outputs ``yaw_rate, lateral_error, heading_error``;
+        control ``steering`` (rad); disturbances ``curvature`` (1/m) and ``bank``
+        (= sin of the bank angle).
+
+    Raises
+    ------
+    ModelError
+        If ``speed`` is not a positive finite number (the model has ``1/V_x`` terms).
+
+    Examples
+    --------
+    >>> from fdikit.plants import single_track
+    >>> m = single_track(70 / 3.6)
+    >>> m.outputs
+    ('yaw_rate', 'lateral_error', 'heading_error')
+    >>> round(float(single_track(70 / 3.6, dt=0.01).A[0, 0]), 6)
+    0.919689
+    """
+    try:
+        v = float(speed)
+    except (TypeError, ValueError):
+        raise ModelError(f"speed must be a number in m/s, got {speed!r}") from None
+    if not (math.isfinite(v) and v > 0):
+        raise ModelError(
+            f"speed must be a positive finite longitudinal speed in m/s, got {speed!r}; "
+            "the single-track model divides by V_x (use e.g. 70 / 3.6 for 70 km/h)"
+        )
+    if not isinstance(params, SingleTrackParameters):
+        raise ModelError(f"params must be a SingleTrackParameters, got {type(params).__name__}")
+    p = params
+    a11 = (p.C_f + p.C_r) / (p.m * v)
+    a12 = (p.C_f * p.l_f - p.C_r * p.l_r) / (p.m * v) - v
+    a21 = (p.l_f * p.C_f - p.l_r * p.C_r) / (p.I_z * v)
+    a22 = (p.l_f**2 * p.C_f + p.l_r**2 * p.C_r) / (p.I_z * v)
+    A = np.array(
+        [
+            [a11, a12, 0.0, 0.0],
+            [a21, a22, 0.0, 0.0],
+            [-1.0, 0.0, 0.0, v],
+            [0.0, -1.0, 0.0, 0.0],
+        ]
+    )
+    Bu = np.array([[-p.C_f / p.m], [-p.l_f * p.C_f / p.I_z], [0.0], [0.0]])
+    Bd = np.array([[0.0, p.g], [0.0, 0.0], [0.0, 0.0], [v, 0.0]])
+    C = np.array([[0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
+    model = FaultModel(
+        A, C, Bu=Bu, Bd=Bd, states=STATES, outputs=OUTPUTS, controls=CONTROLS, disturbances=DISTURBANCES
+    )
+    return model if dt is None else model.discretize(dt)
