@@ -72,7 +72,9 @@ class ThresholdEvaluator:
     persistence : (k, n)
         Fire when ``k`` of the last ``n`` valid samples exceed (default (1, 1)).
     isolates : sequence, optional
-        Fault tied to each residual; defaults to the residuals' own ``isolates``.
+        Fault tied to each residual; :meth:`fit` takes it from the residuals when not
+        given, and :meth:`run` falls back to the residuals' own.  :meth:`step` sees bare
+        vectors, so online isolation needs it set (here or by :meth:`fit`).
 
     Examples
     --------

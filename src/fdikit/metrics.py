@@ -1,0 +1,145 @@
+"""Scores of a diagnosis against the truth: detection delay, false alarms, missed detection, isolation.
+
+Definitions (one trace):
+
+* the **fault label** is the first faulty truth label of the trace (``'none'`` if healthy);
+* a **false alarm** is an alarm that switches on at a sample whose truth is ``'none'``;
+  the rate is their number per hour of fault-free time;
+* **detection** is the first sample at or after the onset where the fault is active
+  and the alarm is on; the **delay** is its time minus the onset;
+* a **missed detection** is a faulty trace never detected while the fault is active;
+* the **isolated** fault is the first label other than ``'unknown'`` named while the
+  fault is active and the alarm on (``'unknown'`` if there is none);
+  isolation is correct when it equals the fault label.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+import numpy as np
+
+from fdikit.diagnosis import UNKNOWN_FAULT, Diagnosis
+from fdikit.errors import DataError
+from fdikit.faults import NO_FAULT
+from fdikit.trace import Trace
+
+__all__ = ["Score", "Summary", "score", "summarize", "confusion_matrix", "MISSED"]
+
+#: Column of the confusion matrix for a faulty trace that was never detected.
+MISSED = "missed"
+
+
+@dataclass(frozen=True)
+class Score:
+    """Scores of one trace (see the module docstring for the definitions)."""
+
+    label: str
+    onset: float | None
+    detected: bool
+    detection_delay: float | None
+    false_alarms: int
+    fault_free_hours: float
+    missed: bool
+    isolated: str
+    isolation_correct: bool | None
+
+    @property
+    def false_alarm_rate(self) -> float:
+        """False alarms per hour of fault-free time (NaN without fault-free time)."""
+        return self.false_alarms / self.fault_free_hours if self.fault_free_hours > 0 else float("nan")
+
+    @property
+    def outcome(self) -> str:
+        """Column of the confusion matrix: the isolated fault, ``'missed'``, or ``'none'``."""
+        if self.label == NO_FAULT:
+            return NO_FAULT if self.false_alarms == 0 else self.isolated
+        return MISSED if self.missed else self.isolated
+
+
+def score(truth: Trace | np.ndarray, diagnosis: Diagnosis) -> Score:
+    """Score one diagnosis against a trace (or its per-sample truth labels)."""
+    labels = truth.fault if isinstance(truth, Trace) else np.asarray(truth, dtype=str)
+    t = diagnosis.t
+    if labels.shape != t.shape:
+        raise DataError(f"truth has {labels.size} samples but the diagnosis {t.size}; score the trace it was run on")
+    healthy = labels == NO_FAULT
+    dt = float(np.median(np.diff(t))) if t.size > 1 else 0.0
+    rises = np.array([a.index for a in diagnosis.alarms], dtype=int)
+    false_alarms = int(healthy[rises].sum()) if rises.size else 0
+    hours = healthy.sum() * dt / 3600.0
+    faulty = np.flatnonzero(~healthy)
+    if faulty.size == 0:
+        first_fa = next((a for a in diagnosis.alarms if healthy[a.index]), None)
+        return Score(NO_FAULT, None, False, None, false_alarms, hours, False,
+                     first_fa.fault if first_fa else NO_FAULT, None)
+    label, onset_idx = str(labels[faulty[0]]), int(faulty[0])
+    onset = float(t[onset_idx])
+    hit = (~healthy) & diagnosis.alarm
+    hit[:onset_idx] = False
+    det = np.flatnonzero(hit)
+    if det.size == 0:
+        return Score(label, onset, False, None, false_alarms, hours, True, NO_FAULT, False)
+    named = det[diagnosis.isolated[det] != UNKNOWN_FAULT]
+    isolated = str(diagnosis.isolated[named[0]]) if named.size else UNKNOWN_FAULT
+    return Score(label, onset, True, float(t[det[0]] - onset), false_alarms, hours, False, isolated,
+                 isolated == label)
+
+
+@dataclass(frozen=True)
+class Summary:
+    """Aggregate over many traces."""
+
+    runs: int
+    faulty_runs: int
+    detection_rate: float
+    missed_rate: float
+    mean_delay: float
+    median_delay: float
+    false_alarms: int
+    false_alarm_rate: float
+    isolation_accuracy: float
+    confusion: object  # pandas.DataFrame
+
+    def as_dict(self) -> dict:
+        d = {k: getattr(self, k) for k in self.__dataclass_fields__ if k != "confusion"}
+        return d
+
+
+def confusion_matrix(scores: Iterable[Score]):
+    """Counts of true label (rows) vs outcome (columns: isolated fault, ``'unknown'``, ``'missed'``, ``'none'``)."""
+    import pandas as pd
+
+    scores = list(scores)
+    rows = sorted({s.label for s in scores})
+    cols = sorted({s.outcome for s in scores} | set(rows))
+    df = pd.DataFrame(0, index=pd.Index(rows, name="true"), columns=pd.Index(cols, name="diagnosed"))
+    for s in scores:
+        df.loc[s.label, s.outcome] += 1
+    return df
+
+
+def summarize(scores: Iterable[Score]) -> Summary:
+    """Rates and means over traces; the false-alarm rate pools fault-free time over all runs."""
+    scores = list(scores)
+    if not scores:
+        raise DataError("no scores to summarise")
+    faulty = [s for s in scores if s.label != NO_FAULT]
+    delays = np.array([s.detection_delay for s in faulty if s.detected], dtype=float)
+    hours = sum(s.fault_free_hours for s in scores)
+    fa = sum(s.false_alarms for s in scores)
+    detected = [s for s in faulty if s.detected]
+    nan = float("nan")
+    return Summary(
+        runs=len(scores),
+        faulty_runs=len(faulty),
+        detection_rate=len(detected) / len(faulty) if faulty else nan,
+        missed_rate=sum(s.missed for s in faulty) / len(faulty) if faulty else nan,
+        mean_delay=float(delays.mean()) if delays.size else nan,
+        median_delay=float(np.median(delays)) if delays.size else nan,
+        false_alarms=fa,
+        false_alarm_rate=fa / hours if hours > 0 else nan,
+        isolation_accuracy=sum(bool(s.isolation_correct) for s in detected) / len(detected) if detected else nan,
+        confusion=confusion_matrix(scores),
+    )

@@ -1,0 +1,61 @@
+"""Plots of residuals, thresholds, alarms and the fault onset."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from fdikit.diagnosis import Diagnosis
+from fdikit.residuals import Residuals
+
+__all__ = ["plot_residuals"]
+
+
+def plot_residuals(
+    residuals: Residuals,
+    diagnosis: Diagnosis | None = None,
+    thresholds: np.ndarray | None = None,
+    center: np.ndarray | None = None,
+    onset: float | None = None,
+    names: Sequence[str] | None = None,
+    title: str | None = None,
+    path: str | Path | None = None,
+):
+    """One panel per residual with its threshold band, alarm samples and the fault onset.
+
+    Returns the matplotlib figure; writes it to ``path`` (PNG, PDF ...) when given.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    names = list(names or residuals.names)
+    idx = [residuals.names.index(n) for n in names]
+    fig, axes = plt.subplots(len(idx), 1, sharex=True, figsize=(9, 1.6 * len(idx) + 0.8), squeeze=False)
+    for ax, j in zip(axes[:, 0], idx):
+        ax.plot(residuals.t, residuals.r[:, j], lw=0.7, color="tab:blue")
+        c = 0.0 if center is None else float(np.broadcast_to(center, (len(residuals.names),))[j])
+        if thresholds is not None:
+            tau = float(np.broadcast_to(thresholds, (len(residuals.names),))[j])
+            for s in (-1, 1):
+                ax.axhline(c + s * tau, color="tab:red", ls="--", lw=0.8)
+        if diagnosis is not None:
+            hit = diagnosis.fired[:, j]
+            ax.plot(residuals.t[hit], residuals.r[hit, j], ".", ms=2, color="tab:red")
+        if onset is not None:
+            ax.axvline(onset, color="k", lw=0.8, ls=":")
+        ax.set_ylabel(residuals.names[j], rotation=0, ha="right", fontsize=8)
+        ax.tick_params(labelsize=7)
+    axes[-1, 0].set_xlabel("time [s]")
+    if title:
+        fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    if path is not None:
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fig.savefig(path, dpi=120)
+        plt.close(fig)
+    return fig
