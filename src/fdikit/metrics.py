@@ -68,7 +68,7 @@ def score(truth: Trace | np.ndarray, diagnosis: Diagnosis) -> Score:
     dt = float(np.median(np.diff(t))) if t.size > 1 else 0.0
     rises = np.array([a.index for a in diagnosis.alarms], dtype=int)
     false_alarms = int(healthy[rises].sum()) if rises.size else 0
-    hours = healthy.sum() * dt / 3600.0
+    hours = float(healthy.sum() * dt / 3600.0)
     faulty = np.flatnonzero(~healthy)
     if faulty.size == 0:
         first_fa = next((a for a in diagnosis.alarms if healthy[a.index]), None)
