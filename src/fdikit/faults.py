@@ -199,7 +199,9 @@ class Intermittent(Fault):
 
     def active(self, t: np.ndarray) -> np.ndarray:
         t = np.asarray(t, dtype=float)
-        phase = np.mod(t - self.onset, self.period)
+        # a relative tolerance keeps samples that fall on a phase boundary on the right side of it
+        tol = 1e-9 * self.period
+        phase = np.mod(t - self.onset + tol, self.period)
         return super().active(t) & (phase < self.duty * self.period)
 
     def _faulty(self, t, v, mask, rng):
@@ -288,7 +290,10 @@ _KINDS = {
     "noise": (Noise, "std"),
     "intermittent": (Intermittent, "size"),
 }
-_SPEC = re.compile(r"^(?P<kind>\w+):(?P<target>[\w.]+)(?::(?P<value>[^@]*))?(?:@(?P<onset>[^-@]+)(?:-(?P<end>.+))?)?$")
+_NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+_SPEC = re.compile(
+    rf"^(?P<kind>\w+):(?P<target>[\w.]+)(?::(?P<value>[^@]*))?(?:@(?P<onset>{_NUM})(?:-(?P<end>{_NUM}))?)?$"
+)
 
 
 def parse_fault(spec: str) -> Fault:

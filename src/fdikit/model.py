@@ -62,10 +62,12 @@ def _matrix(name: str, value, rows: int | None, cols: int | None) -> np.ndarray:
         out = np.zeros((rows, cols))
     else:
         out = np.array(value, dtype=float, copy=True)
+        if out.ndim == 0:
+            out = out.reshape(1, 1)
         if out.ndim == 1 and cols == 1:
             out = out.reshape(-1, 1)
-        if out.ndim == 0 or out.size == 0:
-            out = out.reshape(rows or 0, cols or 0)
+        if out.size == 0:
+            out = np.zeros((rows if rows is not None else 0, cols if cols is not None else 0))
         if out.ndim != 2:
             raise ModelError(f"{name} must be a 2-D matrix, got an array with {out.ndim} dimensions")
         if rows is not None and out.shape[0] != rows:

@@ -154,11 +154,14 @@ class ResidualGenerator:
         Ad, Bd, Cd, Dd, _ = scipy.signal.cont2discrete((self.A, self.B, self.C, self.D), dt, method="zoh")
         return ResidualGenerator(Ad, Bd, Cd, Dd, self.controls, self.outputs, self.residuals, dt, self.isolates)
 
+    def _check_dt(self, dt: float) -> None:
+        if self.dt is not None and not np.isclose(dt, self.dt, rtol=1e-6):
+            raise DataError(f"data sampled at dt={dt:g} but the generator is discrete with dt={self.dt:g}; resample")
+
     def _for_dt(self, dt: float) -> ResidualGenerator:
         if self.dt is None:
             return self.discretize(dt)
-        if not np.isclose(dt, self.dt, rtol=1e-6):
-            raise DataError(f"data sampled at dt={dt:g} but the generator is discrete with dt={self.dt:g}; resample")
+        self._check_dt(dt)
         return self
 
     def inputs_from(self, trace: Trace) -> np.ndarray:
@@ -271,6 +274,8 @@ class ResidualStepper:
 
     def run(self, trace: Trace) -> Residuals:
         """Step through a whole trace (the loop ``run()`` vectorises); bad samples become invalid."""
+        if len(trace) > 1:
+            self.generator._check_dt(trace.dt)
         v = self.generator.inputs_from(trace)
         mu = len(self.generator.controls)
         r = np.empty((len(trace), len(self.generator.residuals)))

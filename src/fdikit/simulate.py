@@ -77,6 +77,9 @@ def _covariance(name: str, value, k: int) -> np.ndarray | None:
     """Covariance from None, a scalar/vector of standard deviations, or a k x k matrix."""
     if value is None:
         return None
+    if k == 0:
+        raise DataError(f"{name} was given but there is no signal for it (the model has no noise inputs w); "
+                        "add a noise group (FaultModel(..., Bw=..., noise=[...])) or omit it")
     arr = np.asarray(value, dtype=float)
     if arr.ndim <= 1:
         std = np.broadcast_to(arr, (k,)) if arr.size in (1, k) else None
@@ -162,31 +165,38 @@ def simulate(
             raise DataError("simulation times t must be uniformly spaced")
     N = t.size
     h = float(t[1] - t[0]) if N > 1 else float(dt or 1.0)
+    if isinstance(plant, FaultModel) and plant.is_discrete and N > 1 and not np.isclose(h, plant.dt, rtol=1e-9):
+        raise DataError(f"t is spaced {h:g} s but the discrete plant runs at dt={plant.dt:g} s; give t at its dt")
     scenario = (scenario or FaultScenario()).resolve(outputs, controls)
+    # independent streams: adding a fault or a noise source never shifts the others' draws
+    rng_w, rng_v, *rng_f = rng.spawn(2 + len(scenario))
 
     u_cmd = _signal("u", u, t, controls)
     u_act = u_cmd.copy()
-    for f in scenario:
+    for f, rf in zip(scenario, rng_f):
         if f.location == "actuator":
             j = controls.index(f.target)
-            u_act[:, j] = f.apply(t, u_act[:, j], rng)
+            u_act[:, j] = f.apply(t, u_act[:, j], rf)
     d_arr = _signal("d", d, t, dists)
-    x0 = None if x0 is None else np.asarray(x0, dtype=float)
+    if x0 is not None:
+        x0 = np.asarray(x0, dtype=float)
+        if x0.shape != (len(states),):
+            raise DataError(f"x0 has shape {x0.shape}; need ({len(states)},), one value per state {list(states)}")
 
     if isinstance(plant, FaultModel):
         W = _covariance("noise_cov", noise_cov, len(plant.noise))
-        y, x = _simulate_linear(plant, h, t, u_act, d_arr, x0, W, rng)
+        y, x = _simulate_linear(plant, h, t, u_act, d_arr, x0, W, rng_w)
     else:
         W = _covariance("noise_cov", noise_cov, len(states))
-        y, x = _simulate_nonlinear(plant, t, h, u_act, x0, W, rng, method, substeps)
+        y, x = _simulate_nonlinear(plant, t, h, u_act, x0, W, rng_w, method, substeps)
 
     R = _covariance("measurement_noise", measurement_noise, len(outputs))
     if R is not None:
-        y = y + _gaussian(rng, R, N)
-    for f in scenario:
+        y = y + _gaussian(rng_v, R, N)
+    for f, rf in zip(scenario, rng_f):
         if f.location == "sensor":
             j = outputs.index(f.target)
-            y[:, j] = f.apply(t, y[:, j], rng)
+            y[:, j] = f.apply(t, y[:, j], rf)
 
     info = {"plant": repr(plant), "seed": None if seed is None else int(seed), "scenario": scenario.label,
             "faults": [repr(f) for f in scenario]}

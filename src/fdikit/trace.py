@@ -91,9 +91,16 @@ class Trace:
             raise DataError("a trace with fewer than 2 samples has no sample time")
         return float(np.median(np.diff(self.t)))
 
+    def names_of(self, kind: str) -> tuple[str, ...]:
+        """Column names of block ``kind`` (``'u'``, ``'y'``, ``'x'`` or ``'d'``)."""
+        names = {"u": self.controls, "y": self.outputs, "x": self.states, "d": self.disturbances}.get(kind)
+        if names is None:
+            raise DataError(f"unknown signal kind {kind!r}; use 'u', 'y', 'x' or 'd'")
+        return names
+
     def signal(self, name: str, kind: str = "y") -> np.ndarray:
         """One column by name; ``kind`` is ``'u'``, ``'y'``, ``'x'`` or ``'d'``."""
-        names = {"u": self.controls, "y": self.outputs, "x": self.states, "d": self.disturbances}[kind]
+        names = self.names_of(kind)
         if name not in names:
             raise DataError(f"the trace has no {kind}-signal named {name!r}; it has {list(names)}")
         return getattr(self, kind)[:, names.index(name)]
@@ -105,11 +112,11 @@ class Trace:
     def check_finite(self, signals: Sequence[str] = ("u", "y")) -> None:
         """Raise :class:`DataError` naming the first NaN/inf sample of the given blocks."""
         for kind in signals:
+            names = self.names_of(kind)
             block = getattr(self, kind)
             bad = np.argwhere(~np.isfinite(block))
             if bad.size:
                 k, j = bad[0]
-                names = {"u": self.controls, "y": self.outputs, "x": self.states, "d": self.disturbances}[kind]
                 raise DataError(
                     f"trace has a non-finite value in {kind}-signal {names[j]!r} at sample {k} (t={self.t[k]:g}); "
                     f"{int((~np.isfinite(block)).sum())} bad values in all. Clean or interpolate the data, or "
