@@ -76,7 +76,7 @@ def main() -> None:
           f"control {control.__version__}, Python {platform.python_version()}, {platform.machine()}")
     print(f"12-state residual generator, {gen.B.shape[1]} inputs, {len(gen.residuals)} residuals, {N} samples, "
           f"best of {args.repeat}\n")
-    print(f"| method | time [s] | samples/s | peak memory [MiB] | time / fdikit batch | max rel. diff vs dlsim |")
+    print("| method | time [s] | samples/s | peak memory [MiB] | time / fdikit batch | max rel. diff vs dlsim |")
     print("|---|---|---|---|---|---|")
     base = results["fdikit ResidualGenerator.run (batch)"][0]
     for name, (t, mem, out) in results.items():
