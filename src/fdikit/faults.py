@@ -15,7 +15,7 @@ Examples
 --------
 >>> from fdikit.faults import Bias, FaultScenario
 >>> scenario = FaultScenario([Bias("yaw_rate", 0.02, onset=10.0)], label="gyro bias")
->>> scenario.faults[0].name
+>>> scenario.resolve(outputs=["yaw_rate", "speed"], controls=["steering"]).faults[0].name
 'yaw_rate_sensor'
 """
 
