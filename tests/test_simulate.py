@@ -16,6 +16,7 @@ import scipy.stats
 from fdikit import DataError, FaultModel, ModelError
 from fdikit.faults import Bias, FaultScenario
 from fdikit.simulate import NonlinearPlant, simulate, time_grid
+from reference import state_space_loop
 
 A_C = np.array([[0.0, 1.0, 0.0], [-4.0, -0.6, 0.8], [0.0, 0.3, -2.0]])
 BU_C = np.array([[0.0, 0.0], [1.0, -0.5], [0.2, 1.0]])
@@ -43,13 +44,8 @@ def _zoh_loop(A, B, C, D, v, x0, dt=None):
     """Independent exact recursion: scipy's ZOH (when dt given) and a plain Python loop."""
     if dt is not None:
         A, B, C, D, _ = scipy.signal.cont2discrete((A, B, C, D), dt, method="zoh")
-    x = np.array(x0, dtype=float)
-    X, Y = [], []
-    for vk in v:
-        X.append(x.copy())
-        Y.append(C @ x + D @ vk)
-        x = A @ x + B @ vk
-    return np.array(Y), np.array(X)
+    y, x, _ = state_space_loop(A, B, C, D, v, x0)
+    return y, x
 
 
 # ---------------------------------------------------------------------------------------------- linear plants
