@@ -236,7 +236,25 @@ def _matrices_14() -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
     return {k: tuple(v) for k, v in out.items()}
 
 
-def path_vehicle_12() -> FaultModel:
+def _with_tiny(m: dict, tiny: str) -> dict[str, np.ndarray]:
+    """Printed values; with ``tiny='midpoint'`` entries printed ``±0.00`` become ``±0.0025``.
+
+    The report's ``-0.00`` entries are nonzero couplings below the print precision; the
+    most important are the brake-torque column of ``C`` (the report calls the brake "very
+    weakly observable", §4.1).  With them at zero ``C`` of the 12-state model has rank 11
+    and no sensor fault can be written as a state fault (``C F¹ = e_i`` has no solution);
+    the midpoint of each rounding interval (half the last printed digit, with the printed
+    sign) restores full rank.  This is an assumption, not report data (research note G3).
+    """
+    if tiny not in ("zero", "midpoint"):
+        raise ModelError(f"tiny must be 'zero' or 'midpoint', got {tiny!r}")
+    out = {}
+    for key, (value, lo, hi) in m.items():
+        out[key] = value if tiny == "zero" else np.where((value == 0) & (lo != hi), (lo + hi) / 2, value)
+    return out
+
+
+def path_vehicle_12(tiny: str = "zero") -> FaultModel:
     """12-state PATH vehicle model for sensor-fault design (Douglas et al. 1996, App. D, (d.2a–d)).
 
     Continuous time, linearised in a 0.005 rad, 24.87 m/s constant-radius turn and
@@ -249,6 +267,9 @@ def path_vehicle_12() -> FaultModel:
     States ``m_a, omega_e, v_x, v_y, v_z, z, phi, phi_dot, theta, theta_dot, eps_dot,
     tau_b``; outputs :data:`OUTPUTS`; controls ``throttle`` (deg), ``brake`` (N·m),
     ``steering`` (rad).
+
+    ``tiny='midpoint'`` restores the entries printed ``±0.00`` as ``±0.0025`` (an
+    assumption; needed for sensor-fault detection filters, see :func:`_with_tiny`).
 
     Data are reconstructed from the OCR'd report and **rounded to 2 decimals** in the
     original; see the module docstring for the transcription choices and
@@ -263,14 +284,14 @@ def path_vehicle_12() -> FaultModel:
     >>> m.n, m.p, m.controls
     (12, 12, ('throttle', 'brake', 'steering'))
     """
-    m = _matrices_12()
+    m = _with_tiny(_matrices_12(), tiny)
     return FaultModel(
-        m["A"][0], m["C"][0], Bu=m["Bu"][0], Du=m["Du"][0],
+        m["A"], m["C"], Bu=m["Bu"], Du=m["Du"],
         states=STATES_12, outputs=OUTPUTS, controls=CONTROLS,
     )
 
 
-def path_vehicle_14() -> FaultModel:
+def path_vehicle_14(tiny: str = "zero") -> FaultModel:
     """14-state PATH vehicle model for actuator-fault design (Douglas et al. 1996, App. D, (d.1a–d)).
 
     As :func:`path_vehicle_12` but with the first-order throttle (``alpha``, pole
@@ -292,9 +313,9 @@ def path_vehicle_14() -> FaultModel:
     >>> m.n, m.states[11], m.is_discrete
     (14, 'alpha', False)
     """
-    m = _matrices_14()
+    m = _with_tiny(_matrices_14(), tiny)
     return FaultModel(
-        m["A"][0], m["C"][0], Bu=m["Bu"][0], Du=m["Du"][0],
+        m["A"], m["C"], Bu=m["Bu"], Du=m["Du"],
         states=STATES_14, outputs=OUTPUTS, controls=CONTROLS,
     )
 
