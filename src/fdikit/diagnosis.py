@@ -96,20 +96,43 @@ def alarm_events(t, alarm, fired, names, isolated) -> tuple[Alarm, ...]:
     )
 
 
-def isolate(fired: np.ndarray, isolates: tuple[str | None, ...]) -> np.ndarray:
+def isolate(
+    fired: np.ndarray, isolates: tuple[str | None, ...], groups: tuple[str, ...] | None = None
+) -> np.ndarray:
     """Per-sample isolated fault from per-residual decisions.
 
     Single-fault logic of Douglas et al. 1996 §1 ("no announcement when more than one
     residual crosses"): the fault is named when every fired residual is tied to the
     same fault; other patterns are ``'unknown'``; no fired residual is ``'none'``.
+
+    With ``groups`` (the filter of each residual, for a bank of filters) the bank logic
+    of §1 applies: a filter whose fired residuals point to two or more faults is
+    discarded (the fault is outside its design set); the fault is named when the
+    remaining filters that point to one fault all point to the same one.
     """
     fired = np.asarray(fired, bool)
-    out = np.full(fired.shape[0], NO_FAULT, dtype=object)
+    N = fired.shape[0]
+    out = np.full(N, NO_FAULT, dtype=object)
     any_ = fired.any(axis=1)
     out[any_] = UNKNOWN_FAULT
-    labels = sorted({f for f in isolates if f is not None})
-    tied = np.array([[iso == f for iso in isolates] for f in labels], bool).reshape(len(labels), len(isolates))
-    for f, cols in zip(labels, tied):
-        only_f = any_ & ~(fired & ~cols).any(axis=1)
-        out[only_f] = f
+    if groups is None:
+        groups = ("",) * len(isolates)
+    # per filter: which of its faults fired (an untied residual counts as a fault of its own)
+    candidate = np.full(N, "", dtype=object)
+    conflict = np.zeros(N, bool)
+    for g in dict.fromkeys(groups):
+        cols = [k for k, gg in enumerate(groups) if gg == g]
+        keys = sorted({isolates[k] if isolates[k] is not None else f"?{k}" for k in cols})
+        per = np.column_stack([
+            fired[:, [k for k in cols if (isolates[k] if isolates[k] is not None else f"?{k}") == key]].any(axis=1)
+            for key in keys
+        ])
+        single = per.sum(axis=1) == 1
+        name = np.array(keys, dtype=object)[per.argmax(axis=1)]
+        vote = single & np.array([not str(x).startswith("?") for x in name])
+        unknown_vote = single & ~vote
+        conflict |= unknown_vote | (vote & (candidate != "") & (candidate != name))
+        candidate = np.where(vote & (candidate == ""), name, candidate)
+    ok = any_ & (candidate != "") & ~conflict
+    out[ok] = candidate[ok]
     return out.astype(str)

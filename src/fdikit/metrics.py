@@ -8,8 +8,10 @@ Definitions (one trace):
 * **detection** is the first sample at or after the onset where the fault is active
   and the alarm is on; the **delay** is its time minus the onset;
 * a **missed detection** is a faulty trace never detected while the fault is active;
-* the **isolated** fault is the first label other than ``'unknown'`` named while the
-  fault is active and the alarm on (``'unknown'`` if there is none);
+* the **isolated** fault is the label other than ``'unknown'`` named most often while the
+  fault is active and the alarm on (the earliest on a tie; ``'unknown'`` if there is none) —
+  a transient confusion, such as the air-mass fault rate leaking into the throttle
+  residual (Douglas et al. 1996, Fig. 5.5), does not decide the isolation;
   isolation is correct when it equals the fault label.
 """
 
@@ -81,8 +83,12 @@ def score(truth: Trace | np.ndarray, diagnosis: Diagnosis) -> Score:
     det = np.flatnonzero(hit)
     if det.size == 0:
         return Score(label, onset, False, None, false_alarms, hours, True, NO_FAULT, False)
-    named = det[diagnosis.isolated[det] != UNKNOWN_FAULT]
-    isolated = str(diagnosis.isolated[named[0]]) if named.size else UNKNOWN_FAULT
+    named = diagnosis.isolated[det][diagnosis.isolated[det] != UNKNOWN_FAULT]
+    if named.size:
+        labels, first, counts = np.unique(named, return_index=True, return_counts=True)
+        isolated = str(labels[np.lexsort((first, -counts))[0]])
+    else:
+        isolated = UNKNOWN_FAULT
     return Score(label, onset, True, float(t[det[0]] - onset), false_alarms, hours, False, isolated,
                  isolated == label)
 

@@ -75,6 +75,9 @@ class ThresholdEvaluator:
         Fault tied to each residual; :meth:`fit` takes it from the residuals when not
         given, and :meth:`run` falls back to the residuals' own.  :meth:`step` sees bare
         vectors, so online isolation needs it set (here or by :meth:`fit`).
+    groups : sequence, optional
+        The filter each residual belongs to, for a bank: filters whose residuals point to
+        two or more faults are discarded (:func:`fdikit.diagnosis.isolate`).
 
     Examples
     --------
@@ -88,7 +91,9 @@ class ThresholdEvaluator:
     3.3
     """
 
-    def __init__(self, thresholds=None, center=None, persistence: tuple[int, int] = (1, 1), isolates=None) -> None:
+    def __init__(
+        self, thresholds=None, center=None, persistence: tuple[int, int] = (1, 1), isolates=None, groups=None
+    ) -> None:
         k, n = persistence
         if not (1 <= k <= n):
             raise ModelError(f"persistence (k, n) needs 1 <= k <= n, got {persistence}")
@@ -98,6 +103,7 @@ class ThresholdEvaluator:
             raise ModelError(f"thresholds must be positive, got {self.thresholds}")
         self.center = None if center is None else np.atleast_1d(np.asarray(center, dtype=float))
         self.isolates = None if isolates is None else tuple(isolates)
+        self.groups = None if groups is None else tuple(groups)
         self.names: tuple[str, ...] | None = None
         self.alpha: float | None = None
         self.reset()
@@ -173,7 +179,7 @@ class ThresholdEvaluator:
         fired = np.zeros((len(residuals), q), bool)
         has = pos >= 0
         fired[has] = fired_v[pos[has]]
-        isolated = isolate(fired, iso)
+        isolated = isolate(fired, iso, self.groups)
         return Diagnosis(
             residuals.t, fired.any(axis=1), fired, residuals.names, isolated, valid=valid,
             meta={"evaluator": "threshold", "thresholds": tau.tolist(), "persistence": list(self.persistence)},
@@ -197,7 +203,7 @@ class ThresholdEvaluator:
             fired = np.sum(self._window, axis=0) >= self.persistence[0]
             self._last = fired
             valid = True
-        fault = str(isolate(fired[None, :], iso)[0])
+        fault = str(isolate(fired[None, :], iso, self.groups)[0])
         return StepDecision(bool(fired.any()), fault, fired.copy(), valid)
 
     def __repr__(self) -> str:
