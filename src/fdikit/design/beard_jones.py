@@ -162,7 +162,7 @@ def _select(V_blocks: list[np.ndarray], pair: list[bool], sweeps: int, rng: np.r
 
     best, best_val = list(coef), smin(coef)
     for _ in range(sweeps):
-        for j, (Qb, is_pair) in enumerate(zip(Q, pair)):
+        for j, Qb in enumerate(Q):
             if len(Q) > 1:
                 U, s, _ = np.linalg.svd(matrix(coef, skip=j), full_matrices=True)
                 r = int((s > 1e-12 * max(s[0], 1e-300)).sum())
@@ -321,8 +321,8 @@ def beard_jones(
         keys = list(spaces)
         what = ", ".join(f"({keys[i]}, {keys[j]})" for i, j in pairs) or f"the set {keys} (no pair alone)"
         raise DesignError(
-            f"faults not output separable: {what}; their output images C T_i are dependent. Keep only the magnitude direction of a sensor fault "
-            "('<output>:magnitude'), or put them in different filters"
+            f"faults not output separable: {what}; their output images C T_i are dependent. Keep only the "
+            "magnitude direction of a sensor fault ('<output>:magnitude'), or put them in different filters"
         )
     mutual, joint, union = linalg.mutually_detectable(A, C, list(maps.values()))
     if not mutual:
