@@ -18,6 +18,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
+import scipy.linalg
 
 from fdikit.errors import DesignError, ModelError
 from fdikit.model import FaultModel
@@ -95,7 +96,8 @@ def intersect(U: np.ndarray, V: np.ndarray, rtol: float | None = None) -> np.nda
 def contains(U: np.ndarray, x: np.ndarray, rtol: float = 1e-8) -> bool:
     """Whether every column of ``x`` lies in ``Im U`` (relative residual below ``rtol``)."""
     Q = orth(U)
-    x = np.atleast_2d(x.T).T
+    x = np.asarray(x)
+    x = x.reshape(-1, 1) if x.ndim == 1 else x
     res = x - Q @ (Q.conj().T @ x)
     return bool(np.linalg.norm(res) <= rtol * max(np.linalg.norm(x), _EPS))
 
@@ -165,27 +167,72 @@ def caisa(A: np.ndarray, C: np.ndarray, F: np.ndarray, rtol: float | None = None
 
 
 def invariant_zeros(
-    A: np.ndarray, C: np.ndarray, F: np.ndarray
+    A: np.ndarray, C: np.ndarray, F: np.ndarray, rtol: float | None = None
 ) -> tuple[np.ndarray, list[np.ndarray]]:
     """Invariant zeros of ``(C, A, F)`` and their state directions.
 
     The zeros are the finite generalised eigenvalues of the Rosenbrock pencil
-    ``[[A − sI, F], [C, 0]]``, computed by slycot's ``ab08nd`` (via python-control) for
-    the non-square case.  For each zero ``z`` the direction is the state part ``x`` of
-    the null space of ``[[A − zI, F], [C, 0]]`` (complex for a complex zero).
+    ``[[A − sI, F], [C, 0]]``, computed by SLICOT ``AB08ND`` (slycot) for square and
+    non-square systems alike.  ``rtol`` is AB08ND's rank-decision tolerance (reciprocal
+    condition bound); the default ``1e3 · (n + max(p, k)) · eps`` scales with the pencil's
+    size.  (AB08ND's own default, ``sqrt((n+p)(n+k)) · eps``, misses zeros of ordinary
+    badly conditioned systems.)
+
+    For each zero ``z`` the direction is the state part ``x`` of a null vector of
+    ``[[A − zI, F], [C, 0]]`` (complex for a complex zero), unit norm.  Zeros that repeat
+    (within ``1e-6`` relative to the pencil's norm) form a cluster whose directions span
+    its whole generalised zero space: independent null vectors when the zero has several
+    directions, and Jordan-chain vectors ``(A − zI) x₂ + F η₂ = x₁, C x₂ = 0`` when it is
+    defective.  So ``span(directions)`` is always the invariant-zero subspace ``V`` that
+    :func:`detection_space` adds to ``W*``.
     """
-    import control
+    from slycot import ab08nd
 
     A, C, F = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (A, C, F))
     n, k, p = A.shape[0], F.shape[1], C.shape[0]
-    sys = control.ss(A, F, C, np.zeros((p, k)))
-    zeros = np.asarray(sys.zeros(), dtype=complex)
-    dirs = []
-    for z in zeros:
-        P = np.block([[A - z * np.eye(n), F], [C, np.zeros((p, k))]])
-        x = np.linalg.svd(P)[2][-1].conj()[:n]  # right singular vector of the smallest singular value
-        dirs.append(x / max(np.linalg.norm(x), _EPS))
-    return zeros, dirs
+    if n == 0:
+        return np.zeros(0, dtype=complex), []
+    tol = rtol if rtol is not None else 1e3 * (n + max(p, k)) * _EPS
+    out = ab08nd(n, k, p, A, F, C, np.zeros((p, k)), equil="N", tol=tol)
+    nu = out[0]
+    if nu == 0:
+        return np.zeros(0, dtype=complex), []
+    zeros = np.asarray(scipy.linalg.eigvals(out[8][:nu, :nu], out[9][:nu, :nu]), dtype=complex)
+    zeros = zeros[np.isfinite(zeros)]
+    return zeros, _zero_directions(A, C, F, zeros)
+
+
+def _zero_directions(A: np.ndarray, C: np.ndarray, F: np.ndarray, zeros: np.ndarray) -> list[np.ndarray]:
+    """Directions of ``zeros`` (see :func:`invariant_zeros`): one unit vector per zero, clusters spanning V."""
+    n, k, p = A.shape[0], F.shape[1], C.shape[0]
+    M = np.block([[A, F], [C, np.zeros((p, k))]])
+    E = np.zeros_like(M)
+    E[:n, :n] = np.eye(n)
+    scale = max(np.linalg.norm(M, 2), 1.0)
+    dirs: list[np.ndarray | None] = [None] * len(zeros)
+    todo = list(range(len(zeros)))
+    while todo:
+        i = todo[0]
+        members = [j for j in todo if abs(zeros[j] - zeros[i]) <= 1e-6 * scale]
+        todo = [j for j in todo if j not in members]
+        m, z = len(members), np.mean(zeros[members])
+        if abs(z.imag) <= 1e-6 * scale:  # a real cluster: keep its directions real
+            z = complex(z.real)
+        P = M - z * E
+        # chains of length m: P v1 = 0, P v2 = E v1, ..., stacked as a block-bidiagonal matrix
+        K = np.kron(np.eye(m), P) - np.kron(np.eye(m, k=-1), E)
+        _, s, Vh = np.linalg.svd(K)
+        s = np.concatenate([s, np.zeros(Vh.shape[0] - s.size)])
+        keep = np.flatnonzero(s <= 1e-8 * max(s[0], _EPS))
+        keep = np.union1d(keep, np.arange(Vh.shape[0] - m, Vh.shape[0]))  # at least m null vectors
+        N = Vh[keep].conj().T
+        X = np.hstack([N[b * (n + k) : b * (n + k) + n] for b in range(m)])
+        U = np.linalg.svd(X)[0][:, :m]
+        if z.imag == 0:
+            U = U.real if np.abs(U.imag).max() <= 1e-12 else np.linalg.svd(np.hstack([X.real, X.imag]))[0][:, :m]
+        for j, col in zip(members, U.T):
+            dirs[j] = col / max(np.linalg.norm(col), _EPS)
+    return dirs
 
 
 def _real_span(vectors: Sequence[np.ndarray], n: int) -> np.ndarray:
