@@ -37,13 +37,27 @@ def test_simulate_bad_input():
     assert res.exit_code == 2 and "kind:target" in res.output
 
 
-def test_demo(tmp_path):
-    res = runner.invoke(app, ["demo", "--out", str(tmp_path)])
+def test_demo_bank(tmp_path):
+    """The default demo: the PATH bank isolates a yaw-rate gyro bias and a throttle fault."""
+    res = runner.invoke(app, ["demo", "--out", str(tmp_path)], terminal_width=200)
+    assert res.exit_code == 0, res.output
+    assert "yaw_rate_sensor" in res.output and "throttle_actuator" in res.output
+    assert res.output.count("True") == 2
+    for name in ("report.png", "structure.png"):
+        assert (tmp_path / name).stat().st_size > 10_000
+    tr = Trace.load(tmp_path / "trace_throttle.parquet")
+    assert np.isclose(tr.fault_onset, 10.0) and set(tr.fault) == {"none", "throttle_actuator"}
+
+
+def test_demo_kalman(tmp_path):
+    res = runner.invoke(app, ["demo", "--method", "kalman", "--out", str(tmp_path)], terminal_width=200)
     assert res.exit_code == 0, res.output
     assert "yaw_rate_sensor" in res.output
     assert (tmp_path / "report.png").stat().st_size > 10_000
     tr = Trace.load(tmp_path / "trace.parquet")
     assert np.isclose(tr.fault_onset, 10.0)
+    res = runner.invoke(app, ["demo", "--method", "nope"])
+    assert res.exit_code == 2 and "unknown method" in res.output
 
 
 def test_help_everywhere():
