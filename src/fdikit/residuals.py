@@ -16,17 +16,18 @@ so decoupling is a number, not a plot.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.linalg
 
 from fdikit.errors import DataError, ModelError
 from fdikit.lti import dlsim_blocked
 from fdikit.model import GROUPS, FaultModel
 from fdikit.trace import Trace
 
-__all__ = ["ResidualGenerator", "ResidualStepper", "Residuals"]
+__all__ = ["ResidualGenerator", "ResidualStepper", "Residuals", "stack_generators"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -285,3 +286,47 @@ class ResidualStepper:
             valid[k] = self.last_valid
         g = self.generator
         return Residuals(trace.t, r, g.residuals, g.isolates, valid, meta={"trace": dict(trace.meta)})
+
+
+def stack_generators(generators: Iterable[ResidualGenerator]) -> ResidualGenerator:
+    """One generator from several: block-diagonal filter states, concatenated residuals.
+
+    Every generator must read the same controls and outputs in the same order and share
+    ``dt``; residual names must be unique across them.
+
+    Raises
+    ------
+    ModelError
+        On an empty list, different signals, different ``dt`` or a repeated residual name.
+    """
+    gens = list(generators)
+    if not gens:
+        raise ModelError("stack_generators needs at least one generator")
+    for i, g in enumerate(gens):
+        if not isinstance(g, ResidualGenerator):
+            raise ModelError(f"item {i} is a {type(g).__name__}, not a ResidualGenerator (use design.generator)")
+    g0 = gens[0]
+    for i, g in enumerate(gens[1:], start=1):
+        if g.controls != g0.controls or g.outputs != g0.outputs:
+            raise ModelError(
+                f"generator {i} reads controls {list(g.controls)} and outputs {list(g.outputs)}, generator 0 reads "
+                f"{list(g0.controls)} and {list(g0.outputs)}; stacked generators must read the same signals in "
+                "the same order"
+            )
+        if g.dt != g0.dt:
+            raise ModelError(f"generator {i} has dt={g.dt}, generator 0 dt={g0.dt}; discretize them alike first")
+    names = [nm for g in gens for nm in g.residuals]
+    dup = sorted({nm for nm in names if names.count(nm) > 1})
+    if dup:
+        raise ModelError(f"residual names {dup} occur in more than one generator; names must be unique")
+    return ResidualGenerator(
+        A=scipy.linalg.block_diag(*[g.A for g in gens]),
+        B=np.vstack([g.B for g in gens]),
+        C=scipy.linalg.block_diag(*[g.C for g in gens]),
+        D=np.vstack([g.D for g in gens]),
+        controls=g0.controls,
+        outputs=g0.outputs,
+        residuals=tuple(names),
+        dt=g0.dt,
+        isolates=tuple(iso for g in gens for iso in g.isolates),
+    )

@@ -68,7 +68,7 @@ def test_air_mass_and_throttle_in_filter4(bank):
     assert leak[0] < 1e-7 * leak.max()  # steady state: none
     assert leak[-1] > 1e-3 * G[:, iso == "throttle_actuator", thr].max()  # high frequency: the F¹ rate leaks in
     assert {k: T.shape[1] for k, T in d.detection_spaces.items()} == {
-        "throttle_actuator": 2, "brake_actuator": 1, "steering_actuator": 1, "air_mass_sensor": 1}
+        "throttle_actuator": 2, "brake_actuator": 2, "steering_actuator": 1, "air_mass_sensor": 1}
 
 
 def test_wheel_speed_projector_structure(bank):

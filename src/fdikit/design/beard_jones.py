@@ -42,7 +42,7 @@ import scipy.linalg
 from fdikit import linalg
 from fdikit.errors import DesignError, ModelError
 from fdikit.model import FaultModel, actuator_fault_name, sensor_fault_name
-from fdikit.residuals import ResidualGenerator
+from fdikit.residuals import ResidualGenerator, stack_generators
 
 __all__ = ["BeardJonesDesign", "beard_jones", "restricted_diagonal", "resolve_faults", "RestrictedDiagonalDesign"]
 
@@ -419,14 +419,4 @@ def restricted_diagonal(
                                            {target: H}, Vm, order, sigma, bound)
         spaces[target] = T_hat
         gens.append(gen)
-    return RestrictedDiagonalDesign(_stack(gens), filters, spaces)
-
-
-def _stack(gens: Sequence[ResidualGenerator]) -> ResidualGenerator:
-    g0 = gens[0]
-    return ResidualGenerator(
-        A=scipy.linalg.block_diag(*[g.A for g in gens]), B=np.vstack([g.B for g in gens]),
-        C=scipy.linalg.block_diag(*[g.C for g in gens]), D=np.vstack([g.D for g in gens]),
-        controls=g0.controls, outputs=g0.outputs, residuals=[r for g in gens for r in g.residuals],
-        dt=g0.dt, isolates=[i for g in gens for i in g.isolates],
-    )
+    return RestrictedDiagonalDesign(stack_generators(gens), filters, spaces)
