@@ -48,11 +48,17 @@ _EPS = np.finfo(float).eps
 
 # ---------------------------------------------------------------------- gains and structure
 def _residual_groups(generator: ResidualGenerator) -> tuple[tuple[str, ...], tuple[tuple[int, ...], ...]]:
-    """Residual groups in order of first appearance: by ``isolates``; a residual with None alone, by its name."""
+    """Residual groups in order of first appearance: by ``isolates``; a residual with None alone, by its name.
+
+    Residuals named ``'<filter>:<...>'`` (a stacked bank, e.g. :func:`fdikit.monitors.path_bank`) are
+    grouped per filter, ``'<filter>:<fault>'``, so a fault covered by two filters keeps two groups.
+    """
     keys: list[str] = []
     rows: dict[str, list[int]] = {}
     for i, (name, iso) in enumerate(zip(generator.residuals, generator.isolates)):
         key = iso if iso is not None else name
+        if iso is not None and ":" in name:
+            key = f"{name.split(':', 1)[0]}:{iso}"
         if iso is None and key in rows:  # a detection-only residual named like an isolated fault
             key = f"{name} (residual)"
         if key not in rows:
