@@ -502,3 +502,45 @@ def test_r_geo_4_group_4_reconstructed_data():
     assert la.output_separable(m.C, Ts) == (True, [])
     ok, joint, union = la.mutually_detectable(m.A, m.C, Fs)
     assert ok and joint.size == 0 and union.size == 0
+
+
+# ---------------------------------------------------------------------- PATH App. C: F-16XL (R-GEO-5)
+def _f16xl(sign_bdelta: float):
+    """F-16XL longitudinal data of Douglas et al. 1996 App. C as reconstructed in the research note §3.6:
+    C(2,4) = 0 (the printed extra 1.0000 is an OCR slip: the printed F_Az needs C(:,4) ∝ e_3) and A(1,5) = 0.0430."""
+    A = np.array([
+        [-0.0674, 0.0430, -0.8886, -0.5587, 0.0430],
+        [0.0205, -1.4666, 16.5800, -0.0299, -1.4666],
+        [0.1377, -1.6788, -0.6819, 0.0, -1.6788],
+        [0.0, 0.0, 1.0, 0.0, 0.0],
+        [0.0, 0.0, 0.0, 0.0, -1.1948],
+    ])
+    C = np.array([
+        [0.0, 0.0, 1.0, 0.0, 0.0],
+        [0.0, 0.0591, 0.0, 0.0, 0.0],
+        [0.0139, 1.0517, 0.1485, -0.0299, 0.0],
+        [-0.0677, 0.0431, 0.0171, 0.0, 0.0],
+    ])
+    B_delta = np.array([[sign_bdelta * 0.1672], [-1.5179], [-9.7842], [0.0], [0.0]])
+    return A, C, B_delta
+
+
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+def test_f16xl_fault_triples_have_no_zeros_and_minimal_spaces(sign):
+    """R-GEO-5: (C, A, F¹_Az), (C, A, F²_Az) and (C, A, F_δ) have no invariant zeros and T* = Im F.
+
+    F¹_Az = e_4 / C(3,4) (C F¹ = e_3), F²_Az = A F¹ ∝ [0.9986, 0.0534, 0, 0, 0] (the printed normalised column);
+    the first entry of B_δ has an uncertain sign (G17), so both are checked.
+    """
+    A, C, B_delta = _f16xl(sign)
+    F1 = np.zeros((5, 1))
+    F1[3, 0] = 1.0 / C[2, 3]
+    np.testing.assert_allclose(C @ F1, [[0], [0], [1], [0]], atol=1e-12)
+    F2 = A @ F1
+    np.testing.assert_allclose((F2 / np.linalg.norm(F2)).ravel() * np.sign(F2[0, 0]), [0.9986, 0.0534, 0, 0, 0],
+                               atol=5e-4)
+    for F in (F1, F2, B_delta):
+        zeros, _ = la.invariant_zeros(A, C, F)
+        assert zeros.size == 0
+        T = la.detection_space(A, C, F)
+        assert T.shape[1] == 1 and la.contains(T, F)

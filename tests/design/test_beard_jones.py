@@ -143,3 +143,14 @@ def test_restricted_diagonal_bank_decouples_each_target():
         assert rd.nuisance_spaces[target].shape[1] == 2
     with pytest.raises(DesignError, match="at least two"):
         restricted_diagonal(model, {"f0": faults["f0"]}, poles=-np.arange(1.0, 6.0))
+
+
+@settings(max_examples=15, deadline=None)
+@given(seed=st.integers(0, 10_000), n=st.integers(3, 6))
+def test_random_non_separable_sets_raise(seed, n):
+    """More 1-D faults than outputs: their output images are dependent, so the design must refuse."""
+    p = 2
+    model, faults = _random_system(seed, n, p, p + 1)
+    sets = {k: [-1.0 - i] for i, k in enumerate(faults)}
+    with pytest.raises(DesignError, match="not output separable|dimensions"):
+        beard_jones(model, faults, sets, -np.arange(10.0, 10.0 + n - len(faults)))

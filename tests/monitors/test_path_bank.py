@@ -115,3 +115,16 @@ def test_all_fifteen_faults_detected_and_isolated(bank):
         s = score(tr, ev.run(bank.generator.run(tr)))
         assert s.detected and s.detection_delay < 0.5, fault
         assert s.isolated == fault and s.false_alarms == 0, (fault, s.isolated)
+
+
+def test_conditioning_report_against_bounds(bank):
+    """R-FDF-5 (soft, report (4.3)/(4.8)): each admissible block V_ij is the v-part of an orthonormal null-space
+    basis of the stacked [v; w] system, so σ_max([V_ij]) ≤ √(number of blocks) (the report's repeated top value
+    √12 = 3.4641 for group 3, √14 for group 4); the selected unit eigenvectors have σ_max(𝒱) ≤ √n; σ_min(𝒱) is of
+    the report's order (group 3: 1.0e-3, group 4: 5e-4), well away from 0."""
+    for name, d in bank.designs.items():
+        n = d.left_eigenvectors.shape[0]
+        assert d.sigma_bound[0] <= np.sqrt(n) * (1 + 1e-12)
+        assert d.sigma[0] <= np.sqrt(n) * (1 + 1e-12)
+        assert 1e-4 < d.sigma[-1] < 1.0, (name, d.sigma[-1])
+    assert bank.designs["filter3"].sigma[-1] == pytest.approx(1.2e-3, rel=0.5)
