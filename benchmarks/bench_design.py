@@ -61,7 +61,8 @@ def main() -> None:
     }
     res = {k: best(fn, args.repeat) for k, fn in runs.items()}
     ref = res["scipy.signal.dlsim"][1]
-    print(f"bank: 4 filters, {gen.n} states, {len(gen.residuals)} residuals, {args.samples} samples, best of {args.repeat}")
+    print(f"bank: 4 filters, {gen.n} states, {len(gen.residuals)} residuals, {args.samples} samples, "
+          f"best of {args.repeat}")
     print("\n| step | time | ratio |\n|---|---|---|")
     print(f"| design of the 4-filter bank (fdikit.monitors.path_bank) | {t_design * 1e3:.0f} ms | "
           f"{t_design / t_place:.0f}x control.place of the same spectra ({t_place * 1e3:.1f} ms) |")
