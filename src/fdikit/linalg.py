@@ -32,6 +32,7 @@ __all__ = [
     "contains",
     "sensor_fault_map",
     "actuator_fault_map",
+    "resolve_fault",
     "caisa",
     "invariant_zeros",
     "detection_space",
@@ -145,6 +146,49 @@ def actuator_fault_map(model: FaultModel, control: str) -> np.ndarray:
             "outputs directly. Use a model with the actuator dynamics as states (e.g. path_vehicle_14)"
         )
     return model.Bu[:, [j]]
+
+
+def resolve_fault(model: FaultModel, name: str) -> tuple[np.ndarray, str]:
+    """State-space fault map of a named fault and its kind.
+
+    * an output name → :func:`sensor_fault_map` ``[F¹, A F¹]`` (kind ``'sensor'``);
+    * ``'<output>:magnitude'`` → ``A F¹`` only (the bias assumption, Douglas et al. 1996 §3.1),
+      ``'<output>:rate'`` → ``F¹`` only;
+    * a control name → :func:`actuator_fault_map`, the column of ``Bu`` (``'actuator'``);
+    * a fault input of the model (group ``f``) → its ``Bf`` column when ``Df`` is zero, the sensor
+      map of output ``i`` when it is a pure sensor fault (``Df = e_i``, ``Bf = 0``).
+    """
+    base, _, suffix = name.partition(":")
+    if suffix and suffix not in ("magnitude", "rate"):
+        raise ModelError(f"unknown fault suffix {suffix!r} in {name!r}; use ':magnitude' or ':rate' (sensor faults)")
+    where = [k for k, pool in (("output", model.outputs), ("control", model.controls), ("fault", model.faults))
+             if base in pool]
+    if not where:
+        raise ModelError(
+            f"{base!r} is not an output, control or fault input of the model; outputs {list(model.outputs)}, "
+            f"controls {list(model.controls)}, faults {list(model.faults)}"
+        )
+    if len(where) > 1:
+        raise ModelError(f"{base!r} names both an {where[0]} and a {where[1]}; pass its fault map in a dict instead")
+    kind = where[0]
+    if kind == "fault":
+        j = model.index("f", base)[0]
+        df, bf = model.Df[:, j], model.Bf[:, j]
+        if not np.any(df):
+            if suffix:
+                raise ModelError(f"{name!r}: the suffix applies to sensor faults only")
+            return bf.reshape(-1, 1), "fault input"
+        i = int(np.argmax(np.abs(df)))
+        if np.any(bf) or np.count_nonzero(df) != 1 or df[i] != 1.0:
+            raise DesignError(f"fault {base!r} reaches the outputs directly and is not a pure sensor fault; "
+                              "pass its state-space fault map in a dict")
+        base, kind = model.outputs[i], "output"
+    if kind == "output":
+        direction = suffix or "both"
+        return sensor_fault_map(model, base, direction), "sensor" if direction == "both" else f"sensor:{suffix}"
+    if suffix:
+        raise ModelError(f"{name!r}: the ':{suffix}' suffix applies to sensor faults only, {base!r} is a control")
+    return actuator_fault_map(model, base), "actuator"
 
 
 # ---------------------------------------------------------------------- geometry

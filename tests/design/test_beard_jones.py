@@ -114,7 +114,7 @@ def test_infeasible_specifications_raise_with_reasons():
     big = FaultModel(A=model.A, C=np.vstack([model.C, rng.standard_normal((3, 4))]))
     with pytest.raises(DesignError, match="dimensions"):
         beard_jones(big, many, {k: [-1.0 - i] for i, k in enumerate(many)}, [])
-    with pytest.raises(ModelError, match="cannot resolve"):
+    with pytest.raises(ModelError, match="not an output, control or fault input"):
         resolve_faults(model, ["nope"])
 
 

@@ -50,10 +50,11 @@ __all__ = ["BeardJonesDesign", "beard_jones", "restricted_diagonal", "resolve_fa
 def resolve_faults(model: FaultModel, faults: Mapping[str, np.ndarray] | Sequence[str]) -> dict[str, np.ndarray]:
     """Fault maps by name.
 
-    A mapping gives explicit ``F`` matrices (n x k).  In a sequence, an output name means
-    the sensor fault ``[F¹, A F¹]`` (named ``<output>_sensor``), ``'<output>:magnitude'``
-    its bias direction ``A F¹`` only (Douglas et al. 1996 §4.1, the air-mass fix), and a
-    control name the actuator fault ``B[:, j]`` (named ``<control>_actuator``).
+    A mapping gives explicit ``F`` matrices (n x k).  A sequence is resolved by
+    :func:`fdikit.linalg.resolve_fault`: an output name means the sensor fault ``[F¹, A F¹]``
+    (named ``<output>_sensor``), ``'<output>:magnitude'`` its bias direction ``A F¹`` only
+    (Douglas et al. 1996 §4.1, the air-mass fix), a control name the actuator fault
+    ``B[:, j]`` (named ``<control>_actuator``), a fault input of the model its own map.
     """
     if isinstance(faults, Mapping):
         out = {}
@@ -67,16 +68,15 @@ def resolve_faults(model: FaultModel, faults: Mapping[str, np.ndarray] | Sequenc
         return out
     out = {}
     for spec in faults:
-        signal, _, kind = str(spec).partition(":")
-        if signal in model.outputs:
-            out[sensor_fault_name(signal)] = linalg.sensor_fault_map(model, signal, kind or "both")
-        elif signal in model.controls and not kind:
-            out[actuator_fault_name(signal)] = linalg.actuator_fault_map(model, signal)
+        F, kind = linalg.resolve_fault(model, str(spec))
+        base = str(spec).partition(":")[0]
+        if base in model.faults:
+            name = base
+        elif kind.startswith("sensor"):
+            name = sensor_fault_name(base)
         else:
-            raise ModelError(
-                f"cannot resolve fault {spec!r}: not an output {list(model.outputs)} (optionally ':magnitude') "
-                f"nor a control {list(model.controls)}"
-            )
+            name = actuator_fault_name(base)
+        out[name] = F
     return out
 
 
