@@ -8,7 +8,7 @@ import numpy as np
 
 from fdikit.faults import NO_FAULT
 
-__all__ = ["Alarm", "Diagnosis", "UNKNOWN_FAULT", "alarm_events", "isolate"]
+__all__ = ["Alarm", "Diagnosis", "StepDecision", "UNKNOWN_FAULT", "alarm_events", "isolate"]
 
 #: Isolation label of an alarm whose residual pattern points to no single fault.
 UNKNOWN_FAULT = "unknown"
@@ -22,6 +22,22 @@ class Alarm:
     index: int
     fault: str
     residuals: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class StepDecision:
+    """Decision for one sample from an evaluator's ``step``.
+
+    ``fired`` are the per-residual (or per-hypothesis) decisions, ``probabilities`` the
+    per-hypothesis probabilities when the evaluator has them, ``valid`` False when the
+    sample was bad and the previous decision was held.
+    """
+
+    alarm: bool
+    fault: str
+    fired: np.ndarray
+    valid: bool
+    probabilities: np.ndarray | None = None
 
 
 @dataclass(frozen=True, eq=False)

@@ -22,16 +22,15 @@ conversion is conservative).
 from __future__ import annotations
 
 from collections import deque
-from dataclasses import dataclass
 
 import numpy as np
 from scipy.stats import norm
 
-from fdikit.diagnosis import Diagnosis, isolate
+from fdikit.diagnosis import Diagnosis, StepDecision, isolate
 from fdikit.errors import DataError, ModelError
 from fdikit.residuals import Residuals
 
-__all__ = ["ThresholdEvaluator", "StepDecision", "alpha_from_rate"]
+__all__ = ["ThresholdEvaluator", "alpha_from_rate"]
 
 
 def alpha_from_rate(false_alarms_per_hour: float, dt: float) -> float:
@@ -39,16 +38,6 @@ def alpha_from_rate(false_alarms_per_hour: float, dt: float) -> float:
     if not false_alarms_per_hour > 0 or not dt > 0:
         raise ModelError(f"need a positive rate and sample time, got {false_alarms_per_hour}/h and dt={dt}")
     return min(1.0, false_alarms_per_hour * dt / 3600.0)
-
-
-@dataclass(frozen=True)
-class StepDecision:
-    """Decision for one sample from :meth:`ThresholdEvaluator.step`."""
-
-    alarm: bool
-    fault: str
-    fired: np.ndarray
-    valid: bool
 
 
 def _persist(exceed: np.ndarray, k: int, n: int) -> np.ndarray:
