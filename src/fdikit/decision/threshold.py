@@ -179,6 +179,7 @@ class ThresholdEvaluator:
         """Forget the persistence window (start of a new run)."""
         self._window: deque = deque(maxlen=self.persistence[1])
         self._last = None
+        self._labels: dict[bytes, str] = {}
 
     def step(self, r) -> StepDecision:
         """Decision for one residual sample; a NaN/inf sample holds the previous decision."""
@@ -192,7 +193,10 @@ class ThresholdEvaluator:
             fired = np.sum(self._window, axis=0) >= self.persistence[0]
             self._last = fired
             valid = True
-        fault = str(isolate(fired[None, :], iso, self.groups)[0])
+        key = fired.tobytes()
+        fault = self._labels.get(key)
+        if fault is None:  # isolation depends only on the pattern of fired residuals: cache it
+            fault = self._labels[key] = str(isolate(fired[None, :], iso, self.groups)[0])
         return StepDecision(bool(fired.any()), fault, fired.copy(), valid)
 
     def __repr__(self) -> str:
