@@ -117,6 +117,32 @@ def simulate(
     console.print(f"{trace!r}\nwrote {path}")
 
 
+@app.command("compare-evaluators")
+def compare_evaluators(
+    runs_per_fault: int = typer.Option(2, help="Test runs per fault (15 faults)."),
+    healthy_runs: int = typer.Option(5, help="Fault-free test runs."),
+    seed: int = typer.Option(0, help="Seed of the training and test runs."),
+    bnn: bool = typer.Option(True, help="Include the Bayesian neural network (slowest to train)."),
+    out: Path = typer.Option(Path("out/compare"), help="Folder for scores.csv and comparison.md."),
+) -> None:
+    """Score every residual evaluator on the same PATH bank residuals and tabulate them side by side."""
+    from fdikit.monitors.path_compare import path_evaluator_comparison
+
+    start = time.perf_counter()
+    try:
+        result = path_evaluator_comparison(runs_per_fault, healthy_runs, seed, out, progress=True, bnn=bnn)
+    except FdiError as exc:
+        _fail(exc)
+    table = Table(title=f"PATH bank residuals: {runs_per_fault} runs per fault, {healthy_runs} fault-free runs")
+    table.add_column("evaluator", no_wrap=True)
+    for col in result.table.columns:
+        table.add_column(col, justify="right")
+    for name, row in result.table.iterrows():
+        table.add_row(name, *[f"{v:.3g}" if isinstance(v, float) else str(v) for v in row])
+    console.print(table)
+    console.print(f"wrote {out / 'comparison.md'} and {out / 'scores.csv'} in {time.perf_counter() - start:.0f} s")
+
+
 def main() -> None:  # pragma: no cover
     app()
 

@@ -30,12 +30,12 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from fdikit.decision.densities import (  # noqa: E402  (re-exported: the MHSSPRT's densities)
+from fdikit.decision.densities import (
     GaussianDensity,
     UniformMeanDensity,
     gaussian_mean_density,
 )
-from fdikit.decision.shiryayev import ShiryayevDP, shiryayev_dp, shiryayev_threshold  # noqa: E402
+from fdikit.decision.shiryayev import ShiryayevDP, shiryayev_dp, shiryayev_threshold
 from fdikit.diagnosis import UNKNOWN_FAULT, Diagnosis, StepDecision
 from fdikit.errors import DataError, ModelError
 from fdikit.faults import NO_FAULT
