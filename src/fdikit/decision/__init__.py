@@ -7,6 +7,8 @@ previous decision) and ``reset()``.
 
 from fdikit.decision.cusum import CusumEvaluator, cusum_arl, cusum_design
 from fdikit.decision.glr import GlrEvaluator, glr_threshold
+from fdikit.decision.mhsprt import MhsprtEvaluator
+from fdikit.decision.shiryayev import shiryayev_threshold
 from fdikit.decision.sprt import SprtEvaluator, sprt_asn, sprt_thresholds
 from fdikit.decision.threshold import ThresholdEvaluator, alpha_from_rate
 from fdikit.diagnosis import StepDecision
@@ -14,6 +16,7 @@ from fdikit.diagnosis import StepDecision
 __all__ = [
     "CusumEvaluator",
     "GlrEvaluator",
+    "MhsprtEvaluator",
     "SprtEvaluator",
     "StepDecision",
     "ThresholdEvaluator",
@@ -21,6 +24,7 @@ __all__ = [
     "cusum_arl",
     "cusum_design",
     "glr_threshold",
+    "shiryayev_threshold",
     "sprt_asn",
     "sprt_thresholds",
 ]
