@@ -5,6 +5,7 @@ Every evaluator has ``fit`` (fault-free or labelled residuals), ``run(residuals)
 previous decision) and ``reset()``.
 """
 
+from fdikit.decision.bnn import BnnEvaluator, GaussianMlEvaluator
 from fdikit.decision.cusum import CusumEvaluator, cusum_arl, cusum_design
 from fdikit.decision.glr import GlrEvaluator, glr_threshold
 from fdikit.decision.mhsprt import MhsprtEvaluator
@@ -14,7 +15,9 @@ from fdikit.decision.threshold import ThresholdEvaluator, alpha_from_rate
 from fdikit.diagnosis import StepDecision
 
 __all__ = [
+    "BnnEvaluator",
     "CusumEvaluator",
+    "GaussianMlEvaluator",
     "GlrEvaluator",
     "MhsprtEvaluator",
     "SprtEvaluator",
