@@ -50,6 +50,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import brentq
 
+from fdikit.decision.common import held, isolate_cached, k_of_n
 from fdikit.diagnosis import Diagnosis, StepDecision, isolate
 from fdikit.errors import DataError, ModelError
 from fdikit.residuals import Residuals
@@ -194,25 +195,6 @@ def _widen(name: str, arr, q: int, default: float) -> np.ndarray:
     if arr.size not in (1, q):
         raise DataError(f"{arr.size} {name} values for {q} residuals")
     return np.array(np.broadcast_to(arr, (q,)))
-
-
-def _hold_extend(exceed: np.ndarray, hold: int) -> np.ndarray:
-    """True where a row among this one and the ``hold`` before it exceeds."""
-    if hold == 0:
-        return exceed
-    c = np.cumsum(np.vstack([np.zeros((1, exceed.shape[1]), int), exceed.astype(int)]), axis=0)
-    lo = np.maximum(np.arange(1, exceed.shape[0] + 1) - hold - 1, 0)
-    return (c[1:] - c[lo]) > 0
-
-
-def _held(values: np.ndarray, valid: np.ndarray, initial) -> np.ndarray:
-    """Rows for every sample from rows for the valid ones; invalid samples repeat the last valid row."""
-    pos = np.cumsum(valid) - 1
-    out = np.empty((valid.size,) + values.shape[1:], dtype=values.dtype)
-    out[...] = initial
-    has = pos >= 0
-    out[has] = values[pos[has]]
-    return out
 
 
 def _page(xp: np.ndarray, xm: np.ndarray | None, h: float, reset: bool):
@@ -456,10 +438,10 @@ class CusumEvaluator:
             gp[:, i], gm[:, i], ex[:, i] = _page(
                 xp[:, i], xm[:, i] if self.two_sided else None, float(h[i]), self.restart == "reset"
             )
-        fired = _held(_hold_extend(ex, self.hold), valid, False)
+        fired = held(k_of_n(ex, 1, self.hold + 1), valid, False)
         isolated = isolate(fired, iso, self.groups)
         meta = self._meta(nu, h, mu, sd)
-        meta["g_plus"], meta["g_minus"] = _held(gp, valid, 0.0), _held(gm, valid, 0.0)
+        meta["g_plus"], meta["g_minus"] = held(gp, valid, 0.0), held(gm, valid, 0.0)
         return Diagnosis(residuals.t, fired.any(axis=1), fired, residuals.names, isolated, valid=valid, meta=meta)
 
     # ------------------------------------------------------------------ online
@@ -521,11 +503,7 @@ class CusumEvaluator:
 
     def _isolate(self, fired: np.ndarray) -> str:
         """Isolation of one sample's pattern (memoised: the patterns of a run are few)."""
-        cache = self._state["cache"]
-        key = fired.tobytes()
-        if key not in cache:
-            cache[key] = str(isolate(fired[None, :], self._state["iso"], self.groups)[0])
-        return cache[key]
+        return isolate_cached(self._state["cache"], fired, self._state["iso"], self.groups)
 
     def __repr__(self) -> str:
         return (f"CusumEvaluator(drift={self.drift}, threshold={self.threshold}, restart={self.restart!r}, "

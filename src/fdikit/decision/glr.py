@@ -40,6 +40,7 @@ import numpy as np
 import scipy.linalg
 from scipy.stats import chi2
 
+from fdikit.decision.common import held, isolate_cached
 from fdikit.diagnosis import Diagnosis, StepDecision, isolate
 from fdikit.errors import DataError, ModelError
 from fdikit.residuals import Residuals
@@ -120,15 +121,6 @@ def _sumsq(S: np.ndarray) -> np.ndarray:
     for i in range(1, S.shape[-1]):
         acc = acc + S[..., i] * S[..., i]
     return acc
-
-
-def _held(values: np.ndarray, valid: np.ndarray, initial) -> np.ndarray:
-    pos = np.cumsum(valid) - 1
-    out = np.empty((valid.size,) + values.shape[1:], dtype=values.dtype)
-    out[...] = initial
-    has = pos >= 0
-    out[has] = values[pos[has]]
-    return out
 
 
 class BlockLayout:
@@ -376,14 +368,14 @@ class GlrEvaluator:
             np.copyto(best_S[m - 1 :], S[m - 1 :], where=upd[..., None])
         size = _lin(layout.chol, best_S) / best_n[..., None]
         change = vidx[np.arange(n)[:, None] - best_n + 1] if n else np.zeros((0, G), int)
-        fired = _held(best > h, valid, False)
+        fired = held(best > h, valid, False)
         isolated = isolate(fired, layout.isolates, layout.groups)
         meta = self._meta(layout, h, residuals.names)
-        meta["statistic"] = _held(best, valid, 0.0)
-        meta["change_index"] = _held(change, valid, -1)
+        meta["statistic"] = held(best, valid, 0.0)
+        meta["change_index"] = held(change, valid, -1)
         meta["change_time"] = np.where(meta["change_index"] >= 0, residuals.t[np.maximum(meta["change_index"], 0)],
                                        np.nan)
-        meta["change_size"] = layout.split(_held(size, valid, np.nan))
+        meta["change_size"] = layout.split(held(size, valid, np.nan))
         return Diagnosis(residuals.t, fired.any(axis=1), fired, layout.names, isolated, valid=valid, meta=meta)
 
     # ------------------------------------------------------------------ online
@@ -448,11 +440,8 @@ class GlrEvaluator:
         return StepDecision(bool(fired.any()), self._isolate(fired), fired.copy(), True)
 
     def _isolate(self, fired: np.ndarray) -> str:
-        cache, layout = self._state["cache"], self._state["layout"]
-        key = fired.tobytes()
-        if key not in cache:
-            cache[key] = str(isolate(fired[None, :], layout.isolates, layout.groups)[0])
-        return cache[key]
+        layout = self._state["layout"]
+        return isolate_cached(self._state["cache"], fired, layout.isolates, layout.groups)
 
     def __repr__(self) -> str:
         return f"GlrEvaluator(window={self.window}, threshold={self.threshold}, blocks={self.blocks!r})"

@@ -42,6 +42,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from fdikit.decision.common import held, isolate_cached, k_of_n
 from fdikit.decision.glr import BlockLayout, as_covariance, fit_moments
 from fdikit.diagnosis import Diagnosis, StepDecision, isolate
 from fdikit.errors import DataError, ModelError
@@ -78,23 +79,6 @@ def sprt_asn(alpha: float, beta: float, divergence: float, hypothesis: int = 1) 
     if hypothesis == 0:
         return ((1 - alpha) * B + alpha * A) / (-divergence)
     raise ModelError(f"hypothesis must be 0 or 1, got {hypothesis}")
-
-
-def _hold_extend(exceed: np.ndarray, hold: int) -> np.ndarray:
-    if hold == 0:
-        return exceed
-    c = np.cumsum(np.vstack([np.zeros((1, exceed.shape[1]), int), exceed.astype(int)]), axis=0)
-    lo = np.maximum(np.arange(1, exceed.shape[0] + 1) - hold - 1, 0)
-    return (c[1:] - c[lo]) > 0
-
-
-def _held(values: np.ndarray, valid: np.ndarray, initial) -> np.ndarray:
-    pos = np.cumsum(valid) - 1
-    out = np.empty((valid.size,) + values.shape[1:], dtype=values.dtype)
-    out[...] = initial
-    has = pos >= 0
-    out[has] = values[pos[has]]
-    return out
 
 
 def _advance(L: np.ndarray, done: np.ndarray, lam: np.ndarray, A: np.ndarray, B: np.ndarray, restart: bool):
@@ -271,15 +255,15 @@ class SprtEvaluator:
         for g in range(G):
             llr[:, g], dec[:, g] = _walk(lam[:, g], self.A, self.B, self.restart)
         if self.restart:
-            fired_v = _hold_extend(dec > 0, self.hold)
+            fired_v = k_of_n(dec > 0, 1, self.hold + 1)
         else:
             dec = np.cumsum(dec, axis=0, dtype=np.int8)  # one ±1 per block at most: latched from then on
             fired_v = dec > 0
-        fired = _held(fired_v, valid, False)
+        fired = held(fired_v, valid, False)
         isolated = isolate(fired, layout.isolates, layout.groups)
         meta = self._meta(layout, c, residuals.names)
-        meta["llr"] = _held(llr, valid, 0.0)
-        meta["decision"] = _held(dec, valid, 0)
+        meta["llr"] = held(llr, valid, 0.0)
+        meta["decision"] = held(dec, valid, 0)
         return Diagnosis(residuals.t, fired.any(axis=1), fired, layout.names, isolated, valid=valid, meta=meta)
 
     # ------------------------------------------------------------------ online
@@ -326,11 +310,8 @@ class SprtEvaluator:
         return StepDecision(bool(fired.any()), self._isolate(fired), fired.copy(), True)
 
     def _isolate(self, fired: np.ndarray) -> str:
-        cache, layout = self._state["cache"], self._state["layout"]
-        key = fired.tobytes()
-        if key not in cache:
-            cache[key] = str(isolate(fired[None, :], layout.isolates, layout.groups)[0])
-        return cache[key]
+        layout = self._state["layout"]
+        return isolate_cached(self._state["cache"], fired, layout.isolates, layout.groups)
 
     def __repr__(self) -> str:
         return (f"SprtEvaluator(shift={self.shift}, alpha={self.alpha}, beta={self.beta}, "

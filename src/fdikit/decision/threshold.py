@@ -26,6 +26,7 @@ from collections import deque
 import numpy as np
 from scipy.stats import norm
 
+from fdikit.decision.common import held, isolate_cached, k_of_n
 from fdikit.diagnosis import Diagnosis, StepDecision, isolate
 from fdikit.errors import DataError, ModelError
 from fdikit.residuals import Residuals
@@ -38,15 +39,6 @@ def alpha_from_rate(false_alarms_per_hour: float, dt: float) -> float:
     if not false_alarms_per_hour > 0 or not dt > 0:
         raise ModelError(f"need a positive rate and sample time, got {false_alarms_per_hour}/h and dt={dt}")
     return min(1.0, false_alarms_per_hour * dt / 3600.0)
-
-
-def _persist(exceed: np.ndarray, k: int, n: int) -> np.ndarray:
-    """``True`` where at least ``k`` of the last ``n`` rows (including this one) exceed."""
-    if k == 1 and n == 1:
-        return exceed
-    c = np.cumsum(np.vstack([np.zeros((1, exceed.shape[1])), exceed.astype(int)]), axis=0)
-    lo = np.maximum(np.arange(1, exceed.shape[0] + 1) - n, 0)
-    return (c[1:] - c[lo]) >= k
 
 
 class ThresholdEvaluator:
@@ -162,12 +154,7 @@ class ThresholdEvaluator:
         r = residuals.r
         valid = residuals.valid & np.all(np.isfinite(r), axis=1)
         k, n = self.persistence
-        fired_v = _persist(np.abs(r[valid] - c) > tau, k, n)
-        # invalid samples hold the previous valid decision (as step() does)
-        pos = np.cumsum(valid) - 1
-        fired = np.zeros((len(residuals), q), bool)
-        has = pos >= 0
-        fired[has] = fired_v[pos[has]]
+        fired = held(k_of_n(np.abs(r[valid] - c) > tau, k, n), valid, False)
         isolated = isolate(fired, iso, self.groups)
         return Diagnosis(
             residuals.t, fired.any(axis=1), fired, residuals.names, isolated, valid=valid,
@@ -193,10 +180,7 @@ class ThresholdEvaluator:
             fired = np.sum(self._window, axis=0) >= self.persistence[0]
             self._last = fired
             valid = True
-        key = fired.tobytes()
-        fault = self._labels.get(key)
-        if fault is None:  # isolation depends only on the pattern of fired residuals: cache it
-            fault = self._labels[key] = str(isolate(fired[None, :], iso, self.groups)[0])
+        fault = isolate_cached(self._labels, fired, iso, self.groups)
         return StepDecision(bool(fired.any()), fault, fired.copy(), valid)
 
     def __repr__(self) -> str:
