@@ -544,3 +544,37 @@ def test_f16xl_fault_triples_have_no_zeros_and_minimal_spaces(sign):
         assert zeros.size == 0
         T = la.detection_space(A, C, F)
         assert T.shape[1] == 1 and la.contains(T, F)
+
+
+def test_time_varying_sensor_fault_map():
+    """App. A.2: F² = A F¹ − dF¹/dt with C(t) F¹(t) = e_i; the derivative by central differences matches the
+    analytic −C⁻¹ Ċ C⁻¹ e_i, and a constant model reduces to the LTI map [F¹, A F¹]."""
+    rng = np.random.default_rng(3)
+    n = 4
+    A0, A1 = rng.standard_normal((n, n)), rng.standard_normal((n, n))
+    C0, C1 = rng.standard_normal((n, n)) + 3 * np.eye(n), rng.standard_normal((n, n))
+
+    def A(t):
+        return A0 + np.sin(t) * A1
+
+    def C(t):
+        return C0 + t * C1
+
+    t, i = 0.7, 2
+    F = la.sensor_fault_map_tv(A, C, i, t)
+    Ci = np.linalg.inv(C(t))
+    F1 = Ci[:, i]
+    dF1 = -Ci @ C1 @ Ci[:, i]
+    np.testing.assert_allclose(F[:, 0], F1, rtol=1e-12)
+    np.testing.assert_allclose(F[:, 1], A(t) @ F1 - dF1, rtol=1e-7)
+    exact = la.sensor_fault_map_tv(A, C, i, t, dF1=lambda _t: dF1)
+    np.testing.assert_allclose(exact[:, 1], A(t) @ F1 - dF1, rtol=1e-12)
+    from fdikit import FaultModel
+
+    m = FaultModel(A=A0, C=C0)
+    np.testing.assert_allclose(la.sensor_fault_map_tv(lambda _t: A0, lambda _t: C0, i, 5.0),
+                               la.sensor_fault_map(m, m.outputs[i]), rtol=1e-9, atol=1e-12)
+    from fdikit.errors import DesignError
+
+    with pytest.raises(DesignError, match="not in the range"):
+        la.sensor_fault_map_tv(A, lambda _t: np.zeros((n, n)), i, t)

@@ -15,7 +15,7 @@ data (``max(shape) · eps · σ_max`` by default, or a caller's relative toleran
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 import scipy.linalg
@@ -32,6 +32,7 @@ __all__ = [
     "contains",
     "sensor_fault_map",
     "actuator_fault_map",
+    "sensor_fault_map_tv",
     "resolve_fault",
     "caisa",
     "invariant_zeros",
@@ -130,6 +131,41 @@ def sensor_fault_map(model: FaultModel, output: str, direction: str = "both", rt
     if direction not in maps:
         raise ModelError(f"direction must be 'both', 'magnitude' or 'rate', got {direction!r}")
     return maps[direction]
+
+
+def sensor_fault_map_tv(
+    A: Callable[[float], np.ndarray],
+    C: Callable[[float], np.ndarray],
+    output: int,
+    t: float,
+    dF1: Callable[[float], np.ndarray] | None = None,
+    step: float | None = None,
+    rtol: float = 1e-9,
+) -> np.ndarray:
+    """Two-dimensional sensor-fault map of a time-varying model at time ``t``: ``[F¹(t), F²(t)]``.
+
+    ``C(t) F¹(t) = e_i`` (minimum-norm) and ``F² = A F¹ − dF¹/dt`` (Douglas et al. 1996, App. A.2; the
+    printed (a.9b) has ``+ ḃ``, the sign G16 of the research note corrects, consistent with A.2 and (9.38)).
+    ``dF1`` gives the derivative; otherwise a central difference with ``step`` (default ``1e-6 · max(1, |t|)``).
+    ``A`` and ``C`` are callables ``t -> matrix``; ``output`` is the output's index.
+    """
+    def f1(tau: float) -> np.ndarray:
+        Ct = np.atleast_2d(np.asarray(C(tau), dtype=float))
+        e = np.zeros(Ct.shape[0])
+        e[output] = 1.0
+        x, *_ = np.linalg.lstsq(Ct, e, rcond=None)
+        if np.linalg.norm(Ct @ x - e) > rtol:
+            raise DesignError(f"output {output} is not in the range of C(t) at t = {tau:g}; no sensor-fault map")
+        return x
+
+    F1 = f1(t)
+    if dF1 is not None:
+        d = np.asarray(dF1(t), dtype=float).ravel()
+    else:
+        h = step if step is not None else 1e-6 * max(1.0, abs(t))
+        d = (f1(t + h) - f1(t - h)) / (2 * h)
+    F2 = np.atleast_2d(np.asarray(A(t), dtype=float)) @ F1 - d
+    return np.column_stack([F1, F2])
 
 
 def actuator_fault_map(model: FaultModel, control: str) -> np.ndarray:
