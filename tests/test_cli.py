@@ -72,9 +72,11 @@ def test_compare_evaluators_command(tmp_path):
                               "--out", str(tmp_path)], terminal_width=250)
     assert res.exit_code == 0, res.output
     md = (tmp_path / "comparison.md").read_text()
-    for name in ("threshold (5 of 10)", "CUSUM", "GLR (M = 50)", "SPRT", "MHSSPRT", "Gaussian ML"):
+    names = ("threshold (5 of 10)", "CUSUM", "GLR (M = 50)", "SPRT", "CUSUM, whitened", "GLR, whitened",
+             "SPRT, whitened", "MHSSPRT", "Gaussian ML")
+    for name in names:
         assert f"| {name} |" in md
     rows = (tmp_path / "scores.csv").read_text().strip().splitlines()
-    assert len(rows) == 1 + 16 * 6  # header + (15 faulty + 1 healthy runs) x 6 evaluators
+    assert len(rows) == 1 + 16 * len(names)  # header + (15 faulty + 1 healthy runs) x evaluators
     # the calibrated threshold bank isolates every fault with no false alarm (as in tests/monitors)
     assert "| threshold (5 of 10) | 16 | 1 | 0 |" in md

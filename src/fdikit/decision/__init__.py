@@ -12,6 +12,7 @@ from fdikit.decision.mhsprt import MhsprtEvaluator
 from fdikit.decision.shiryayev import shiryayev_threshold
 from fdikit.decision.sprt import SprtEvaluator, sprt_asn, sprt_thresholds
 from fdikit.decision.threshold import ThresholdEvaluator, alpha_from_rate
+from fdikit.decision.whiten import Whitened
 from fdikit.diagnosis import StepDecision
 
 __all__ = [
@@ -23,6 +24,7 @@ __all__ = [
     "SprtEvaluator",
     "StepDecision",
     "ThresholdEvaluator",
+    "Whitened",
     "alpha_from_rate",
     "cusum_arl",
     "cusum_design",

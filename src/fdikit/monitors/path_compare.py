@@ -30,7 +30,9 @@ def path_evaluator_comparison(
 
     ``out``: a folder for ``scores.csv`` (written run by run) and ``comparison.md``.
     """
-    from fdikit.decision import CusumEvaluator, GlrEvaluator, SprtEvaluator, ThresholdEvaluator
+    import numpy as np
+
+    from fdikit.decision import CusumEvaluator, GlrEvaluator, SprtEvaluator, ThresholdEvaluator, Whitened
     from fdikit.decision.bnn import BnnEvaluator, GaussianMlEvaluator
     from fdikit.decision.mhsprt import MhsprtEvaluator
 
@@ -52,6 +54,15 @@ def path_evaluator_comparison(
         "GLR (M = 50)": GlrEvaluator(window=50, blocks=blocks, groups=g).fit(healthy, false_alarms_per_hour=1),
         "SPRT": SprtEvaluator(shift=shift, alpha=1e-6, beta=1e-3, blocks=blocks, groups=g).fit(healthy),
     }
+    # the same tests on AR(5)-prewhitened residuals (the bank's residuals are coloured; decision.whiten)
+    innov = Whitened(ThresholdEvaluator(), order=5).fit(healthy, false_alarm_prob=1e-3).whiten(healthy)
+    w_shift = 4.0 * np.nanstd(innov.r, axis=0, ddof=1)
+    evaluators["CUSUM, whitened"] = Whitened(CusumEvaluator(groups=g), 5).fit(
+        healthy, mean_time_between_false_alarms=3600.0, shift=w_shift)
+    evaluators["GLR, whitened"] = Whitened(GlrEvaluator(window=50, blocks=blocks, groups=g), 5).fit(
+        healthy, false_alarms_per_hour=1)
+    evaluators["SPRT, whitened"] = Whitened(
+        SprtEvaluator(shift=w_shift, alpha=1e-6, beta=1e-3, blocks=blocks, groups=g), 5).fit(healthy)
     by_fault = {"none": healthy}
     for trace, res in labelled[1:]:
         by_fault[str(trace.fault[-1])] = res.slice(start=onset + 1.0)
