@@ -40,6 +40,7 @@ import numpy as np
 import scipy.linalg
 
 from fdikit import linalg
+from fdikit.design.observer import observer_generator
 from fdikit.errors import DesignError, ModelError
 from fdikit.model import FaultModel, actuator_fault_name, sensor_fault_name
 from fdikit.residuals import ResidualGenerator, stack_generators
@@ -270,12 +271,8 @@ def _residual_generator(model, L, names, spaces, rtol):
         res_names += [f"{name}[{k}]" for k in range(Q.shape[1])]
         isolates += [name] * Q.shape[1]
     Q = np.hstack(blocks)
-    # r = y − C x̂ − Du u with x̂' = (A + LC) x̂ + (Bu + L Du) u − L y
-    gen = ResidualGenerator(
-        A=model.A + L @ C, B=np.hstack([model.Bu + L @ model.Du, -L]), C=-Q.T @ C,
-        D=np.hstack([-Q.T @ model.Du, Q.T]), controls=model.controls, outputs=model.outputs,
-        residuals=res_names, dt=model.dt, isolates=isolates,
-    )
+    # the report's A + LC is an observer with gain −L: r = y − C x̂ − Du u, x̂' = (A + LC) x̂ + (Bu + L Du) u − L y
+    gen = observer_generator(model, -L, res_names, Q, isolates)
     return gen, projectors
 
 
@@ -410,11 +407,7 @@ def restricted_diagonal(
         H = np.eye(model.p) - image_hat @ image_hat.T
         Q = linalg.orth(H, rtol)
         names = [f"{target}[{k}]" for k in range(Q.shape[1])]
-        gen = ResidualGenerator(
-            A=A + L @ C, B=np.hstack([model.Bu + L @ model.Du, -L]), C=-Q.T @ C,
-            D=np.hstack([-Q.T @ model.Du, Q.T]), controls=model.controls, outputs=model.outputs,
-            residuals=names, dt=model.dt, isolates=[target] * len(names),
-        )
+        gen = observer_generator(model, -L, names, Q, [target] * len(names))
         filters[target] = BeardJonesDesign(gen, L, sub, scipy.linalg.eigvals(A + L @ C), {nuis_name: T_hat},
                                            {target: H}, Vm, order, sigma, bound)
         spaces[target] = T_hat

@@ -62,19 +62,34 @@ def unobservable_modes(A: np.ndarray, C: np.ndarray) -> np.ndarray:
     return np.array(out)
 
 
-def observer_generator(model: FaultModel, L: np.ndarray, outputs: Sequence[str] | None = None) -> ResidualGenerator:
-    """The residual generator ``r = y − C x̂ − Du u`` of the observer with gain ``L``."""
+def observer_generator(
+    model: FaultModel,
+    L: np.ndarray,
+    outputs: Sequence[str] | None = None,
+    projection: np.ndarray | None = None,
+    isolates: Sequence[str | None] | None = None,
+) -> ResidualGenerator:
+    """The residual generator of the observer ``x̂' = A x̂ + Bu u + L (y − C x̂ − Du u)``.
+
+    The residual is ``r = y − C x̂ − Du u``, or its coordinates ``Qᵀ r`` in the columns of an
+    output ``projection`` Q (p x k; e.g. the projected residuals of a detection filter).
+    ``outputs`` names the generator's residual outputs (default: the model's output names, or
+    ``r0, r1 …`` with a projection).
+    """
     A, C, Bu, Du = model.A, model.C, model.Bu, model.Du
-    p = model.p
+    Q = np.eye(model.p) if projection is None else np.asarray(projection, dtype=float)
+    if outputs is None:
+        outputs = model.outputs if projection is None else tuple(f"r{k}" for k in range(Q.shape[1]))
     return ResidualGenerator(
         A=A - L @ C,
         B=np.hstack([Bu - L @ Du, L]),
-        C=-C,
-        D=np.hstack([-Du, np.eye(p)]),
+        C=-Q.T @ C,
+        D=np.hstack([-Q.T @ Du, Q.T]),
         controls=model.controls,
         outputs=model.outputs,
-        residuals=tuple(outputs or model.outputs),
+        residuals=tuple(outputs),
         dt=model.dt,
+        isolates=tuple(isolates) if isolates is not None else (),
     )
 
 
