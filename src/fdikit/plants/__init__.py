@@ -9,6 +9,8 @@ name               model                                            source
 ``path12``         PATH vehicle, 12 states, sensor-fault design     Douglas et al. 1996, (d.2)
 ``path14``         PATH vehicle, 14 states, actuator-fault design   Douglas et al. 1996, (d.1)
 ``single-track``   lateral single-track model with lane errors      van der Ploeg 2018, (B.12)
+``f16xl``          F-16XL longitudinal, 4 states, ``C = I``         Murray 2012, §6.1
+``white-speyer``   3-state system with invariant-zero cases         Murray 2012, §6.2
 =================  ==============================================  ======================
 
 Examples
@@ -32,7 +34,9 @@ from fdikit.plants.path_vehicle import (
     path_vehicle_14,
     rounding_intervals,
 )
+from fdikit.plants.f16xl import f16xl_longitudinal
 from fdikit.plants.single_track import PRIUS_2010, SingleTrackParameters, single_track, understeer_gradient
+from fdikit.plants.white_speyer import WHITE_SPEYER_CASES, white_speyer
 
 __all__ = [
     "PLANTS",
@@ -46,6 +50,9 @@ __all__ = [
     "PRIUS_2010",
     "single_track",
     "understeer_gradient",
+    "f16xl_longitudinal",
+    "white_speyer",
+    "WHITE_SPEYER_CASES",
 ]
 
 #: Plant constructors by name; call with the plant's own keyword parameters.
@@ -53,6 +60,8 @@ PLANTS: dict[str, Callable[..., FaultModel]] = {
     "path12": path_vehicle_12,
     "path14": path_vehicle_14,
     "single-track": single_track,
+    "f16xl": f16xl_longitudinal,
+    "white-speyer": white_speyer,
 }
 
 
