@@ -27,6 +27,7 @@ from collections.abc import Callable
 
 from fdikit.errors import ModelError
 from fdikit.model import FaultModel
+from fdikit.plants.f16xl import f16xl_longitudinal
 from fdikit.plants.path_vehicle import (
     TABLE_2_1_EIGENVALUES_12,
     TABLE_2_1_EIGENVALUES_14,
@@ -34,7 +35,6 @@ from fdikit.plants.path_vehicle import (
     path_vehicle_14,
     rounding_intervals,
 )
-from fdikit.plants.f16xl import f16xl_longitudinal
 from fdikit.plants.single_track import PRIUS_2010, SingleTrackParameters, single_track, understeer_gradient
 from fdikit.plants.white_speyer import WHITE_SPEYER_CASES, white_speyer
 
