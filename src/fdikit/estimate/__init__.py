@@ -1,0 +1,1 @@
+"""Fault estimation: sizes of faults from residuals (e.g. additive vs multiplicative steering faults)."""

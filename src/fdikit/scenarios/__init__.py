@@ -1,0 +1,1 @@
+"""Simulation scenarios of the seeds, as functions that return :class:`~fdikit.trace.Trace` objects."""
