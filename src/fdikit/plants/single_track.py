@@ -27,22 +27,28 @@ with a repeated row).  The matrices above are the reconstruction of research not
 lateral error ``y_e' = -V_y + V_x psi_e`` (B.10), bank force ``m g sin(phi)`` in the
 lateral force balance (B.11).  Steering faults ``delta = f_m delta_set + f_a`` enter along
 ``B`` (add them with :meth:`FaultModel.with_actuator_faults`).
+
+:func:`single_track_lpv` is the speed-scheduled family ``V_x -> sampled model`` of Sec. 4-3-4
+(the speed frozen over each sample), with the DAE matrices (4.17) of each member.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from fdikit.errors import ModelError
-from fdikit.model import FaultModel
+from fdikit.model import FaultModel, actuator_fault_name
 
 __all__ = [
+    "SingleTrackLPV",
     "SingleTrackParameters",
     "PRIUS_2010",
     "single_track",
+    "single_track_lpv",
     "understeer_gradient",
     "STATES",
     "OUTPUTS",
@@ -154,6 +160,18 @@ def single_track(speed: float, params: SingleTrackParameters = PRIUS_2010, dt: f
     >>> round(float(single_track(70 / 3.6, dt=0.01).A[0, 0]), 6)
     0.919689
     """
+    v = _speed(speed)
+    if not isinstance(params, SingleTrackParameters):
+        raise ModelError(f"params must be a SingleTrackParameters, got {type(params).__name__}")
+    A, Bu, Bd, C = _continuous_matrices(v, params)
+    model = FaultModel(
+        A, C, Bu=Bu, Bd=Bd, states=STATES, outputs=OUTPUTS, controls=CONTROLS, disturbances=DISTURBANCES
+    )
+    return model if dt is None else model.discretize(dt)
+
+
+def _speed(speed) -> float:
+    """``speed`` as a positive finite float (m/s), or a ModelError saying how to fix it."""
     try:
         v = float(speed)
     except (TypeError, ValueError):
@@ -163,9 +181,11 @@ def single_track(speed: float, params: SingleTrackParameters = PRIUS_2010, dt: f
             f"speed must be a positive finite longitudinal speed in m/s, got {speed!r}; "
             "the single-track model divides by V_x (use e.g. 70 / 3.6 for 70 km/h)"
         )
-    if not isinstance(params, SingleTrackParameters):
-        raise ModelError(f"params must be a SingleTrackParameters, got {type(params).__name__}")
-    p = params
+    return v
+
+
+def _continuous_matrices(v: float, p: SingleTrackParameters) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``A, B, B_d, C`` of (B.12) (research note §3.9) at speed ``v`` (m/s)."""
     a11 = (p.C_f + p.C_r) / (p.m * v)
     a12 = (p.C_f * p.l_f - p.C_r * p.l_r) / (p.m * v) - v
     a21 = (p.l_f * p.C_f - p.l_r * p.C_r) / (p.I_z * v)
@@ -181,7 +201,138 @@ def single_track(speed: float, params: SingleTrackParameters = PRIUS_2010, dt: f
     Bu = np.array([[-p.C_f / p.m], [-p.l_f * p.C_f / p.I_z], [0.0], [0.0]])
     Bd = np.array([[0.0, p.g], [0.0, 0.0], [0.0, 0.0], [v, 0.0]])
     C = np.array([[0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
-    model = FaultModel(
-        A, C, Bu=Bu, Bd=Bd, states=STATES, outputs=OUTPUTS, controls=CONTROLS, disturbances=DISTURBANCES
-    )
-    return model if dt is None else model.discretize(dt)
+    return A, Bu, Bd, C
+
+
+def _expm(M: np.ndarray) -> np.ndarray:
+    """``e^M`` by scaling and squaring with a degree-16 Taylor polynomial (numpy only).
+
+    After scaling ``‖M / 2^s‖₁ ≤ 1/2`` the truncation error is below ``0.5¹⁷ / 17! < 1e-19``;
+    for the 7 x 7 single-track matrices this agrees with :func:`scipy.linalg.expm` to
+    round-off (tested) and costs ~20 small products instead of a LAPACK solve, which matters
+    when the LPV filter rediscretises at every sample.
+    """
+    norm = float(np.abs(M).sum(axis=0).max())
+    s = max(0, math.ceil(math.log2(norm / 0.5))) if norm > 0.5 else 0
+    X = M / 2.0**s
+    E = np.eye(M.shape[0])
+    term = E
+    for k in range(1, 17):
+        term = term @ X / k
+        E = E + term
+    for _ in range(s):
+        E = E @ E
+    return E
+
+
+@functools.lru_cache(maxsize=8192)
+def _sampled_matrices(v: float, p: SingleTrackParameters, dt: float) -> tuple[np.ndarray, ...]:
+    """Exact ZOH ``(𝒜, ℬ, ℬ_d, C)`` at one speed (thesis (4.5)), cached by ``(v, p, dt)``.
+
+    ``expm([[A, B, B_d], [0, 0, 0]] h)`` — the augmented exponential that
+    :func:`scipy.signal.cont2discrete` (``'zoh'``) also uses, so the values equal
+    ``single_track(v, p, dt)`` to round-off.
+    """
+    A, Bu, Bd, C = _continuous_matrices(v, p)
+    n, k = A.shape[0], Bu.shape[1] + Bd.shape[1]
+    M = np.zeros((n + k, n + k))
+    M[:n, :n], M[:n, n : n + 1], M[:n, n + 1 :] = A, Bu, Bd
+    E = _expm(dt * M)[:n]
+    out = (E[:, :n], E[:, n : n + 1], E[:, n + 1 :], C)
+    for arr in out:
+        arr.setflags(write=False)
+    return out
+
+
+@dataclass(frozen=True)
+class SingleTrackLPV:
+    """Speed-scheduled family of sampled single-track models (van der Ploeg 2018, Sec. 4-3-4).
+
+    Calling the family with a speed (m/s) returns the discrete :class:`FaultModel` of
+    :func:`single_track` at that speed, with the steering fault ``steering_actuator``
+    (``ℬ_f = ℬ``, eq. (4.5)) when ``steering_fault`` is true.  This is the thesis' "complete
+    discretisation" (ref. [36]): the speed is frozen over each sample, so the parameter-varying
+    model is ``X(k+1) = 𝒜(V_x(k)) X(k) + ℬ(V_x(k)) δ(k) + ℬ_d(V_x(k)) d(k)``.  The sampled
+    matrices are cached per speed (the LPV filter asks for the same speeds several times).
+
+    Attributes
+    ----------
+    params : SingleTrackParameters
+        Vehicle parameters (default :data:`PRIUS_2010`, Table 4-1).
+    dt : float
+        Sample time ``h`` in s (default 0.01, as in the thesis).
+    steering_fault : bool
+        Add the additive steering fault input ``steering_actuator`` (default True).
+
+    Examples
+    --------
+    >>> family = single_track_lpv()
+    >>> model = family(70 / 3.6)
+    >>> model.faults, model.dt
+    (('steering_actuator',), 0.01)
+    >>> round(float(model.A[0, 0]), 6)
+    0.919689
+    """
+
+    params: SingleTrackParameters = PRIUS_2010
+    dt: float = 0.01
+    steering_fault: bool = True
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.params, SingleTrackParameters):
+            raise ModelError(f"params must be a SingleTrackParameters, got {type(self.params).__name__}")
+        try:
+            dt = float(self.dt)
+        except (TypeError, ValueError):
+            raise ModelError(f"dt must be a sample time in s, got {self.dt!r}") from None
+        if not (math.isfinite(dt) and dt > 0):
+            raise ModelError(f"dt must be a positive sample time in s (the thesis uses 0.01), got {self.dt!r}")
+        object.__setattr__(self, "dt", dt)
+
+    def matrices(self, speed: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Read-only ``(𝒜, ℬ, ℬ_d, C)`` at ``speed`` (m/s): the sampled (4.5) matrices, cached."""
+        return _sampled_matrices(_speed(speed), self.params, self.dt)
+
+    def __call__(self, speed: float) -> FaultModel:
+        """The discrete model at ``speed`` (m/s)."""
+        A, Bu, Bd, C = self.matrices(speed)
+        faults = {"Bf": Bu, "faults": [actuator_fault_name(c) for c in CONTROLS]} if self.steering_fault else {}
+        return FaultModel(
+            A, C, Bu=Bu, Bd=Bd, states=STATES, outputs=OUTPUTS, controls=CONTROLS, disturbances=DISTURBANCES,
+            dt=self.dt, **faults,
+        )
+
+    def dae_matrices(self, speed: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(H_0, H_1, L, F)`` of the DAE (4.17) at ``speed`` (m/s): ``(H_0 + H_1 q) x + L z + F f = 0``.
+
+        ``x = [V_y, r, y_e, ψ_e, κ, sin φ]``, ``z = [r, y_e, ψ_e, δ_set]`` (outputs, then the
+        steering command), ``f`` the steering fault (``f_a``, or ``(f_m − 1) δ_set``)::
+
+            H_0 = [[𝒜, ℬ_d], [C, 0]],  H_1 = [[−I, 0], [0, 0]],  L = [[0, ℬ], [−I, 0]],  F = [ℬ; 0]
+        """
+        return _dae_matrices(_speed(speed), self.params, self.dt)
+
+
+@functools.lru_cache(maxsize=8192)
+def _dae_matrices(v: float, p: SingleTrackParameters, dt: float) -> tuple[np.ndarray, ...]:
+    A, Bu, Bd, C = _sampled_matrices(v, p, dt)
+    n, ny, nd = A.shape[0], C.shape[0], Bd.shape[1]
+    H0, H1 = np.zeros((n + ny, n + nd)), np.zeros((n + ny, n + nd))
+    H0[:n, :n], H0[:n, n:], H0[n:, :n] = A, Bd, C
+    H1[:n, :n] = -np.eye(n)
+    L, F = np.zeros((n + ny, ny + 1)), np.zeros((n + ny, 1))
+    L[:n, ny:], L[n:, :ny], F[:n] = Bu, -np.eye(ny), Bu
+    for arr in (H0, H1, L, F):
+        arr.setflags(write=False)
+    return H0, H1, L, F
+
+
+def single_track_lpv(
+    params: SingleTrackParameters = PRIUS_2010, dt: float = 0.01, steering_fault: bool = True
+) -> SingleTrackLPV:
+    """The speed-scheduled single-track family ``speed (m/s) -> discrete FaultModel`` (van der Ploeg 2018, (4.17)).
+
+    See :class:`SingleTrackLPV`; ``family(v)`` equals ``single_track(v, params, dt)`` (plus the
+    steering fault) and ``family.dae_matrices(v)`` gives the DAE (4.17).
+    """
+    return SingleTrackLPV(params, dt, steering_fault)

@@ -1,0 +1,463 @@
+"""Speed-scheduled (LPV) parity fault detection filter (van der Ploeg 2018, Sec. 3-3, Thm 3-3.4; Sec. 4-3-4).
+
+The model varies with a measured parameter ``ρ`` (the longitudinal speed): ``H_k(q)[x] +
+L_k(q)[z] + F_k(q)[f] = 0`` (3.11), sampled with the parameter frozen over each sample
+("complete discretisation", Sec. 4-3-4).  At every step ``k`` the filter rebuilds the
+time-indexed bar matrices of Lemma 3-3.2 from the models at the instants of its window and
+takes the parity row of Theorem 3-3.4::
+
+    N̄_k*(γ) = ½ F̄_{k,j}ᵀ (I + γ H̄_k H̄_kᵀ)⁻¹                                    (3.17)
+
+or its exact limit ``γ → ∞``, ``N̄_k = ½ (P_k F̄_{k,j})ᵀ`` with ``P_k`` the orthogonal projector
+onto the left null space of ``H̄_k`` (``gamma=None``; research note §3.3).  ``N̄_k`` is then
+scaled so that ``Σ N̄_k F̄_k = −d(1)`` ((4.18)–(4.19): the fault-to-residual DC gain is 1),
+and the residual follows the input-output form of Corollary 3-3.5::
+
+    d(q) r = w,   w(k) = N̄_k L̄_k [z(τ_0); …; z(τ_{d_N + d_L})],   τ_i = k − deg d + i
+
+so ``r(k)`` uses ``z`` and ``ρ`` up to ``k − 1`` only (strictly proper).
+
+Errata and reconstruction choices (research note §3.3, §4 A13, §8 item 13):
+
+* the windows are time-consistent: block row ``i`` of ``H̄_k`` holds ``H_j(ρ(τ_i))`` at block
+  column ``i + j`` (columns ``x(τ_0) … x(τ_{d_N} + d_H)``), ``F̄_k``, ``L̄_k`` likewise.  The
+  thesis labels its first block row ``ρ_1 = V_x(k − 1)`` (reversed) and prints the ``z``
+  window one sample short and the ``r`` sum from ``i = 0``; the rank test (3.15) is
+  unaffected by the ordering;
+* ``N_k(1) F_k(1)`` in (4.18) is read as ``Σ N̄_k F̄_k`` (the current coefficients);
+* ``j`` must select a coefficient of ``F`` that reaches ``N_k(q) F_k(q)``: for the
+  single-track model the ``q²`` column lies in the range of ``H̄_k`` (the fault at the last
+  instant only moves the next state), so ``N̄_k ≈ 0`` there (Sec. 4-3-4); that choice raises
+  :class:`DesignError`;
+* ``d(q) = Π (q − p_i)`` with real poles, run as a cascade of first-order sections.
+
+The schedule is a measured signal: :meth:`ScheduledResidualGenerator.run` reads it from the
+trace by name (an output or control column, default ``"speed"``) or takes an array;
+:func:`simulate_scheduled` appends it to the trace as an output column.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.signal
+
+from fdikit.design.dae_parity import DAEModel, ParityDesign, RankTest, _real_poles, dae_form, parity_filter
+from fdikit.design.dae_parity import time_varying_bar as _bar
+from fdikit.errors import DataError, DesignError, ModelError
+from fdikit.faults import FaultScenario
+from fdikit.linalg import rank
+from fdikit.model import FaultModel
+from fdikit.residuals import Residuals
+from fdikit.trace import Trace
+
+__all__ = [
+    "ScheduledResidualGenerator",
+    "ScheduledStepper",
+    "lpv_bar_matrices",
+    "lpv_parity_row",
+    "lpv_rank_test",
+    "scheduled_parity_filter",
+    "simulate_scheduled",
+    "vaf",
+]
+
+Family = Callable[[float], FaultModel]
+
+
+def lpv_bar_matrices(window: Sequence[DAEModel], fault: str | None = None) -> tuple[np.ndarray, ...]:
+    """``(H̄_k, L̄_k, F̄_k)`` of Lemma 3-3.2 from the DAE models at the instants ``τ_0 … τ_{d_N}`` (oldest first)."""
+    j = window[0].fault_index(fault)
+    return (_bar([m.H for m in window]), _bar([m.L for m in window]), _bar([[F[:, [j]] for F in m.F] for m in window]))
+
+
+def lpv_rank_test(window: Sequence[DAEModel], fault: str | None = None) -> RankTest:
+    """Fact 3-3.3 / (3.15): ``Rank [H̄_k F̄_k] > Rank H̄_k`` for one window of parameter values."""
+    Hb, _, Fb = lpv_bar_matrices(window, fault)
+    r_with, r_without = rank(np.hstack([Hb, Fb])), rank(Hb)
+    return RankTest(r_with > r_without, r_with, r_without)
+
+
+def lpv_parity_row(H_bar: np.ndarray, F_column: np.ndarray, gamma: float | None = None) -> np.ndarray:
+    """Parity row(s) of Theorem 3-3.4 before normalisation; stacks of windows are allowed (leading axis).
+
+    ``gamma`` a positive number: the closed form (3.17) ``½ F̄_jᵀ (I + γ H̄ H̄ᵀ)⁻¹``.
+    ``gamma=None``: its limit ``½ (P F̄_j)ᵀ``, ``P = I − H̄ H̄⁺`` (SVD, relative rank tolerance).
+    """
+    H = np.asarray(H_bar, dtype=float)
+    f = np.asarray(F_column, dtype=float)
+    single = H.ndim == 2
+    H, f = (H[None], f.reshape(1, -1)) if single else (H, f.reshape(H.shape[0], -1))
+    if gamma is None:
+        U, s, _ = np.linalg.svd(H, full_matrices=True)
+        tol = 1e3 * max(H.shape[1:]) * np.finfo(float).eps * s[:, :1]
+        c = np.einsum("kij,ki->kj", U, f)
+        c[:, : s.shape[1]] *= ~(s > tol)
+        out = 0.5 * np.einsum("kij,kj->ki", U, c)
+    else:
+        if not (np.isfinite(gamma) and gamma > 0):
+            raise DesignError(f"gamma must be a positive Lagrange multiplier (thesis: 1e7) or None, got {gamma}")
+        M = np.eye(H.shape[1]) + gamma * np.einsum("kij,klj->kil", H, H)
+        out = 0.5 * np.linalg.solve(M, f[..., None])[..., 0]
+    return out[0] if single else out
+
+
+def vaf(reference: np.ndarray, estimate: np.ndarray) -> float:
+    """Variance accounted for, ``max(0, 1 − var(y − ŷ)/var(y)) · 100 %`` (Verhaegen & Verdult, thesis ref. [37])."""
+    y, yh = np.asarray(reference, dtype=float).ravel(), np.asarray(estimate, dtype=float).ravel()
+    if y.shape != yh.shape or y.size < 2:
+        raise DataError(f"vaf needs two equally long signals of 2+ samples, got {y.size} and {yh.size}")
+    return float(max(0.0, 1.0 - np.var(y - yh) / np.var(y)) * 100.0)
+
+
+@dataclass(frozen=True, eq=False)
+class ScheduledResidualGenerator:
+    """A parity filter whose row ``N̄_k`` follows a measured schedule ``ρ`` (Thm 3-3.4, Cor. 3-3.5).
+
+    Build it with :func:`scheduled_parity_filter`.  ``run(trace)`` is vectorised; ``online()``
+    gives a :class:`ScheduledStepper` with ``step(u, y, rho)``; both give the same residuals.
+
+    Attributes
+    ----------
+    family : ``ρ -> FaultModel`` (discrete, same names and ``dt`` for every ``ρ``).
+    fault, degree, poles, gamma, column : design choices (``gamma=None`` is the exact projection).
+    controls, outputs, residuals, isolates, dt : as :class:`~fdikit.residuals.ResidualGenerator`.
+    schedule : name of the trace column holding ``ρ``.
+    reference : the LTI :class:`ParityDesign` at the design point.
+    """
+
+    family: Family
+    fault: str
+    degree: int
+    poles: np.ndarray
+    gamma: float | None
+    column: int
+    controls: tuple[str, ...]
+    outputs: tuple[str, ...]
+    residuals: tuple[str, ...]
+    isolates: tuple[str | None, ...]
+    dt: float
+    schedule: str
+    reference: ParityDesign
+    fast_path: bool = False
+    _cache: dict = field(default_factory=dict, repr=False, compare=False)
+
+    @property
+    def window(self) -> int:
+        """Number of past samples the filter reads (``deg d``)."""
+        return self.poles.size
+
+    def _coefficients(self, rho: float) -> tuple[tuple[np.ndarray, ...], ...]:
+        """``(H, L, F)`` coefficient tuples at ``rho`` (``F``: the fault column), cached per value."""
+        key = float(rho)
+        hit = self._cache.get(key)
+        if hit is None:
+            if self.fast_path:
+                H0, H1, L, F = self.family.dae_matrices(key)
+                hit = ((H0, H1), (L,), (F,))
+            else:
+                model = self.family(key)
+                if not isinstance(model, FaultModel) or model.dt != self.dt or model.outputs != self.outputs:
+                    raise ModelError(f"family({key}) must return a discrete FaultModel with dt={self.dt} and "
+                                     f"outputs {list(self.outputs)} like the design point")
+                dae = dae_form(model, [self.fault])
+                hit = (dae.H, dae.L, dae.F)
+            if len(self._cache) > 100_000:
+                self._cache.clear()
+            self._cache[key] = hit
+        return hit
+
+    def dae(self, rho: float) -> DAEModel:
+        """The DAE (4.17) at parameter value ``rho``.
+
+        A family with a ``dae_matrices(rho) -> (H_0, H_1, L, F)`` method (e.g.
+        :class:`~fdikit.plants.single_track.SingleTrackLPV`) whose matrices equal
+        ``dae_form(family(reference), [fault])`` at the design point is read through it
+        (``fast_path``); otherwise ``dae_form(family(rho), [fault])``.  Values are cached.
+        """
+        H, L, F = self._coefficients(rho)
+        ref = self.reference.dae
+        return DAEModel(H, L, F, ref.unknowns, ref.outputs, ref.controls, (self.fault,), ref.dt)
+
+    def bar_matrices(self, windows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Stacks of ``(H̄_k, L̄_k, F̄_k)`` (Lemma 3-3.2), one per row of ``windows`` (``d_N + 1`` values, oldest first).
+
+        The same matrices as :func:`lpv_bar_matrices` on ``[dae(ρ) for ρ in window]``, assembled
+        for many windows at once.
+        """
+        windows = np.atleast_2d(np.asarray(windows, dtype=float))
+        vals, idx = np.unique(windows, return_inverse=True)
+        idx = idx.reshape(windows.shape)
+        coeffs = [self._coefficients(v) for v in vals]
+        out = []
+        for part in range(3):
+            C = np.stack([np.stack(c[part]) for c in coeffs])  # (values, degree + 1, rows, cols)
+            _, deg1, r, c = C.shape
+            K, n_rows = windows.shape
+            M = np.zeros((K, n_rows * r, (n_rows + deg1 - 1) * c))
+            for i in range(n_rows):
+                for j in range(deg1):
+                    M[:, i * r : (i + 1) * r, (i + j) * c : (i + j + 1) * c] = C[idx[:, i], j]
+            out.append(M)
+        return out[0], out[1], out[2]
+
+    def rows(self, windows: np.ndarray) -> np.ndarray:
+        """Normalised ``N̄_k L̄_k`` (one row per window of ``d_N + 1`` parameter values, oldest first).
+
+        Raises :class:`DesignError` where ``Σ N̄_k F̄_k ≈ 0`` (a degenerate column ``j``).
+        """
+        windows = np.atleast_2d(np.asarray(windows, dtype=float))
+        uniq, inv = np.unique(windows, axis=0, return_inverse=True)
+        Hb, Lb, Fb = self.bar_matrices(uniq)
+        Nb = lpv_parity_row(Hb, Fb[:, :, self.column], self.gamma)
+        nf = np.einsum("ki,kij->k", Nb, Fb)
+        bad = np.flatnonzero(~(np.abs(nf) > 1e-12 * np.linalg.norm(Fb, axis=(1, 2)) ** 2))
+        if bad.size:
+            raise DesignError(
+                f"at schedule window {uniq[bad[0]].tolist()} the parity row does not see the fault "
+                f"(Σ N̄F̄ = {nf[bad[0]]:.2e}): column j={self.column} of F̄ lies in the range of H̄; choose column=0"
+            )
+        scale = -np.prod(1.0 - self.poles) / nf
+        return (np.einsum("ki,kij->kj", Nb, Lb) * scale[:, None])[inv.ravel()]
+
+    def _windows(self, rho: np.ndarray) -> np.ndarray:
+        """Per sample ``k`` the parameters at ``τ_i = k − deg d + i``, ``i = 0…d_N`` (before ``k = 0``: ``ρ(0)``)."""
+        n = self.window
+        padded = np.concatenate([np.full(n, rho[0]), rho])
+        return np.stack([padded[i : i + rho.size] for i in range(self.degree + 1)], axis=1)
+
+    def _z_lags(self) -> int:
+        return self.degree + len(self.reference.dae.L)
+
+    def run(self, trace: Trace, schedule: np.ndarray | str | None = None) -> Residuals:
+        """Residuals of a whole trace; ``schedule`` is an array (N,), a column name, or None (``self.schedule``)."""
+        if len(trace) > 1 and not np.isclose(trace.dt, self.dt, rtol=1e-6):
+            raise DataError(f"data sampled at dt={trace.dt:g} but the filter runs at dt={self.dt:g}; resample")
+        rho = self._schedule_of(trace, schedule)
+        z = np.hstack([trace.columns("y", self.outputs), trace.columns("u", self.controls)])
+        if not np.all(np.isfinite(z)):
+            k = int(np.argwhere(~np.isfinite(z))[0, 0])
+            raise DataError(f"a used signal is not finite at sample {k}; run() needs clean data — use online().step()")
+        n, m = self.window, self._z_lags()
+        zp = np.vstack([np.zeros((n, z.shape[1])), z])
+        zwin = np.hstack([zp[i : i + len(trace)] for i in range(m)])
+        w = np.einsum("kj,kj->k", self.rows(self._windows(rho)), zwin)
+        for p in self.poles:
+            w = scipy.signal.lfilter([1.0], [1.0, -p], w)
+        meta = {"trace": dict(trace.meta), "schedule": schedule if isinstance(schedule, str) else self.schedule}
+        return Residuals(trace.t, w[:, None], self.residuals, self.isolates, meta=meta)
+
+    def _schedule_of(self, trace: Trace, schedule) -> np.ndarray:
+        if schedule is None or isinstance(schedule, str):
+            name = schedule or self.schedule
+            kind = "y" if name in trace.outputs else "u" if name in trace.controls else None
+            if kind is None:
+                raise DataError(f"the trace has no column {name!r} for the schedule; pass schedule=<array of "
+                                f"{len(trace)} values> or the name of one of {list(trace.outputs + trace.controls)}")
+            rho = trace.signal(name, kind)
+        else:
+            rho = np.asarray(schedule, dtype=float).ravel()
+        if rho.shape != (len(trace),) or not np.all(np.isfinite(rho)):
+            raise DataError(f"the schedule must be {len(trace)} finite values (one per sample), got shape {rho.shape}")
+        return rho
+
+    def online(self) -> ScheduledStepper:
+        """A stepper with zero initial history (like ``run``)."""
+        return ScheduledStepper(self)
+
+
+class ScheduledStepper:
+    """Online scheduled residuals: ``step(u, y, rho)`` returns ``r(k)`` for the sample ``(u(k), y(k), ρ(k))``.
+
+    A sample with a NaN/inf gives a NaN residual, counts in ``invalid`` and is skipped (the
+    window and the filter state hold), as :class:`~fdikit.residuals.ResidualStepper` does.
+    """
+
+    def __init__(self, generator: ScheduledResidualGenerator) -> None:
+        self.generator = generator
+        n = generator.window
+        self._z = np.zeros((n, len(generator.outputs) + len(generator.controls)))
+        self._rho: np.ndarray | None = None
+        self._x = np.zeros(n)
+        self.invalid = 0
+        self.last_valid = True
+
+    def step(self, u: Sequence[float], y: Sequence[float], rho: float) -> float:
+        """Residual of this sample (``u``, ``y`` in the generator's controls/outputs order, ``rho`` the schedule)."""
+        g = self.generator
+        u, y = np.asarray(u, dtype=float).ravel(), np.asarray(y, dtype=float).ravel()
+        if u.size != len(g.controls) or y.size != len(g.outputs):
+            raise DataError(f"step() needs {len(g.controls)} controls {list(g.controls)} and {len(g.outputs)} "
+                            f"outputs {list(g.outputs)}, got {u.size} and {y.size}")
+        if not (np.all(np.isfinite(u)) and np.all(np.isfinite(y)) and np.isfinite(rho)):
+            self.invalid += 1
+            self.last_valid = False
+            return float("nan")
+        self.last_valid = True
+        if self._rho is None:
+            self._rho = np.full(g.window, float(rho))
+        row = g.rows(self._rho[: g.degree + 1])[0]
+        w = float(row @ self._z[: g._z_lags()].ravel())
+        for i, p in enumerate(g.poles):
+            self._x[i] = p * self._x[i] + w
+            w = self._x[i]
+        self._z = np.vstack([self._z[1:], np.concatenate([y, u])])
+        self._rho = np.append(self._rho[1:], float(rho))
+        return w
+
+
+def scheduled_parity_filter(
+    family: Family,
+    reference: float,
+    fault: str | None = None,
+    *,
+    degree: int | None = None,
+    poles: float | Sequence[float] = 0.9048,
+    gamma: float | None = None,
+    column: int = 0,
+    schedule: str = "speed",
+    name: str | None = None,
+) -> ScheduledResidualGenerator:
+    """Speed-scheduled parity filter (van der Ploeg 2018, Thm 3-3.4, (3.17), (4.18); Sec. 4-3-4).
+
+    Parameters
+    ----------
+    family : callable ``ρ -> FaultModel``
+        Discrete models with the fault input, e.g. :func:`fdikit.plants.single_track.single_track_lpv`.
+    reference : float
+        Design point ``ρ`` for the degree search and the checks (e.g. ``70 / 3.6`` m/s).
+    fault : str, optional
+        Fault to detect (default: the model's only fault).
+    degree : int, optional
+        ``d_N``; default the minimal degree at ``reference``.
+    poles : float or sequence of float
+        Real poles of ``d(q)`` (default 0.9048, repeated ``d_N + d_L + 1`` times).
+    gamma : float or None
+        Lagrange multiplier of (3.17) (the thesis uses 1e7); None (default) is the exact
+        ``γ → ∞`` projection.
+    column : int
+        ``j``, the column of ``F̄_k`` (coefficient of ``q^j``) that (3.16) maximises; default 0.
+    schedule : str
+        Name of the trace column holding ``ρ`` (default ``"speed"``).
+    name : str, optional
+        Residual name (default ``r_<fault>``).
+
+    Raises
+    ------
+    DesignError
+        If the fault is not detectable at ``reference``, ``column`` is out of range or
+        degenerate there, or there are fewer than ``d_N + d_L + 1`` poles.
+
+    Examples
+    --------
+    >>> from fdikit.plants.single_track import single_track_lpv
+    >>> gen = scheduled_parity_filter(single_track_lpv(), 70 / 3.6)
+    >>> gen.degree, gen.window, gen.residuals
+    (2, 3, ('r_steering_actuator',))
+    """
+    model = family(reference)
+    if not isinstance(model, FaultModel) or not model.is_discrete:
+        raise ModelError(f"family({reference}) must return a discrete FaultModel, got {model!r}")
+    dae = dae_form(model)
+    fault = dae.faults[dae.fault_index(fault)]
+    ref = parity_filter(dae_form(model, [fault]), fault, degree=degree, poles=poles, name=name)
+    min_poles = ref.degree + len(dae.L)
+    p = _real_poles(poles, min_poles)
+    if p.size < min_poles:
+        raise DesignError(f"the scheduled filter needs at least d_N + d_L + 1 = {min_poles} poles, got {p.size}")
+    n_cols = ref.degree + len(dae.F)
+    if not 0 <= int(column) < n_cols:
+        raise DesignError(f"column must index F̄ (0 … {n_cols - 1}), got {column}")
+    fast = callable(getattr(family, "dae_matrices", None))
+    if fast:
+        mats = family.dae_matrices(reference)
+        want = (*ref.dae.H, *ref.dae.L, *ref.dae.F)
+        fast = len(mats) == len(want) and all(np.shape(a) == b.shape and np.allclose(a, b) for a, b in zip(mats, want))
+    gen = ScheduledResidualGenerator(
+        family=family, fault=fault, degree=ref.degree, poles=p, gamma=None if gamma is None else float(gamma),
+        column=int(column), controls=model.controls, outputs=model.outputs, residuals=ref.generator.residuals,
+        isolates=ref.generator.isolates, dt=float(model.dt), schedule=schedule, reference=ref, fast_path=fast,
+    )
+    Hb, _, Fb = gen.bar_matrices(np.full((1, ref.degree + 1), float(reference)))
+    Fj = Fb[0, :, gen.column]
+    if np.linalg.norm(lpv_parity_row(Hb[0], Fj)) <= 1e-8 * np.linalg.norm(Fj):
+        raise DesignError(f"column j={column} of F̄ lies in the range of H̄ at the design point (P F̄_j = 0), so "
+                          "(3.17) gives N̄ ≈ 0 (Sec. 4-3-4: the q² column); choose column=0")
+    gen.rows(np.full((1, ref.degree + 1), float(reference)))  # e.g. a bad gamma fails now, not at run time
+    return gen
+
+
+def simulate_scheduled(
+    family: Family,
+    schedule: np.ndarray,
+    scenario: FaultScenario | None = None,
+    *,
+    u: np.ndarray | None = None,
+    d: np.ndarray | None = None,
+    x0: np.ndarray | None = None,
+    schedule_name: str = "speed",
+    rng: np.random.Generator | int | None = None,
+) -> Trace:
+    """Simulate the parameter-varying plant ``x(k+1) = A(ρ_k) x(k) + B(ρ_k) v(k)`` (frozen ρ over each sample).
+
+    The "complete discretisation" of Sec. 4-3-4: sample ``k`` uses ``family(schedule[k])``.
+    Faults act on signals as in :func:`fdikit.simulate.simulate` (actuator faults before the
+    plant, in scenario order — so ``[ScaleFactor, Bias]`` gives ``δ = f_m δ_set + f_a``, (1.3);
+    sensor faults after).  The trace carries ``ρ`` as an extra output column ``schedule_name``.
+    ``u`` (N, m) and ``d`` (N, n_d) default to zero; the model's noise group is not simulated.
+    A family with ``dae_matrices`` (see :meth:`ScheduledResidualGenerator.dae`) is read through it.
+    """
+    rho = np.asarray(schedule, dtype=float).ravel()
+    if rho.size < 2 or not np.all(np.isfinite(rho)):
+        raise DataError("schedule must hold 2+ finite parameter values, one per sample")
+    m0 = family(float(rho[0]))
+    if not isinstance(m0, FaultModel) or not m0.is_discrete:
+        raise ModelError("family must return discrete FaultModels")
+    if schedule_name in m0.outputs:
+        raise ModelError(f"schedule_name {schedule_name!r} is already an output of the plant; choose another name")
+    N, t = rho.size, np.arange(rho.size) * m0.dt
+    blocks = {}
+    for key, val, names in (("u", u, m0.controls), ("d", d, m0.disturbances)):
+        arr = np.zeros((N, len(names))) if val is None else np.asarray(val, dtype=float).reshape(N, -1)
+        if arr.shape != (N, len(names)) or not np.all(np.isfinite(arr)):
+            raise DataError(f"{key} must be a finite ({N}, {len(names)}) array, columns {list(names)}")
+        blocks[key] = arr
+    scenario = (scenario or FaultScenario()).resolve(m0.outputs, m0.controls)
+    streams = np.random.default_rng(rng).spawn(max(1, len(scenario)))
+    u_act = blocks["u"].copy()
+    for f, rf in zip(scenario, streams):
+        if f.location == "actuator":
+            j = m0.controls.index(f.target)
+            u_act[:, j] = f.apply(t, u_act[:, j], rf)
+    x = np.zeros(m0.n) if x0 is None else np.asarray(x0, dtype=float).reshape(m0.n)
+    X, Y = np.empty((N, m0.n)), np.empty((N, m0.p))
+    v = np.hstack([u_act, blocks["d"]])
+    n, ny = m0.n, m0.p
+    ref = dae_form(m0, [])
+    fast = callable(getattr(family, "dae_matrices", None))
+    fast = fast and all(np.allclose(a, b) for a, b in zip(family.dae_matrices(float(rho[0]))[:3], (*ref.H, *ref.L)))
+    mats: dict[float, tuple[np.ndarray, ...]] = {}
+    for k in range(N):
+        key = float(rho[k])
+        mk = mats.get(key)
+        if mk is None:
+            if fast:  # H_0 = [[A, Bd], [C, Dd]], L = [[0, Bu], [-I, Du]] (dae_form), without building a FaultModel
+                H0, _, L, _ = family.dae_matrices(key)
+                mk = (H0[:n, :n], np.hstack([L[:n, ny:], H0[:n, n:]]), H0[n:, :n], np.hstack([L[n:, ny:], H0[n:, n:]]))
+            else:
+                mod = family(key)
+                mk = (mod.A, np.hstack([mod.Bu, mod.Bd]), mod.C, np.hstack([mod.Du, mod.Dd]))
+            mats[key] = mk
+        X[k] = x
+        Y[k] = mk[2] @ x + mk[3] @ v[k]
+        x = mk[0] @ x + mk[1] @ v[k]
+    for f, rf in zip(scenario, streams):
+        if f.location == "sensor":
+            j = m0.outputs.index(f.target)
+            Y[:, j] = f.apply(t, Y[:, j], rf)
+    return Trace(t=t, u=blocks["u"], y=np.hstack([Y, rho[:, None]]), controls=m0.controls,
+                 outputs=m0.outputs + (schedule_name,), x=X, states=m0.states, d=blocks["d"],
+                 disturbances=m0.disturbances, fault=scenario.truth(t),
+                 meta={"plant": repr(m0), "scenario": scenario.label, "schedule": schedule_name})
