@@ -49,7 +49,7 @@ from fdikit.residuals import ResidualGenerator
 
 __all__ = [
     "DAEModel",
-    "ParityDesign",
+    "PolynomialParityDesign",
     "RankTest",
     "bar",
     "bar_matrices",
@@ -334,7 +334,7 @@ def _newton_chain(num: np.ndarray, poles: np.ndarray) -> tuple[np.ndarray, np.nd
 
 
 @dataclass(frozen=True, eq=False)
-class ParityDesign:
+class PolynomialParityDesign:
     """An LTI parity (DAE null-space) fault detection filter (van der Ploeg 2018, (2.6)–(2.9)).
 
     Attributes
@@ -377,6 +377,14 @@ class ParityDesign:
         return float(self.fault_gain(1.0).real)
 
     @property
+    def fault_map(self) -> tuple[np.ndarray, np.ndarray]:
+        """``G(q) = −N(q) F(q) / d(q)`` (2.7) as ``(num, den)`` in descending powers of ``q`` (scipy.signal order).
+
+        This is the pre-filter of :func:`fdikit.estimate.isolate_steering_faults` (Sec. 3-2).
+        """
+        return -self.NF[::-1], self.denominator[::-1]
+
+    @property
     def fault_zeros(self) -> np.ndarray:
         """Zeros of ``N(q) F(q)`` (leading coefficients below ``1e-10 · max|NF|`` dropped)."""
         nf = self.NF.copy()
@@ -392,7 +400,7 @@ def parity_filter(
     degree: int | None = None,
     poles: float | Sequence[float] = 0.9048,
     name: str | None = None,
-) -> ParityDesign:
+) -> PolynomialParityDesign:
     """LTI parity-space fault detection filter (van der Ploeg 2018, Lemma 2-1.2, (2.6)–(2.9); Sec. 4-3-1).
 
     Parameters
@@ -412,7 +420,7 @@ def parity_filter(
 
     Returns
     -------
-    ParityDesign
+    PolynomialParityDesign
         With ``G(1) = 1`` (2.8b) and ``N̄ H̄ = 0`` (2.8a).
 
     Raises
@@ -464,7 +472,7 @@ def parity_filter(
     name = name or f"r_{fault}"
     gen = ResidualGenerator(A, B, C, D, dae.controls, dae.outputs, (name,), dae.dt, (fault,))
     decoupling = float(np.linalg.norm(Nb @ Hb) / (np.linalg.norm(Nb) * np.linalg.norm(Hb)))
-    return ParityDesign(
+    return PolynomialParityDesign(
         generator=gen, dae=dae, fault=fault, degree=dN, null_dimension=V.shape[0], N=Nb.reshape(dN + 1, -1),
         NL=NL, NF=NF, denominator=den, poles=p, decoupling=decoupling,
     )

@@ -44,7 +44,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.signal
 
-from fdikit.design.dae_parity import DAEModel, ParityDesign, RankTest, _real_poles, dae_form, parity_filter
+from fdikit.design.dae_parity import DAEModel, PolynomialParityDesign, RankTest, _real_poles, dae_form, parity_filter
 from fdikit.design.dae_parity import time_varying_bar as _bar
 from fdikit.errors import DataError, DesignError, ModelError
 from fdikit.faults import FaultScenario
@@ -125,7 +125,7 @@ class ScheduledResidualGenerator:
     fault, degree, poles, gamma, column : design choices (``gamma=None`` is the exact projection).
     controls, outputs, residuals, isolates, dt : as :class:`~fdikit.residuals.ResidualGenerator`.
     schedule : name of the trace column holding ``ρ``.
-    reference : the LTI :class:`ParityDesign` at the design point.
+    reference : the LTI :class:`PolynomialParityDesign` at the design point.
     """
 
     family: Family
@@ -140,7 +140,7 @@ class ScheduledResidualGenerator:
     isolates: tuple[str | None, ...]
     dt: float
     schedule: str
-    reference: ParityDesign
+    reference: PolynomialParityDesign
     fast_path: bool = False
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
 

@@ -11,6 +11,7 @@ name               model                                            source
 ``single-track``   lateral single-track model with lane errors      van der Ploeg 2018, (B.12)
 ``f16xl``          F-16XL longitudinal, 4 states, ``C = I``         Murray 2012, §6.1
 ``white-speyer``   3-state system with invariant-zero cases         Murray 2012, §6.2
+``varrier-lateral`` lateral 2-state model, ρ = 1/v, Euler 0.02 s    Varrier et al. 2014, (48)
 =================  ==============================================  ======================
 
 Examples
@@ -35,7 +36,22 @@ from fdikit.plants.path_vehicle import (
     path_vehicle_14,
     rounding_intervals,
 )
-from fdikit.plants.single_track import PRIUS_2010, SingleTrackParameters, single_track, understeer_gradient
+from fdikit.plants.single_track import (
+    PRIUS_2010,
+    SingleTrackLPV,
+    SingleTrackParameters,
+    single_track,
+    single_track_lpv,
+    understeer_gradient,
+)
+from fdikit.plants.varrier_lateral import (
+    SCENIC,
+    VarrierParameters,
+    rho_from_speed,
+    varrier_lateral,
+    varrier_lateral_lpv,
+    varrier_uncertainty,
+)
 from fdikit.plants.white_speyer import WHITE_SPEYER_CASES, white_speyer
 
 __all__ = [
@@ -50,6 +66,14 @@ __all__ = [
     "PRIUS_2010",
     "single_track",
     "understeer_gradient",
+    "single_track_lpv",
+    "SingleTrackLPV",
+    "varrier_lateral",
+    "varrier_lateral_lpv",
+    "varrier_uncertainty",
+    "VarrierParameters",
+    "SCENIC",
+    "rho_from_speed",
     "f16xl_longitudinal",
     "white_speyer",
     "WHITE_SPEYER_CASES",
@@ -62,6 +86,7 @@ PLANTS: dict[str, Callable[..., FaultModel]] = {
     "single-track": single_track,
     "f16xl": f16xl_longitudinal,
     "white-speyer": white_speyer,
+    "varrier-lateral": varrier_lateral,
 }
 
 

@@ -1,1 +1,20 @@
-"""Simulation scenarios of the seeds, as functions that return :class:`~fdikit.trace.Trace` objects."""
+"""Simulation scenarios of the seeds, as functions that return :class:`~fdikit.trace.Trace` objects.
+
+* :mod:`fdikit.scenarios.vanderploeg` — the single-track steering-fault cases S1–S8 of van der Ploeg
+  2018, Ch. 4 (:func:`vanderploeg_case`, :func:`lateral_run`, :func:`cornering_run`);
+* :mod:`fdikit.scenarios.varrier` — the lateral-acceleration sensor fault of Varrier et al. 2014, §5
+  (:func:`varrier_trace`, the ϖ score :func:`min_max_ratio`).
+"""
+
+from fdikit.scenarios.vanderploeg import cornering_run, lateral_run, true_steering_faults, vanderploeg_case
+from fdikit.scenarios.varrier import min_max_ratio, varrier_comparison, varrier_trace
+
+__all__ = [
+    "cornering_run",
+    "lateral_run",
+    "min_max_ratio",
+    "true_steering_faults",
+    "vanderploeg_case",
+    "varrier_comparison",
+    "varrier_trace",
+]
