@@ -12,6 +12,7 @@ name               model                                            source
 ``f16xl``          F-16XL longitudinal, 4 states, ``C = I``         Murray 2012, §6.1
 ``white-speyer``   3-state system with invariant-zero cases         Murray 2012, §6.2
 ``varrier-lateral`` lateral 2-state model, ρ = 1/v, Euler 0.02 s    Varrier et al. 2014, (48)
+``path7``          PATH longitudinal, 7 states (reduced, 25 m/s)    Douglas et al. 1996, §9.6
 =================  ==============================================  ======================
 
 Examples
@@ -29,6 +30,7 @@ from collections.abc import Callable
 from fdikit.errors import ModelError
 from fdikit.model import FaultModel
 from fdikit.plants.f16xl import f16xl_longitudinal
+from fdikit.plants.path_longitudinal import path_longitudinal_7, path_longitudinal_7_fault_maps
 from fdikit.plants.path_vehicle import (
     TABLE_2_1_EIGENVALUES_12,
     TABLE_2_1_EIGENVALUES_14,
@@ -76,6 +78,8 @@ __all__ = [
     "rho_from_speed",
     "f16xl_longitudinal",
     "white_speyer",
+    "path_longitudinal_7",
+    "path_longitudinal_7_fault_maps",
     "WHITE_SPEYER_CASES",
 ]
 
@@ -87,6 +91,7 @@ PLANTS: dict[str, Callable[..., FaultModel]] = {
     "f16xl": f16xl_longitudinal,
     "white-speyer": white_speyer,
     "varrier-lateral": varrier_lateral,
+    "path7": path_longitudinal_7,
 }
 
 
