@@ -3,17 +3,17 @@
 Each plant is a function returning a :class:`~fdikit.model.FaultModel`; :data:`PLANTS`
 maps a short name to that function and :func:`get_plant` looks one up by name.
 
-=================  ==============================================  ======================
-name               model                                            source
-=================  ==============================================  ======================
-``path12``         PATH vehicle, 12 states, sensor-fault design     Douglas et al. 1996, (d.2)
-``path14``         PATH vehicle, 14 states, actuator-fault design   Douglas et al. 1996, (d.1)
-``single-track``   lateral single-track model with lane errors      van der Ploeg 2018, (B.12)
-``f16xl``          F-16XL longitudinal, 4 states, ``C = I``         Murray 2012, §6.1
-``white-speyer``   3-state system with invariant-zero cases         Murray 2012, §6.2
-``varrier-lateral`` lateral 2-state model, ρ = 1/v, Euler 0.02 s    Varrier et al. 2014, (48)
-``path7``          PATH longitudinal, 7 states (reduced, 25 m/s)    Douglas et al. 1996, §9.6
-=================  ==============================================  ======================
+===================  ==============================================  ======================
+name                 model                                            source
+===================  ==============================================  ======================
+``path12``           PATH vehicle, 12 states, sensor-fault design     Douglas et al. 1996, (d.2)
+``path14``           PATH vehicle, 14 states, actuator-fault design   Douglas et al. 1996, (d.1)
+``single-track``     lateral single-track model with lane errors      van der Ploeg 2018, (B.12)
+``f16xl``            F-16XL longitudinal, 4 states, ``C = I``         Murray 2012, §6.1
+``white-speyer``     3-state system with invariant-zero cases         Murray 2012, §6.2
+``varrier-lateral``  lateral 2-state model, ρ = 1/v, Euler 0.02 s     Varrier et al. 2014, (48)
+``path7``            PATH longitudinal, 7 states (reduced, 25 m/s)    Douglas et al. 1996, §9.6
+===================  ==============================================  ======================
 
 Examples
 --------
