@@ -1,4 +1,5 @@
-"""Finite-horizon time-varying game filters (fdikit.design.game_ltv; Murray 2012, Ch. 3).
+"""Finite-horizon time-varying game filters and LTV geometry (fdikit.design.game_ltv, fdikit.design.ltv;
+Murray 2012, Ch. 3).
 
 Oracles: the steady-state CARE of the P-form GTFDF (scipy) and the single-fault eigenvalues of
 Murray 2012, Remark 6.6 (§6.2.3); the linear Hamiltonian system whose solution is P = Y X⁻¹ (finite
@@ -20,15 +21,9 @@ from scipy.optimize import brentq
 
 from fdikit import FaultModel
 from fdikit.design import restricted_diagonal
-from fdikit.design.game_ltv import (
-    LTVModel,
-    invariant_generators,
-    ltv_detection_filter,
-    ltv_feasibility,
-    ltv_game_filter,
-    ltv_projector,
-)
+from fdikit.design.game_ltv import ltv_detection_filter, ltv_feasibility, ltv_game_filter
 from fdikit.design.game_setup import game_problem
+from fdikit.design.ltv import LTVModel, invariant_generators, ltv_projector
 from fdikit.design.observer import observer_generator
 from fdikit.errors import DataError, DesignError, ModelError
 from fdikit.plants import single_track
