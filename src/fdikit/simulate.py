@@ -6,6 +6,10 @@ integrated between samples by fixed-step RK4 or :func:`scipy.integrate.solve_ivp
 with the inputs held.  Actuator faults change the commanded control before the
 plant, sensor faults change the measurement after the sensor noise (a stuck sensor
 reads a frozen, noise-free value).
+
+Parameter-varying plants (a family ``ρ -> discrete FaultModel`` and a measured schedule ρ)
+are simulated by :func:`simulate_scheduled` with ρ frozen over each sample, the "complete
+discretisation" of van der Ploeg 2018, Sec. 4-3-4; faults act as in :func:`simulate`.
 """
 
 from __future__ import annotations
@@ -14,6 +18,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from fdikit.errors import DataError, ModelError
 from fdikit.faults import FaultScenario
@@ -21,7 +26,7 @@ from fdikit.lti import dlsim_blocked
 from fdikit.model import FaultModel
 from fdikit.trace import Trace
 
-__all__ = ["NonlinearPlant", "simulate", "time_grid"]
+__all__ = ["NonlinearPlant", "simulate", "simulate_scheduled", "time_grid"]
 
 
 @dataclass(frozen=True)
@@ -172,16 +177,9 @@ def simulate(
     rng_w, rng_v, *rng_f = rng.spawn(2 + len(scenario))
 
     u_cmd = _signal("u", u, t, controls)
-    u_act = u_cmd.copy()
-    for f, rf in zip(scenario, rng_f):
-        if f.location == "actuator":
-            j = controls.index(f.target)
-            u_act[:, j] = f.apply(t, u_act[:, j], rf)
+    u_act = _apply_faults(scenario, "actuator", t, u_cmd, controls, rng_f)
     d_arr = _signal("d", d, t, dists)
-    if x0 is not None:
-        x0 = np.asarray(x0, dtype=float)
-        if x0.shape != (len(states),):
-            raise DataError(f"x0 has shape {x0.shape}; need ({len(states)},), one value per state {list(states)}")
+    x0 = _initial_state(x0, states)
 
     if isinstance(plant, FaultModel):
         W = _covariance("noise_cov", noise_cov, len(plant.noise))
@@ -193,16 +191,33 @@ def simulate(
     R = _covariance("measurement_noise", measurement_noise, len(outputs))
     if R is not None:
         y = y + _gaussian(rng_v, R, N)
-    for f, rf in zip(scenario, rng_f):
-        if f.location == "sensor":
-            j = outputs.index(f.target)
-            y[:, j] = f.apply(t, y[:, j], rf)
+    y = _apply_faults(scenario, "sensor", t, y, outputs, rng_f)
 
     info = {"plant": repr(plant), "seed": None if seed is None else int(seed), "scenario": scenario.label,
             "faults": [repr(f) for f in scenario]}
     info.update(meta or {})
     return Trace(t=t, u=u_cmd, y=y, x=x, d=d_arr, controls=controls, outputs=outputs, states=states,
                  disturbances=dists, fault=scenario.truth(t), meta=info)
+
+
+def _apply_faults(scenario: FaultScenario, location: str, t: np.ndarray, signals: np.ndarray,
+                  names: Sequence[str], streams: Sequence[np.random.Generator]) -> np.ndarray:
+    """``signals`` (N, k) with the scenario's ``location`` faults applied in scenario order, one stream per fault."""
+    out = signals.copy()
+    for f, rf in zip(scenario, streams):
+        if f.location == location:
+            j = names.index(f.target)
+            out[:, j] = f.apply(t, out[:, j], rf)
+    return out
+
+
+def _initial_state(x0, states: Sequence[str]) -> np.ndarray | None:
+    if x0 is None:
+        return None
+    x0 = np.asarray(x0, dtype=float)
+    if x0.shape != (len(states),):
+        raise DataError(f"x0 has shape {x0.shape}; need ({len(states)},), one value per state {list(states)}")
+    return x0
 
 
 def _simulate_linear(model, h, t, u, d, x0, W, rng):
@@ -251,3 +266,110 @@ def _simulate_nonlinear(plant, t, h, u, x0, W, rng, method, substeps):
         if not np.all(np.isfinite(xk)):
             raise DataError(f"the nonlinear plant state became non-finite at t={t[k + 1]:g}; check f or the step size")
     return y, x
+
+
+def simulate_scheduled(
+    family: Callable[[float], FaultModel],
+    schedule: ArrayLike,
+    scenario: FaultScenario | None = None,
+    *,
+    u=None,
+    d=None,
+    x0=None,
+    schedule_name: str = "speed",
+    rng: np.random.Generator | int | None = None,
+) -> Trace:
+    """Simulate the parameter-varying plant ``x(k+1) = A(ρ_k) x(k) + B(ρ_k) v(k)`` (ρ frozen over each sample).
+
+    The "complete discretisation" of van der Ploeg 2018, Sec. 4-3-4: sample ``k`` uses the
+    discrete model ``family(schedule[k])``.  A constant schedule is :func:`simulate` of that one
+    model (same code path and random streams).  Faults act on signals as in :func:`simulate`
+    (actuator faults before the plant, in scenario order — so ``[ScaleFactor, Bias]`` gives
+    ``δ = f_m δ_set + f_a``, (1.3); sensor faults after).  The model's noise group is not simulated.
+
+    Parameters
+    ----------
+    family : callable ``ρ -> FaultModel``
+        Discrete models with the same names and ``dt`` for every ρ, e.g.
+        :func:`fdikit.plants.single_track.single_track_lpv`.  A family with a vectorised
+        ``state_space(rho) -> (A, B, C, D)`` (stacks over a 1-D array of ρ; ``B``, ``D`` over the
+        controls then the disturbances) is evaluated in one call — needed when ρ changes every
+        sample (a speed sweep); otherwise ``family`` is called once per distinct ρ.
+    schedule : (N,) array_like
+        ρ at each sample (2+ finite values); the trace carries it as the extra output ``schedule_name``.
+    scenario : FaultScenario, optional
+        Faults on the plant's named sensors and actuators.
+    u, d : array (N, m) or callable ``t -> (m,)``, optional
+        Commanded controls and disturbances (zero when omitted).
+    x0 : array, optional
+        Initial state (default zero).
+    rng : numpy.random.Generator or int seed
+        Source of random fault signals.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.plants.single_track import single_track_lpv
+    >>> tr = simulate_scheduled(single_track_lpv(), np.linspace(70, 120, 101) / 3.6, u=np.full(101, 1e-3))
+    >>> tr.outputs
+    ('yaw_rate', 'lateral_error', 'heading_error', 'speed')
+    """
+    rho = np.asarray(schedule, dtype=float).ravel()
+    if rho.size < 2 or not np.all(np.isfinite(rho)):
+        raise DataError("schedule must hold 2+ finite parameter values, one per sample")
+    m0 = family(float(rho[0]))
+    if not isinstance(m0, FaultModel) or not m0.is_discrete:
+        raise ModelError(f"family must return discrete FaultModels; family({rho[0]:g}) gave {m0!r}")
+    if schedule_name in m0.outputs:
+        raise ModelError(f"schedule_name {schedule_name!r} is already an output of the plant; choose another name")
+    t = np.arange(rho.size) * m0.dt
+    scenario = (scenario or FaultScenario()).resolve(m0.outputs, m0.controls)
+    _, _, *rng_f = np.random.default_rng(rng).spawn(2 + len(scenario))  # the fault streams of simulate()
+    u_cmd = _signal("u", u, t, m0.controls)
+    u_act = _apply_faults(scenario, "actuator", t, u_cmd, m0.controls, rng_f)
+    d_arr = _signal("d", d, t, m0.disturbances)
+    x0 = _initial_state(x0, m0.states)
+    if np.all(rho == rho[0]):
+        y, x = _simulate_linear(m0, m0.dt, t, u_act, d_arr, x0, None, None)
+    else:
+        y, x = _simulate_varying(family, m0, rho, np.hstack([u_act, d_arr]), x0)
+    y = _apply_faults(scenario, "sensor", t, y, m0.outputs, rng_f)
+    return Trace(t=t, u=u_cmd, y=np.hstack([y, rho[:, None]]), controls=m0.controls,
+                 outputs=m0.outputs + (schedule_name,), x=x, states=m0.states, d=d_arr,
+                 disturbances=m0.disturbances, fault=scenario.truth(t),
+                 meta={"plant": repr(m0), "scenario": scenario.label, "schedule": schedule_name})
+
+
+def _scheduled_matrices(family, m0: FaultModel, values: np.ndarray, i0: int) -> tuple[np.ndarray, ...]:
+    """``(A, B, C, D)`` stacks at the distinct schedule ``values`` (``values[i0]`` gave ``m0``); B, D over [u, d]."""
+    ref = (m0.A, np.hstack([m0.Bu, m0.Bd]), m0.C, np.hstack([m0.Du, m0.Dd]))
+    state_space = getattr(family, "state_space", None)
+    if callable(state_space):
+        mats = tuple(np.asarray(M, dtype=float) for M in state_space(values))
+        ok = len(mats) == 4 and all(M.shape == (values.size,) + R.shape for M, R in zip(mats, ref))
+        if not (ok and all(np.allclose(M[i0], R, rtol=1e-9, atol=1e-12) for M, R in zip(mats, ref))):
+            raise ModelError(f"family.state_space disagrees with family({values[i0]:g}); it must return the stacks "
+                             "(A, [Bu Bd], C, [Du Dd]) of the family's models, one per schedule value")
+        return mats
+    models = [m0 if i == i0 else family(float(r)) for i, r in enumerate(values)]
+    for r, m in zip(values, models):
+        if not isinstance(m, FaultModel) or m.dt != m0.dt or m.inputs != m0.inputs or m.outputs != m0.outputs \
+                or m.n != m0.n:
+            raise ModelError(f"family({r:g}) must be a discrete FaultModel with the names, sizes and dt of "
+                             f"family({values[i0]:g})")
+    return tuple(np.stack(M) for M in zip(*[(m.A, np.hstack([m.Bu, m.Bd]), m.C, np.hstack([m.Du, m.Dd]))
+                                            for m in models]))
+
+
+def _simulate_varying(family, m0: FaultModel, rho: np.ndarray, v: np.ndarray, x0: np.ndarray | None):
+    """Outputs and states with the model of ``rho[k]`` at sample k; ``v`` = [u, d] per sample."""
+    values, idx = np.unique(rho, return_inverse=True)
+    A, B, C, D = _scheduled_matrices(family, m0, values, int(idx[0]))
+    drive = np.einsum("kij,kj->ki", B[idx], v)
+    Ak = A[idx]
+    x = np.empty((rho.size, m0.n))
+    xk = np.zeros(m0.n) if x0 is None else x0
+    for k in range(rho.size):
+        x[k] = xk
+        xk = Ak[k] @ xk + drive[k]
+    return np.einsum("kij,kj->ki", C[idx], x) + np.einsum("kij,kj->ki", D[idx], v), x

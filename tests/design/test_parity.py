@@ -12,18 +12,14 @@ import pytest
 import scipy.linalg
 
 from fdikit import FaultModel
-from fdikit.design.parity import (
+from fdikit.design.lpv import (
     LPVModel,
     Uncertainty,
-    lpv_parity_residuals,
     lpv_stacked_matrices,
-    minimal_horizon,
-    parity_design,
-    parity_matrix,
-    regular_rows,
     stacked_matrices,
     uncertain_stacked_matrices,
 )
+from fdikit.design.parity import lpv_parity_residuals, minimal_horizon, parity_design, parity_matrix, regular_rows
 from fdikit.errors import DataError, DesignError, ModelError
 from fdikit.plants.varrier_lateral import varrier_lateral_lpv, varrier_uncertainty
 from fdikit.trace import Trace

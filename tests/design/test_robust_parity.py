@@ -16,22 +16,25 @@ import pytest
 import scipy.linalg
 import scipy.optimize
 
-from fdikit.design.parity import lpv_stacked_matrices, parity_matrix
-from fdikit.design.robust_parity import (
+from fdikit.design.lpv import lpv_stacked_matrices
+from fdikit.design.parity import parity_matrix
+from fdikit.design.polytope import (
     adjugate,
     box_vertices,
-    gamma_kappa,
     is_admissible,
-    kappa_max,
-    lti_lmi,
-    p2_solution,
     polynomial_coefficients,
     polytopic_lmi,
     property1_vertices,
     repair_vertex,
+    scheduling_weights,
+)
+from fdikit.design.robust_parity import (
+    gamma_kappa,
+    kappa_max,
+    lti_lmi,
+    p2_solution,
     robust_criteria,
     robust_lpv_parity,
-    scheduling_weights,
     theorem1,
     theorem1_batch,
 )

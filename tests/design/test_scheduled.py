@@ -12,13 +12,12 @@ from fdikit.design.scheduled import (
     lpv_parity_row,
     lpv_rank_test,
     scheduled_parity_filter,
-    simulate_scheduled,
     vaf,
 )
 from fdikit.errors import DataError, DesignError, ModelError
-from fdikit.faults import Bias, FaultScenario, ScaleFactor
+from fdikit.faults import Bias, FaultScenario, Noise, ScaleFactor
 from fdikit.plants.single_track import single_track, single_track_lpv
-from fdikit.simulate import simulate, time_grid
+from fdikit.simulate import simulate, simulate_scheduled, time_grid
 from fdikit.trace import Trace
 
 KMH = 1 / 3.6
@@ -191,7 +190,11 @@ def test_online_equals_batch_and_skips_bad_samples():
 
 
 def test_generic_family_equals_fast_path():
-    """A family without dae_matrices goes through dae_form(family(ρ)); both paths give the same residual."""
+    """A family without dae_matrices goes through dae_form(family(ρ)); both paths give the same residual.
+
+    Likewise the simulator: SingleTrackLPV.state_space (one batched exponential for all speeds) and
+    family(ρ) per speed give the same trace (bitwise here: the batch shares the per-speed scaling).
+    """
     t = time_grid(2.0, 0.01)
     speed = (80 + 20 * t) * KMH
     trace = simulate_scheduled(FAMILY, speed, u=_steering(t))
@@ -207,9 +210,10 @@ def test_simulate_scheduled_matches_simulate_at_constant_speed():
     t = time_grid(20.0, 0.01)
     d = np.where(t[:, None] >= 5.0, [1 / 350, 0.03], 0.0)
     scenario = FaultScenario([ScaleFactor("steering", factor=0.8, onset=8.0), Bias("steering", FA, onset=12.0),
-                              Bias("yaw_rate", 1e-3, onset=15.0)])
-    mine = simulate_scheduled(FAMILY, np.full(t.size, V70), scenario, u=_steering(t), d=d)
-    ref = simulate(FAMILY(V70), scenario, t=t, u=_steering(t), d=d)
+                              Bias("yaw_rate", 1e-3, onset=15.0), Noise("heading_error", std=1e-3, onset=4.0)])
+    mine = simulate_scheduled(FAMILY, np.full(t.size, V70), scenario, u=_steering(t), d=d, rng=5)
+    ref = simulate(FAMILY(V70), scenario, t=t, u=_steering(t), d=d, rng=5)
+    # same fault streams as simulate(): the noise fault (std 1e-3) draws the same numbers
     np.testing.assert_allclose(mine.y[:, :3], ref.y, rtol=1e-12, atol=1e-14)
     np.testing.assert_array_equal(mine.fault, ref.fault)
     np.testing.assert_array_equal(mine.signal("speed"), V70)
@@ -232,3 +236,26 @@ def test_bad_input_errors():
         scheduled_parity_filter(lambda v: single_track(v), V70)
     with pytest.raises(DataError, match="equally long"):
         vaf(np.ones(3), np.ones(4))
+
+
+def test_simulate_scheduled_bad_family():
+    speed = np.linspace(70, 80, 50) * KMH
+
+    class Wrong:  # state_space that does not match the family's models
+        def __call__(self, v):
+            return FAMILY(v)
+
+        def state_space(self, v):
+            A, B, C, D = FAMILY.state_space(v)
+            return 0.5 * A, B, C, D
+
+    with pytest.raises(ModelError, match="state_space disagrees"):
+        simulate_scheduled(Wrong(), speed)
+    with pytest.raises(ModelError, match="names, sizes and dt"):
+        simulate_scheduled(lambda v: single_track(v, dt=0.01 if v < 20 else 0.02), speed)
+    with pytest.raises(ModelError, match="discrete"):
+        simulate_scheduled(lambda v: single_track(v), speed)
+    with pytest.raises(ModelError, match="already an output"):
+        simulate_scheduled(FAMILY, speed, schedule_name="yaw_rate")
+    with pytest.raises(DataError, match="2\\+ finite"):
+        simulate_scheduled(FAMILY, [V70, np.nan])

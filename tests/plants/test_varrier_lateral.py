@@ -12,7 +12,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from fdikit.design.parity import LPVModel
+from fdikit.design.lpv import LPVModel
 from fdikit.errors import ModelError
 from fdikit.plants.varrier_lateral import (
     RHO_STAR,

@@ -8,10 +8,11 @@ from fdikit.design.beard_jones import (
     restricted_diagonal,
 )
 from fdikit.design.dae_parity import DAEModel, PolynomialParityDesign, dae_form, minimal_degree, parity_filter
+from fdikit.design.lpv import LPVModel, stacked_matrices
 from fdikit.design.observer import ObserverDesign, kalman, observer, observer_generator, unobservable_modes
-from fdikit.design.parity import LPVModel, ParityDesign, lpv_parity_residuals, parity_design, stacked_matrices
+from fdikit.design.parity import ParityDesign, lpv_parity_residuals, parity_design
 from fdikit.design.robust_parity import RobustParityDesign, robust_lpv_parity, theorem1
-from fdikit.design.scheduled import ScheduledResidualGenerator, scheduled_parity_filter, simulate_scheduled
+from fdikit.design.scheduled import ScheduledResidualGenerator, scheduled_parity_filter
 from fdikit.design.uio import UIODesign, uio, uio_bank, unknown_input_matrix
 
 __all__ = [
@@ -38,7 +39,6 @@ __all__ = [
     "restricted_diagonal",
     "robust_lpv_parity",
     "scheduled_parity_filter",
-    "simulate_scheduled",
     "stacked_matrices",
     "theorem1",
     "uio",

@@ -33,7 +33,7 @@ Errata and reconstruction choices (research note §3.3, §4 A13, §8 item 13):
 
 The schedule is a measured signal: :meth:`ScheduledResidualGenerator.run` reads it from the
 trace by name (an output or control column, default ``"speed"``) or takes an array;
-:func:`simulate_scheduled` appends it to the trace as an output column.
+:func:`fdikit.simulate.simulate_scheduled` appends it to the trace as an output column.
 """
 
 from __future__ import annotations
@@ -47,7 +47,6 @@ import scipy.signal
 from fdikit.design.dae_parity import DAEModel, PolynomialParityDesign, RankTest, _real_poles, dae_form, parity_filter
 from fdikit.design.dae_parity import time_varying_bar as _bar
 from fdikit.errors import DataError, DesignError, ModelError
-from fdikit.faults import FaultScenario
 from fdikit.linalg import rank
 from fdikit.model import FaultModel
 from fdikit.residuals import Residuals
@@ -60,7 +59,6 @@ __all__ = [
     "lpv_parity_row",
     "lpv_rank_test",
     "scheduled_parity_filter",
-    "simulate_scheduled",
     "vaf",
 ]
 
@@ -387,77 +385,3 @@ def scheduled_parity_filter(
                           "(3.17) gives N̄ ≈ 0 (Sec. 4-3-4: the q² column); choose column=0")
     gen.rows(np.full((1, ref.degree + 1), float(reference)))  # e.g. a bad gamma fails now, not at run time
     return gen
-
-
-def simulate_scheduled(
-    family: Family,
-    schedule: np.ndarray,
-    scenario: FaultScenario | None = None,
-    *,
-    u: np.ndarray | None = None,
-    d: np.ndarray | None = None,
-    x0: np.ndarray | None = None,
-    schedule_name: str = "speed",
-    rng: np.random.Generator | int | None = None,
-) -> Trace:
-    """Simulate the parameter-varying plant ``x(k+1) = A(ρ_k) x(k) + B(ρ_k) v(k)`` (frozen ρ over each sample).
-
-    The "complete discretisation" of Sec. 4-3-4: sample ``k`` uses ``family(schedule[k])``.
-    Faults act on signals as in :func:`fdikit.simulate.simulate` (actuator faults before the
-    plant, in scenario order — so ``[ScaleFactor, Bias]`` gives ``δ = f_m δ_set + f_a``, (1.3);
-    sensor faults after).  The trace carries ``ρ`` as an extra output column ``schedule_name``.
-    ``u`` (N, m) and ``d`` (N, n_d) default to zero; the model's noise group is not simulated.
-    A family with ``dae_matrices`` (see :meth:`ScheduledResidualGenerator.dae`) is read through it.
-    """
-    rho = np.asarray(schedule, dtype=float).ravel()
-    if rho.size < 2 or not np.all(np.isfinite(rho)):
-        raise DataError("schedule must hold 2+ finite parameter values, one per sample")
-    m0 = family(float(rho[0]))
-    if not isinstance(m0, FaultModel) or not m0.is_discrete:
-        raise ModelError("family must return discrete FaultModels")
-    if schedule_name in m0.outputs:
-        raise ModelError(f"schedule_name {schedule_name!r} is already an output of the plant; choose another name")
-    N, t = rho.size, np.arange(rho.size) * m0.dt
-    blocks = {}
-    for key, val, names in (("u", u, m0.controls), ("d", d, m0.disturbances)):
-        arr = np.zeros((N, len(names))) if val is None else np.asarray(val, dtype=float).reshape(N, -1)
-        if arr.shape != (N, len(names)) or not np.all(np.isfinite(arr)):
-            raise DataError(f"{key} must be a finite ({N}, {len(names)}) array, columns {list(names)}")
-        blocks[key] = arr
-    scenario = (scenario or FaultScenario()).resolve(m0.outputs, m0.controls)
-    streams = np.random.default_rng(rng).spawn(max(1, len(scenario)))
-    u_act = blocks["u"].copy()
-    for f, rf in zip(scenario, streams):
-        if f.location == "actuator":
-            j = m0.controls.index(f.target)
-            u_act[:, j] = f.apply(t, u_act[:, j], rf)
-    x = np.zeros(m0.n) if x0 is None else np.asarray(x0, dtype=float).reshape(m0.n)
-    X, Y = np.empty((N, m0.n)), np.empty((N, m0.p))
-    v = np.hstack([u_act, blocks["d"]])
-    n, ny = m0.n, m0.p
-    ref = dae_form(m0, [])
-    fast = callable(getattr(family, "dae_matrices", None))
-    fast = fast and all(np.allclose(a, b) for a, b in zip(family.dae_matrices(float(rho[0]))[:3], (*ref.H, *ref.L)))
-    mats: dict[float, tuple[np.ndarray, ...]] = {}
-    for k in range(N):
-        key = float(rho[k])
-        mk = mats.get(key)
-        if mk is None:
-            if fast:  # H_0 = [[A, Bd], [C, Dd]], L = [[0, Bu], [-I, Du]] (dae_form), without building a FaultModel
-                H0, _, L, _ = family.dae_matrices(key)
-                mk = (H0[:n, :n], np.hstack([L[:n, ny:], H0[:n, n:]]), H0[n:, :n], np.hstack([L[n:, ny:], H0[n:, n:]]))
-            else:
-                mod = family(key)
-                mk = (mod.A, np.hstack([mod.Bu, mod.Bd]), mod.C, np.hstack([mod.Du, mod.Dd]))
-            mats[key] = mk
-        X[k] = x
-        Y[k] = mk[2] @ x + mk[3] @ v[k]
-        x = mk[0] @ x + mk[1] @ v[k]
-    for f, rf in zip(scenario, streams):
-        if f.location == "sensor":
-            j = m0.outputs.index(f.target)
-            Y[:, j] = f.apply(t, Y[:, j], rf)
-    return Trace(t=t, u=blocks["u"], y=np.hstack([Y, rho[:, None]]), controls=m0.controls,
-                 outputs=m0.outputs + (schedule_name,), x=X, states=m0.states, d=blocks["d"],
-                 disturbances=m0.disturbances, fault=scenario.truth(t),
-                 meta={"plant": repr(m0), "scenario": scenario.label, "schedule": schedule_name})

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fdikit.design.parity import LPVModel, Uncertainty
+from fdikit.design.lpv import LPVModel, Uncertainty
 from fdikit.errors import ModelError
 from fdikit.model import FaultModel
 

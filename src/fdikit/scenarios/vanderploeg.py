@@ -31,7 +31,8 @@ scheduling signal of an LPV filter); states of (B.12); disturbances ``curvature`
 (``sin φ``).  Truth labels are ``steering_additive``, ``steering_multiplicative`` or both
 (``'+'``-joined); :func:`true_steering_faults` returns the fault signals (``f_a`` in rad).
 Varying speed is simulated by switching the ZOH model every sample ("complete discretisation",
-Sec. 4-3-4): ``x(k+1) = 𝒜(V_x(k)) x(k) + ℬ(V_x(k)) δ(k) + ℬ_d(V_x(k)) d(k)``.
+Sec. 4-3-4): ``x(k+1) = 𝒜(V_x(k)) x(k) + ℬ(V_x(k)) δ(k) + ℬ_d(V_x(k)) d(k)``, by
+:func:`fdikit.simulate.simulate_scheduled` on :func:`fdikit.plants.single_track.single_track_lpv`.
 """
 
 from __future__ import annotations
@@ -40,13 +41,12 @@ from collections.abc import Callable, Sequence
 from dataclasses import asdict, replace
 
 import numpy as np
-import scipy.linalg
 from numpy.typing import ArrayLike
 
 from fdikit.errors import DataError, ModelError
 from fdikit.faults import NO_FAULT
-from fdikit.lti import dlsim_blocked
-from fdikit.plants.single_track import PRIUS_2010, SingleTrackParameters, single_track
+from fdikit.plants.single_track import PRIUS_2010, SingleTrackParameters, single_track, single_track_lpv
+from fdikit.simulate import simulate_scheduled
 from fdikit.trace import Trace
 
 __all__ = [
@@ -180,46 +180,6 @@ def _speed_array(speed_kmh, t: np.ndarray, duration: float) -> tuple[np.ndarray,
     return v, desc
 
 
-def _affine_speed_model(params: SingleTrackParameters):
-    """Continuous (B.12) matrices as ``M(v) = M_0 + M_1 v + M_2 / v`` identified from :func:`single_track`.
-
-    The entries of (B.12) are affine in ``(1, v, 1/v)``; three speeds identify the coefficients and a
-    fourth checks them, so the varying-speed simulation uses exactly the plant module's model.
-    """
-    speeds = (10.0, 25.0, 40.0)
-    mats = [single_track(v, params) for v in speeds]
-    basis = np.array([[1.0, v, 1.0 / v] for v in speeds])
-    stack = np.array([np.hstack([m.A, m.b("u"), m.b("d")]) for m in mats])
-    coef = np.linalg.solve(basis, stack.reshape(3, -1)).reshape(3, *stack.shape[1:])
-    check = single_track(31.0, params)
-    approx = coef[0] + 31.0 * coef[1] + coef[2] / 31.0
-    if not np.allclose(approx, np.hstack([check.A, check.b("u"), check.b("d")]), rtol=1e-10, atol=1e-10):
-        raise ModelError("the single-track model is no longer affine in (1, V_x, 1/V_x); update _affine_speed_model")
-    return coef, mats[0].C
-
-
-def _simulate(speed_ms: np.ndarray, delta: np.ndarray, d: np.ndarray, x0: np.ndarray, params, dt: float):
-    """States (N, 4) of the sampled model, switching with the speed per sample (or one LTI model)."""
-    N = speed_ms.size
-    inputs = np.column_stack([delta, d])
-    if np.all(speed_ms == speed_ms[0]):
-        m = single_track(float(speed_ms[0]), params, dt=dt)
-        B = np.hstack([m.b("u"), m.b("d")])
-        _, x, _ = dlsim_blocked(m.A, B, m.C, np.zeros((m.p, 3)), inputs, x0)
-        return x, m.C
-    coef, C = _affine_speed_model(params)
-    cont = coef[0] + speed_ms[:, None, None] * coef[1] + coef[2] / speed_ms[:, None, None]  # (N, 4, 7)
-    aug = np.zeros((N, 7, 7))
-    aug[:, :4, :] = cont * dt
-    disc = scipy.linalg.expm(aug)[:, :4, :]  # exact ZOH per sample: [𝒜 | ℬ ℬ_d]
-    x = np.empty((N, 4))
-    xk = x0.copy()
-    for k in range(N):
-        x[k] = xk
-        xk = disc[k, :, :4] @ xk + disc[k, :, 4:] @ inputs[k]
-    return x, C
-
-
 def _labels(f_a: np.ndarray, f_m: np.ndarray) -> np.ndarray:
     add, mul = f_a != 0.0, f_m != 1.0
     out = np.full(f_a.shape, NO_FAULT, dtype=object)
@@ -315,8 +275,8 @@ def lateral_run(
     x0_arr = np.zeros(4) if x0 is None else np.asarray(x0, dtype=float)
     if x0_arr.shape != (4,) or not np.all(np.isfinite(x0_arr)):
         raise DataError(f"x0 must be 4 finite numbers [V_y, yaw rate, y_e, psi_e], got {x0!r}")
-    x, C = _simulate(speed / 3.6, applied, d, x0_arr, params, dt)
-    y = x @ C.T
+    run = simulate_scheduled(single_track_lpv(params, dt, steering_fault=False), speed / 3.6, u=applied, d=d, x0=x0_arr)
+    x, y = run.x, run.y[:, :3]
     seed = int(rng) if isinstance(rng, int | np.integer) else None
     if measurement_noise is not None:
         std = np.broadcast_to(np.asarray(measurement_noise, dtype=float), (3,))
