@@ -14,14 +14,8 @@ import scipy.linalg
 import scipy.signal
 
 from fdikit.design.beard_jones import resolve_faults
-from fdikit.design.game import (
-    game_cost,
-    game_filter,
-    game_filter_bank,
-    game_riccati,
-    single_fault_game_filter,
-)
-from fdikit.design.game_riccati import solve_game_are
+from fdikit.design.game import game_filter, game_filter_bank, single_fault_game_filter
+from fdikit.design.game_riccati import game_cost, game_riccati, solve_game_are
 from fdikit.design.game_setup import game_problem
 from fdikit.errors import DesignError
 from fdikit.plants.f16xl import f16xl_longitudinal

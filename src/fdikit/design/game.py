@@ -44,8 +44,6 @@ from fdikit.design.game_riccati import (
     _margins,
     _per_target,
     _targets,
-    game_cost,
-    game_riccati,
     solve_game_are,
 )
 from fdikit.design.game_setup import GameProblem, game_problem, weight
@@ -58,10 +56,8 @@ __all__ = [
     "GameDesign",
     "GameBankDesign",
     "SingleFaultGameDesign",
-    "game_cost",
     "game_filter",
     "game_filter_bank",
-    "game_riccati",
     "single_fault_game_filter",
 ]
 
