@@ -9,7 +9,6 @@ discretised bank.  Run: ``python benchmarks/bench_design.py``.
 from __future__ import annotations
 
 import argparse
-import time
 
 import control
 import numpy as np
@@ -20,15 +19,7 @@ from fdikit.monitors import path_bank, path_fault_model
 from fdikit.monitors.path_bank import EIGENVALUES
 from fdikit.plants import path_vehicle_12, path_vehicle_14
 from fdikit.simulate import simulate
-
-
-def best(fn, repeat):
-    times, out = [], None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return min(times), out
+from timing import best
 
 
 def place_all():

@@ -13,7 +13,6 @@ Run: ``python benchmarks/bench_game.py``.
 from __future__ import annotations
 
 import argparse
-import time
 
 import control
 import numpy as np
@@ -24,15 +23,7 @@ from fdikit.design.game_riccati import solve_game_are
 from fdikit.design.reduced_order import goh_detector
 from fdikit.plants.f16xl import f16xl_longitudinal
 from fdikit.plants.path_longitudinal import path_longitudinal_7, path_longitudinal_7_fault_maps
-
-
-def best(fn, repeat):
-    times, out = [], None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return min(times), out
+from timing import best
 
 
 def main() -> None:

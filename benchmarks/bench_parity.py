@@ -13,7 +13,6 @@ Run: ``python benchmarks/bench_parity.py``.
 from __future__ import annotations
 
 import argparse
-import time
 
 import numpy as np
 import scipy.signal
@@ -23,15 +22,7 @@ from fdikit.design.scheduled import scheduled_parity_filter
 from fdikit.estimate import isolate_steering_faults
 from fdikit.plants.single_track import single_track_lpv
 from fdikit.scenarios.vanderploeg import lateral_run
-
-
-def best(fn, repeat):
-    times, out = [], None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return min(times), out
+from timing import best
 
 
 def lfilter_parity(design, z):

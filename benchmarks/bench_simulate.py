@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import argparse
 import platform
-import time
 import tracemalloc
 
 import control
@@ -24,15 +23,7 @@ import fdikit
 from fdikit.demo import ACTUATOR_NOISE_STD, SENSOR_NOISE_STD, demo_model
 from fdikit.design import kalman
 from fdikit.simulate import simulate
-
-
-def best_time(fn, repeat: int) -> tuple[float, object]:
-    best, out = np.inf, None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - t0)
-    return best, out
+from timing import best
 
 
 def peak_memory(fn) -> float:
@@ -67,7 +58,7 @@ def main() -> None:
     }
     results = {}
     for name, fn in methods.items():
-        t, out = best_time(fn, args.repeat)
+        t, out = best(fn, args.repeat)
         results[name] = (t, peak_memory(fn), out)
 
     ref = results["scipy.signal.dlsim"][2]

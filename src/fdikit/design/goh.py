@@ -282,6 +282,19 @@ def _weights(C: np.ndarray, V, Q) -> tuple[np.ndarray, np.ndarray]:
     return Vw, weight("Q", Q, p)
 
 
+def _prepare(A, C, F_hat, V, Q, projector, rtol):
+    """Common data of the Goh Riccati equation: checked matrices, weights, Goh transformation, Ĥ and H̄."""
+    A = _as2d("A", A)
+    n = A.shape[0]
+    C = _as2d("C", C)
+    F = np.asarray(F_hat, dtype=float).reshape(n, -1)
+    Vw, Qw = _weights(C, V, Q)
+    goh = goh_transformation(A, C, F, rtol)
+    H = _orthogonal_projector(C, goh.invariant_subspace) if projector is None else _as2d(
+        "projector", projector, C.shape[0])
+    return A, C, F, Vw, Qw, np.linalg.inv(Vw), goh, H, oblique_projector(C, goh.B_tilde, Vw)
+
+
 def goh_riccati(A, C, F_hat, *, V=1.0, Q=1e-4, projector=None, rtol: float | None = None) -> GohRiccatiSolution:
     """Steady state of the Goh Riccati equation from ``S(t0) = 0`` (Douglas et al. 1996, (9.44), (9.77)).
 
@@ -315,16 +328,8 @@ def goh_riccati(A, C, F_hat, *, V=1.0, Q=1e-4, projector=None, rtol: float | Non
     >>> sol.order, np.round(sol.kernel_zeros.real, 6).tolist()
     (1, [3.0])
     """
-    A = _as2d("A", A)
-    n = A.shape[0]
-    C = _as2d("C", C)
-    F = np.asarray(F_hat, dtype=float).reshape(n, -1)
-    Vw, Qw = _weights(C, V, Q)
-    Vi = np.linalg.inv(Vw)
-    goh = goh_transformation(A, C, F, rtol)
-    W = goh.invariant_subspace
-    H = _orthogonal_projector(C, W) if projector is None else _as2d("projector", projector, C.shape[0])
-    Hb = oblique_projector(C, goh.B_tilde, Vw)
+    A, C, F, Vw, Qw, Vi, goh, H, Hb = _prepare(A, C, F_hat, V, Q, projector, rtol)
+    n, W = A.shape[0], goh.invariant_subspace
     scale = max(np.linalg.norm(A, 2), 1.0)
     zeros, Z = _unstable_zero_directions(A, C, F, scale)
     Gam, n1 = _split(np.hstack([W, Z]), n)
@@ -381,16 +386,8 @@ def goh_riccati_transient(A, C, F_hat, t: Sequence[float], *, V=1.0, Q=1e-4, S0=
     (unstable) equilibrium: from ``S(0) = 0`` it stays in ``Ker S(t)`` for all t, whereas from any
     ``S(0) > 0`` on it (e.g. (4.50)) ``S(t)`` converges to the stabilizing solution of :func:`goh_riccati`.
     """
-    A = _as2d("A", A)
-    n = A.shape[0]
-    C = _as2d("C", C)
-    F = np.asarray(F_hat, dtype=float).reshape(n, -1)
-    Vw, Qw = _weights(C, V, Q)
-    Vi = np.linalg.inv(Vw)
-    goh = goh_transformation(A, C, F, rtol)
-    W = goh.invariant_subspace
-    H = _orthogonal_projector(C, W) if projector is None else _as2d("projector", projector, C.shape[0])
-    Hb = oblique_projector(C, goh.B_tilde, Vw)
+    A, C, F, Vw, Qw, Vi, goh, H, Hb = _prepare(A, C, F_hat, V, Q, projector, rtol)
+    n, W = A.shape[0], goh.invariant_subspace
     Gam, n1 = _split(W, n)
     G1 = Gam[:n1]
     CB = C @ goh.B_tilde
