@@ -10,7 +10,8 @@ from scipy.integrate import quad_vec
 
 from fdikit import FaultModel, linalg
 from fdikit.design.beard_jones import beard_jones
-from fdikit.design.hinf import detection_gain_family, enhancement_direction, hinf_detection_filter
+from fdikit.design.detection_gain import detection_gain_family
+from fdikit.design.hinf import enhancement_direction, hinf_detection_filter
 from fdikit.errors import DesignError, ModelError
 from fdikit.faults import Bias, FaultScenario
 from fdikit.plants.f16xl import F16XL_DRYDEN_GAIN, f16xl_gust

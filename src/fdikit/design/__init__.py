@@ -20,6 +20,7 @@ from fdikit.design.game_discrete import dgtfdf, dgtmfdf, discrete_game_setup
 from fdikit.design.game_ltv import LTVGameDesign, ltv_feasibility, ltv_game_filter
 from fdikit.design.game_riccati import game_riccati, solve_game_are
 from fdikit.design.game_setup import GameProblem, game_problem
+from fdikit.design.hinf import Enhancement, HinfDesign, enhancement_direction, hinf_detection_filter
 from fdikit.design.lpv import LPVModel, stacked_matrices
 from fdikit.design.ltv import LTVModel
 from fdikit.design.observer import ObserverDesign, kalman, observer, observer_generator, unobservable_modes
@@ -32,10 +33,13 @@ from fdikit.design.uio import UIODesign, uio, uio_bank, unknown_input_matrix
 __all__ = [
     "BeardJonesDesign",
     "DAEModel",
+    "DetectionGainFamily",
+    "Enhancement",
     "GameBankDesign",
     "GameDesign",
     "GameProblem",
     "GohFilterDesign",
+    "HinfDesign",
     "LPVModel",
     "LTVGameDesign",
     "LTVModel",
@@ -49,15 +53,18 @@ __all__ = [
     "UIODesign",
     "beard_jones",
     "dae_form",
+    "detection_gain_family",
     "dgtfdf",
     "dgtmfdf",
     "discrete_game_setup",
+    "enhancement_direction",
     "game_filter",
     "game_filter_bank",
     "game_problem",
     "game_riccati",
     "goh_detector",
     "goh_filter",
+    "hinf_detection_filter",
     "kalman",
     "lpv_parity_residuals",
     "ltv_feasibility",

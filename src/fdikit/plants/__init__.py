@@ -10,6 +10,7 @@ name                 model                                            source
 ``path14``           PATH vehicle, 14 states, actuator-fault design   Douglas et al. 1996, (d.1)
 ``single-track``     lateral single-track model with lane errors      van der Ploeg 2018, (B.12)
 ``f16xl``            F-16XL longitudinal, 4 states, ``C = I``         Murray 2012, §6.1
+``f16xl-gust``       F-16XL, 5 states with Dryden gust, 4 sensors     Douglas et al. 1996, App. C.5
 ``white-speyer``     3-state system with invariant-zero cases         Murray 2012, §6.2
 ``varrier-lateral``  lateral 2-state model, ρ = 1/v, Euler 0.02 s     Varrier et al. 2014, (48)
 ``path7``            PATH longitudinal, 7 states (reduced, 25 m/s)    Douglas et al. 1996, §9.6
@@ -29,7 +30,7 @@ from collections.abc import Callable
 
 from fdikit.errors import ModelError
 from fdikit.model import FaultModel
-from fdikit.plants.f16xl import f16xl_longitudinal
+from fdikit.plants.f16xl import F16XL_DRYDEN_GAIN, f16xl_gust, f16xl_longitudinal
 from fdikit.plants.path_longitudinal import path_longitudinal_7, path_longitudinal_7_fault_maps
 from fdikit.plants.path_vehicle import (
     TABLE_2_1_EIGENVALUES_12,
@@ -77,6 +78,8 @@ __all__ = [
     "SCENIC",
     "rho_from_speed",
     "f16xl_longitudinal",
+    "f16xl_gust",
+    "F16XL_DRYDEN_GAIN",
     "white_speyer",
     "path_longitudinal_7",
     "path_longitudinal_7_fault_maps",
@@ -89,6 +92,7 @@ PLANTS: dict[str, Callable[..., FaultModel]] = {
     "path14": path_vehicle_14,
     "single-track": single_track,
     "f16xl": f16xl_longitudinal,
+    "f16xl-gust": f16xl_gust,
     "white-speyer": white_speyer,
     "varrier-lateral": varrier_lateral,
     "path7": path_longitudinal_7,
