@@ -1,0 +1,509 @@
+"""Model-set design for multiple-model estimation: Hallouzi 2008, Ch. 3 and App. B.
+
+A local model ``{A, B, C, D}`` is the vector ``𝔐 = vec([A B; C D])`` (3.14); a large model set is
+the matrix ``M_ℓ`` of such columns (3.15).  Three designs reduce it to a few local models:
+
+* :func:`od_model_set` — orthogonal decomposition (pivoted QR) with affine projection, §3.3.2,
+  (3.19)–(3.23); selects members of ``M_ℓ``.
+* :func:`cp_model_set` — an enclosing convex polytope in SVD coordinates, §3.4, (3.31)–(3.33).
+  Kanev's (2006) optimiser is not given in the thesis; a documented substitute is used.
+* :func:`limit_value_model_set` — limit values of the varying entries, §3.5, (3.34)–(3.40).
+
+Helpers: :func:`first_order_discretize` and :func:`taylor_remainder_bound` (App. B),
+:func:`affine_weights` (3.21), :func:`nearest_model` (3.51)–(3.52),
+:func:`minimum_mismatch_points` (Li et al. 2005, §3.6.4) and :func:`observability_condition`
+(Def. 3.1, (3.7)–(3.9)).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg
+import scipy.optimize
+import scipy.spatial
+
+from fdikit.errors import DesignError, ModelError
+
+__all__ = [
+    "vectorize",
+    "unvectorize",
+    "first_order_discretize",
+    "taylor_remainder_bound",
+    "gap_rank",
+    "affine_weights",
+    "ODModelSet",
+    "od_model_set",
+    "CPModelSet",
+    "cp_model_set",
+    "convex_weights",
+    "LimitValueModelSet",
+    "limit_value_model_set",
+    "nearest_model",
+    "minimum_mismatch_points",
+    "observability_condition",
+]
+
+
+# ---------------------------------------------------------------------------------------------- vec
+def vectorize(A, B, C, D=None) -> np.ndarray:
+    """``vec([A B; C D])`` (column stacking), Hallouzi 2008, (3.14).
+
+    Examples
+    --------
+    >>> vectorize([[1.0]], [[2.0]], [[3.0]]).tolist()
+    [1.0, 3.0, 2.0, 0.0]
+    """
+    A, B, C = (np.atleast_2d(np.asarray(M, float)) for M in (A, B, C))
+    D = np.zeros((C.shape[0], B.shape[1])) if D is None else np.atleast_2d(np.asarray(D, float))
+    if A.shape[0] != A.shape[1] or B.shape[0] != A.shape[0] or C.shape[1] != A.shape[0] or \
+            D.shape != (C.shape[0], B.shape[1]):
+        raise ModelError(f"inconsistent shapes A {A.shape}, B {B.shape}, C {C.shape}, D {D.shape}; "
+                         "need A n×n, B n×m, C p×n, D p×m")
+    return np.block([[A, B], [C, D]]).ravel(order="F")
+
+
+def unvectorize(vector, n: int, m: int, p: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Inverse of :func:`vectorize`: ``(A, B, C, D)`` from a model vector, Hallouzi 2008, (3.24)."""
+    vector = np.asarray(vector, float).ravel()
+    if vector.size != (n + p) * (n + m):
+        raise ModelError(f"a model vector for n={n}, m={m}, p={p} has {(n + p) * (n + m)} entries, got {vector.size}")
+    M = vector.reshape((n + p, n + m), order="F")
+    return M[:n, :n].copy(), M[:n, n:].copy(), M[n:, :n].copy(), M[n:, n:].copy()
+
+
+def _as_model_matrix(models) -> np.ndarray:
+    M = np.asarray(models, float)
+    if M.ndim != 2 or M.shape[1] < 1:
+        raise ModelError(f"the large model set must be a 2-D array with one model vector per column, got {M.shape}")
+    if not np.all(np.isfinite(M)):
+        raise ModelError("the large model set contains NaN or inf; remove or repair those models")
+    return M
+
+
+# ------------------------------------------------------------------------------------ App. B
+def first_order_discretize(A, B, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """First-order Taylor discretisation ``(I + T A, T B)``, Hallouzi 2008, App. B, (B.8)–(B.9).
+
+    Unlike ZOH it is linear in ``(A, B)``, so for weights summing to one the discretised convex
+    combination of local models equals the combination of the discretised local models (B.9).
+
+    Examples
+    --------
+    >>> Ad, Bd = first_order_discretize([[-2.0]], [[1.0]], 0.1)
+    >>> Ad.tolist(), Bd.tolist()
+    ([[0.8]], [[0.1]])
+    """
+    A = np.atleast_2d(np.asarray(A, float))
+    B = np.atleast_2d(np.asarray(B, float))
+    dt = float(dt)
+    if not np.isfinite(dt) or dt <= 0:
+        raise ModelError(f"the sample time must be positive, got {dt}")
+    if A.shape[0] != A.shape[1] or B.shape[0] != A.shape[0]:
+        raise ModelError(f"A must be square and B must have as many rows, got A {A.shape}, B {B.shape}")
+    return np.eye(A.shape[0]) + dt * A, dt * B
+
+
+def taylor_remainder_bound(A, dt: float, order: int = 1) -> float:
+    """Entrywise bound on the remainder of the order-``M`` Taylor series of ``expm(A T)``.
+
+    Hallouzi 2008, (B.5)–(B.7) (after Moler & Van Loan 2003):
+    ``|r_ij| ≤ (‖A‖T)^{M+1}/(M+1)! · 1/(1 − ‖A‖T/(M+2))`` with ``‖A‖ = Σ|a_ij|``.  ``A`` may be a
+    matrix or the norm itself (a scalar).
+
+    Raises
+    ------
+    DesignError
+        If ``‖A‖T ≥ M + 2`` (the geometric tail does not converge): take a smaller ``T``.
+
+    Examples
+    --------
+    >>> round(taylor_remainder_bound(3.0, 0.01), 7)   # B747, §4.3.1: "in the order of 1e-4"
+    0.0004545
+    """
+    A = np.asarray(A, float)
+    norm = float(A) if A.ndim == 0 else float(np.abs(A).sum())
+    if order < 0:
+        raise DesignError(f"the Taylor order M must be >= 0, got {order}")
+    x = norm * float(dt)
+    if x >= order + 2:
+        raise DesignError(f"‖A‖T = {x:.3g} >= M + 2 = {order + 2}: the bound (B.5) does not hold; reduce the "
+                          "sample time or raise the order")
+    return x ** (order + 1) / float(np.prod(np.arange(1, order + 2))) / (1.0 - x / (order + 2))
+
+
+# ------------------------------------------------------------------------------------ rank
+def gap_rank(values, min_gap: float = 10.0) -> int:
+    """Numerical rank as the position of the largest gap in non-increasing values (σ or |diag R|).
+
+    Hallouzi 2008, §3.3.2 picks "the first significant gap" by eye (research note §5.1 [GAP]).
+    Here: values at or below ``max · len · eps`` count as zero (the rank is then at most the number
+    of nonzero values); the rank is the index of the largest ratio ``v_i / v_{i+1}`` if that ratio is
+    at least ``min_gap``, else all values count.
+
+    Examples
+    --------
+    >>> gap_rank([3.0, 1.0, 0.5, 1e-6, 1e-7])
+    3
+    """
+    v = np.abs(np.asarray(values, float).ravel())
+    if v.size == 0 or v[0] == 0:
+        return 0
+    floor = v[0] * v.size * np.finfo(float).eps
+    w = np.maximum(v, floor)
+    if v.size == 1:
+        return 1
+    ratios = w[:-1] / w[1:]
+    k = int(np.argmax(ratios))
+    return k + 1 if ratios[k] >= min_gap else int(v.size)
+
+
+def affine_weights(reduced, models) -> np.ndarray:
+    """Affine (sum-to-one) least-squares weights of ``models`` on ``reduced``, Hallouzi 2008, (3.21).
+
+    ``W = [M_r; 1]^† [M; 1]``; column ``j`` holds the weights of model ``j``.  As in the thesis the
+    sum-to-one condition is one more least-squares row: it holds exactly for models in the affine hull
+    of ``M_r`` (e.g. every large-set model once OD has found the rank) and approximately otherwise.
+    """
+    Mr = _as_model_matrix(reduced)
+    M = _as_model_matrix(models)
+    if Mr.shape[0] != M.shape[0]:
+        raise ModelError(f"reduced set vectors have {Mr.shape[0]} entries, the models {M.shape[0]}")
+    return np.linalg.pinv(np.vstack([Mr, np.ones(Mr.shape[1])])) @ np.vstack([M, np.ones(M.shape[1])])
+
+
+# ------------------------------------------------------------------------------------ OD
+@dataclass(frozen=True)
+class ODModelSet:
+    """Result of :func:`od_model_set` (Hallouzi 2008, §3.3.2).
+
+    Attributes
+    ----------
+    indices : tuple of int
+        Columns of ``M_ℓ`` selected, in the pivot order of (3.22) ("most influential first").
+    models : numpy.ndarray
+        ``M̃_r = M_ℓ[:, indices]`` (3.23).
+    rank : int
+        ``N_r``, the numerical rank from the gap in ``|diag R|`` of (3.19).
+    diag_r : numpy.ndarray
+        ``|diag R_{M_ℓ}|`` of the pivoted QR (3.19).
+    singular_values : numpy.ndarray
+        Singular values of ``M_ℓ`` (for comparison with ``diag_r``).
+    weights : numpy.ndarray
+        Affine weights (3.21) of every large-set model on the final set, ``(N_r+1) × N_ℓ``.
+    residual : numpy.ndarray
+        ``‖M̃_r w_j − 𝔐_j‖₂`` per large-set model (0 when the set represents it exactly).
+    """
+
+    indices: tuple[int, ...]
+    models: np.ndarray
+    rank: int
+    diag_r: np.ndarray
+    singular_values: np.ndarray
+    weights: np.ndarray
+    residual: np.ndarray
+
+
+def od_model_set(models, rank: int | None = None, min_gap: float = 10.0) -> ODModelSet:
+    """Orthogonal-decomposition model-set design, Hallouzi 2008, §3.3.2, (3.19)–(3.23).
+
+    1. Pivoted QR ``M_ℓ Π = Q R`` (Businger–Golub, ``scipy.linalg.qr(pivoting=True)``); ``N_r``
+       from the gap in ``|diag R|`` (:func:`gap_rank`) unless ``rank`` is given.
+    2. ``M_r`` = the first ``N_r + 1`` pivoted columns (one more for the sum-to-one constraint).
+    3. ``M̃_ℓ = [M_r; 1]^† [M_ℓ; 1]`` (affine projection).
+    4. Pivoted QR of ``M̃_ℓ``; the final set is the first ``N_r + 1`` pivoted columns of ``M_ℓ``.
+
+    Parameters
+    ----------
+    models : array_like
+        ``M_ℓ``, one model vector per column (see :func:`vectorize`).
+    rank : int, optional
+        ``N_r``; the set then has ``N_r + 1`` models.
+    min_gap : float
+        Smallest ratio counted as a significant gap.
+
+    Raises
+    ------
+    DesignError
+        If ``N_r + 1`` exceeds the number of models.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> od = od_model_set(rng.normal(size=(2, 1000)) + [[3.0], [1.0]])
+    >>> len(od.indices), bool(od.residual.max() < 1e-10)
+    (3, True)
+    """
+    M = _as_model_matrix(models)
+    _, R, piv = scipy.linalg.qr(M, mode="economic", pivoting=True)
+    diag_r = np.abs(np.diag(R))
+    sv = np.linalg.svd(M, compute_uv=False)
+    n_r = gap_rank(diag_r, min_gap) if rank is None else int(rank)
+    if n_r < 0 or n_r + 1 > M.shape[1]:
+        raise DesignError(f"N_r + 1 = {n_r + 1} models requested but the large set has {M.shape[1]}; "
+                          "lower the rank or add models")
+    Mr = M[:, piv[: n_r + 1]]
+    projected = affine_weights(Mr, M)
+    _, _, piv2 = scipy.linalg.qr(projected, mode="economic", pivoting=True)
+    indices = tuple(int(i) for i in piv2[: n_r + 1])
+    final = M[:, list(indices)]
+    weights = affine_weights(final, M)
+    residual = np.linalg.norm(final @ weights - M, axis=0)
+    return ODModelSet(indices, final, n_r, diag_r, sv, weights, residual)
+
+
+# ------------------------------------------------------------------------------------ CP
+@dataclass(frozen=True)
+class CPModelSet:
+    """Result of :func:`cp_model_set` (Hallouzi 2008, §3.4).
+
+    Attributes
+    ----------
+    basis : numpy.ndarray
+        ``U¹`` of (3.31), ``n_q × n_g``.
+    coordinates : numpy.ndarray
+        ``M̄_ℓ = Σ¹ V¹ᵀ`` (3.32), ``n_g × N_ℓ``.
+    vertices : numpy.ndarray
+        Polytope vertices ``v^{(i)}`` in reduced coordinates, ``n_g × N_h``.
+    models : numpy.ndarray
+        Model vectors ``U¹ v^{(i)}`` (3.33), ``n_q × N_h``.
+    weights : numpy.ndarray
+        Convex (barycentric) weights of every large-set model, ``N_h × N_ℓ``.
+    cost : float
+        ``J_CP = Σ d²(v, conv(M̄_ℓ))`` (3.29) of the vertices.
+    """
+
+    basis: np.ndarray
+    coordinates: np.ndarray
+    vertices: np.ndarray
+    models: np.ndarray
+    weights: np.ndarray
+    cost: float
+
+
+def convex_weights(vertices, point) -> np.ndarray | None:
+    """Weights ``λ ≥ 0, Σλ = 1`` with ``V λ = x`` by a linear program, or ``None`` if ``x ∉ conv(V)``.
+
+    Used to check polytope enclosure (Hallouzi 2008, (3.30)); solved with ``scipy.optimize.linprog``
+    (HiGHS), minimising the ℓ1 equality violation with a tolerance of ``1e-9 · scale``.
+    """
+    V = np.atleast_2d(np.asarray(vertices, float))
+    x = np.asarray(point, float).ravel()
+    d, k = V.shape
+    # variables λ (k), slack s+ (d), s- (d): V λ + s+ − s- = x, Σλ = 1, minimise Σ s
+    A_eq = np.block([[V, np.eye(d), -np.eye(d)], [np.ones((1, k)), np.zeros((1, 2 * d))]])
+    b_eq = np.concatenate([x, [1.0]])
+    c = np.concatenate([np.zeros(k), np.ones(2 * d)])
+    res = scipy.optimize.linprog(c, A_eq=A_eq, b_eq=b_eq, bounds=(0, None), method="highs")
+    scale = max(1.0, float(np.abs(V).max()), float(np.abs(x).max()))
+    if res.status != 0 or res.fun > 1e-9 * scale:
+        return None
+    return res.x[:k]
+
+
+def _distance_to_hull(points: np.ndarray, v: np.ndarray) -> float:
+    """``d(v, conv(points))`` (3.27)–(3.28) by a small simplex-constrained least squares (SLSQP)."""
+    k = points.shape[1]
+    res = scipy.optimize.minimize(lambda lam: float(np.sum((points @ lam - v) ** 2)), np.full(k, 1.0 / k),
+                                  jac=lambda lam: 2 * points.T @ (points @ lam - v), method="SLSQP",
+                                  bounds=[(0, 1)] * k, constraints=[{"type": "eq", "fun": lambda lam: lam.sum() - 1}])
+    return float(np.sqrt(max(res.fun, 0.0)))
+
+
+def cp_model_set(models, rank: int | None = None, min_gap: float = 10.0) -> CPModelSet:
+    """Enclosing-simplex model-set design, a substitute for Kanev's optimiser in Hallouzi 2008, §3.4.
+
+    Steps (3.31)–(3.33) as in the thesis: SVD ``M_ℓ = U Σ Vᵀ``, ``n_g`` from the singular-value gap
+    (or ``rank``), reduced coordinates ``M̄_ℓ = Σ¹V¹ᵀ``; vertices mapped back by ``U¹ v``.
+
+    The thesis minimises ``J_CP`` (3.29) subject to enclosure (3.30) with Kanev's (2006) non-convex
+    QCQP, which it does not give.  Substitute (research note §2.10 [GAP]): work in the affine hull of
+    ``M̄_ℓ`` (dimension ``d``; models that contain constant entries such as ``I + T A`` lie in a proper
+    affine subspace, ``d = n_g − 1``), pick ``d + 1`` well-separated samples by pivoted QR of the
+    homogeneous coordinates ``[M̄; 1]``, and replace this base simplex by the tightest simplex with
+    facets parallel to it that contains every sample: with barycentric coordinates ``λ`` and
+    ``a_j = min λ_j ≤ 0`` the new vertex ``j`` has ``λ_k = a_k`` (k ≠ j), ``λ_j = 1 − Σ_{k≠j} a_k``.
+    Every facet touches a sample, every sample is inside (check: :func:`convex_weights`), and
+    ``N_h = d + 1`` vertices (the thesis's ``N_h ≥ n_g + 1`` counts the linear rank).
+
+    Raises
+    ------
+    DesignError
+        If the samples are affinely degenerate (fewer than two distinct models).
+    """
+    M = _as_model_matrix(models)
+    U, s, Vt = np.linalg.svd(M, full_matrices=False)
+    n_g = gap_rank(s, min_gap) if rank is None else int(rank)
+    basis = U[:, :n_g]
+    coords = s[:n_g, None] * Vt[:n_g]
+    centre = coords.mean(axis=1, keepdims=True)
+    Ua, sa, _ = np.linalg.svd(coords - centre, full_matrices=False)
+    d = gap_rank(sa, min_gap)
+    if d < 1:
+        raise DesignError("the large model set has fewer than two distinct models; nothing to enclose")
+    local = Ua[:, :d].T @ (coords - centre)  # d × N_ℓ coordinates in the affine hull
+    _, _, piv = scipy.linalg.qr(np.vstack([local, np.ones(local.shape[1])]), mode="economic", pivoting=True)
+    base = local[:, piv[: d + 1]]
+    T = np.vstack([base, np.ones(d + 1)])
+    lam = np.linalg.solve(T, np.vstack([local, np.ones(local.shape[1])]))  # barycentric, (d+1) × N_ℓ
+    a = np.minimum(lam.min(axis=1), 0.0)
+    bary = np.tile(a[:, None], (1, d + 1))
+    np.fill_diagonal(bary, 1.0 - (a.sum() - a))
+    vertices_local = base @ bary
+    vertices = centre + Ua[:, :d] @ vertices_local
+    weights = (lam - a[:, None]) / (1.0 - a.sum())
+    hull_points = local
+    if 1 < d <= 8 and local.shape[1] > d + 1:
+        try:
+            hull_points = local[:, scipy.spatial.ConvexHull(local.T).vertices]
+        except scipy.spatial.QhullError:  # pragma: no cover - degenerate hull, fall back to all samples
+            hull_points = local
+    cost = float(sum(_distance_to_hull(hull_points, vertices_local[:, j]) ** 2 for j in range(d + 1)))
+    return CPModelSet(basis, coords, vertices, basis @ vertices, weights, cost)
+
+
+# ------------------------------------------------------------------------------------ LV
+Quadruple = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+
+@dataclass(frozen=True)
+class LimitValueModelSet:
+    """Limit-value model ``M(μ) = M⁺ + Σ_j μ_j M^Δ_j`` with ``μ_j ∈ [0, 1]``, Hallouzi 2008, (3.39)–(3.40).
+
+    Attributes
+    ----------
+    names : tuple of str
+        One weight per varying parameter (entries varying through the same parameter share it, §3.6.1).
+    offset : tuple of arrays
+        ``(A⁺, B⁺, C⁺, D⁺)``: the model at the "+" limits of all parameters.
+    deltas : tuple of tuples of arrays
+        ``(A^Δ_j, B^Δ_j, C^Δ_j, D^Δ_j)``: change when parameter ``j`` moves to its other limit.
+    dt : float or None
+        First-order sample time if discretised (3.44)–(3.45), else ``None``.
+    """
+
+    names: tuple[str, ...]
+    offset: Quadruple
+    deltas: tuple[Quadruple, ...]
+    dt: float | None = None
+
+    def model(self, weights) -> Quadruple:
+        """``(A, B, C, D)`` at the given weights (one per name, each in ``[0, 1]``)."""
+        mu = np.asarray(weights, float).ravel()
+        if mu.shape != (len(self.names),):
+            raise DesignError(f"expected {len(self.names)} weights for {self.names}, got shape {mu.shape}")
+        if np.any(mu < -1e-12) or np.any(mu > 1 + 1e-12):
+            raise DesignError(f"limit-value weights must lie in [0, 1], got {mu.tolist()}")
+        return tuple(self.offset[k] + sum(m * delta[k] for m, delta in zip(mu, self.deltas)) for k in range(4))
+
+
+def limit_value_model_set(matrices: Callable[..., Sequence], upper: Mapping[str, float], lower: Mapping[str, float],
+                          dt: float | None = None) -> LimitValueModelSet:
+    """Limit-value model set, Hallouzi 2008, §3.5, (3.34)–(3.40), with one weight per parameter.
+
+    ``matrices(**params)`` returns ``(A, B, C)`` or ``(A, B, C, D)``.  The offset is the model with
+    every parameter at its ``upper`` ("+") limit; ``M^Δ_j`` is the change when parameter ``j`` alone
+    moves to its ``lower`` limit, so ``a = a⁺ + μ a^Δ`` with ``a^Δ = a⁻ − a⁺`` (3.36).  The
+    representation is exact when every entry is affine in one (possibly transformed) parameter,
+    as in the MSD (``1/m3``); :meth:`LimitValueModelSet.model` then reproduces ``matrices`` for all
+    parameter values.  With ``dt`` the blocks are first-order discretised (3.44): ``A⁺ → I + T A⁺``,
+    ``A^Δ → T A^Δ``, ``B → T B``.
+
+    Raises
+    ------
+    DesignError
+        If ``upper`` and ``lower`` name different parameters.
+    """
+    if set(upper) != set(lower) or not upper:
+        raise DesignError(f"upper and lower limits must name the same parameters, got {sorted(upper)} and "
+                          f"{sorted(lower)}")
+    names = tuple(upper)
+
+    def quad(params) -> list[np.ndarray]:
+        mats = [np.atleast_2d(np.asarray(M, float)) for M in matrices(**params)]
+        if len(mats) == 3:
+            mats.append(np.zeros((mats[2].shape[0], mats[1].shape[1])))
+        return mats
+
+    plus = quad(dict(upper))
+    deltas = []
+    for name in names:
+        q = quad({**upper, name: lower[name]})
+        deltas.append([qk - pk for qk, pk in zip(q, plus)])
+    if dt is not None:
+        Ad, Bd = first_order_discretize(plus[0], plus[1], dt)
+        plus = [Ad, Bd, plus[2], plus[3]]
+        deltas = [[dt * d[0], dt * d[1], d[2], d[3]] for d in deltas]
+    return LimitValueModelSet(names, tuple(plus), tuple(tuple(d) for d in deltas), None if dt is None else float(dt))
+
+
+# ------------------------------------------------------------------------------------ reconstruction
+def nearest_model(models, estimate) -> int:
+    """Index ``n_s = argmin_i ‖𝔐^{(i)} − M̂‖₂`` of the large-set model nearest an estimate, (3.52).
+
+    ``estimate`` is a model vector, e.g. ``M̃_r μ̂`` (OD) or ``U¹ V μ̂`` (CP, (3.51)).
+    """
+    M = _as_model_matrix(models)
+    x = np.asarray(estimate, float).ravel()
+    if x.size != M.shape[0]:
+        raise ModelError(f"the estimate has {x.size} entries, the model vectors {M.shape[0]}")
+    return int(np.argmin(np.linalg.norm(M - x[:, None], axis=0)))
+
+
+def minimum_mismatch_points(distribution, n_models: int) -> np.ndarray:
+    """Parameter values of Li et al.'s (2005) "minimum-mismatch" set, Hallouzi 2008, §3.6.4, (3.58).
+
+    The CDF is split into ``n_models`` equiprobable regions; each model sits at the probability
+    centre of its region, ``F⁻¹((i − ½)/N)``.  ``distribution`` is a frozen ``scipy.stats``
+    distribution (anything with ``ppf``).
+
+    Examples
+    --------
+    >>> from scipy.stats import norm
+    >>> minimum_mismatch_points(norm(1.0, 0.2), 2).round(4).tolist()   # §3.6.4: 0.865 and 1.135
+    [0.8651, 1.1349]
+    """
+    if int(n_models) < 1:
+        raise DesignError(f"n_models must be >= 1, got {n_models}")
+    if not hasattr(distribution, "ppf"):
+        raise DesignError("distribution must have a ppf (inverse CDF), e.g. scipy.stats.norm(1.0, 0.2)")
+    q = (np.arange(int(n_models)) + 0.5) / int(n_models)
+    return np.asarray(distribution.ppf(q), float)
+
+
+# ------------------------------------------------------------------------------------ observability
+def observability_condition(step: Callable[[np.ndarray, np.ndarray], np.ndarray],
+                            output: Callable[[np.ndarray], np.ndarray], state, inputs,
+                            rel_step: float = 1e-6) -> tuple[float, np.ndarray]:
+    """Condition number (3.9) of the nonlinear observability matrix ``∂hⁿ/∂x`` of Def. 3.1, (3.7)–(3.8).
+
+    ``hⁿ(x) = [h(x); h(f(x, u_k)); …; h(f^{n−1}(x))]`` with ``f(x, u) = step(x, u)``, ``h = output``
+    and ``u_k … u_{k+n−2}`` the first ``n − 1`` rows of ``inputs``.  The Jacobian is taken by
+    central differences (exact for systems quadratic in ``x``, such as the MM system with the
+    weights appended to the state, (3.10)).  Returns ``(cond, jacobian)``; ``cond`` is ``inf`` if
+    the matrix is rank deficient.
+    """
+    x0 = np.asarray(state, float).ravel()
+    n = x0.size
+    U = np.atleast_2d(np.asarray(inputs, float))
+    if U.shape[0] < n - 1:
+        raise DesignError(f"need n − 1 = {n - 1} input samples, got {U.shape[0]}")
+
+    def stacked(x):
+        out = [np.atleast_1d(output(x))]
+        for k in range(n - 1):
+            x = np.asarray(step(x, U[k]), float)
+            out.append(np.atleast_1d(output(x)))
+        return np.concatenate(out)
+
+    J = np.empty((stacked(x0).size, n))
+    for i in range(n):
+        h = rel_step * max(1.0, abs(x0[i]))
+        e = np.zeros(n)
+        e[i] = h
+        J[:, i] = (stacked(x0 + e) - stacked(x0 - e)) / (2 * h)
+    sv = np.linalg.svd(J, compute_uv=False)
+    cond = float(sv[0] / sv[-1]) if sv[-1] > 0 and sv.size >= n else float("inf")
+    return cond, J
