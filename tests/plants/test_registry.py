@@ -13,7 +13,7 @@ from fdikit.plants import PLANTS, get_plant, path_vehicle_12, path_vehicle_14, s
 
 def test_registry_names():
     assert set(PLANTS) == {"path12", "path14", "single-track", "f16xl", "f16xl-gust", "white-speyer", "varrier-lateral",
-                           "path7"}
+                           "path7", "msd", "b747"}
     assert PLANTS["path12"] is path_vehicle_12
     assert PLANTS["path14"] is path_vehicle_14
     assert PLANTS["single-track"] is single_track

@@ -14,6 +14,8 @@ name                 model                                            source
 ``white-speyer``     3-state system with invariant-zero cases         Murray 2012, §6.2
 ``varrier-lateral``  lateral 2-state model, ρ = 1/v, Euler 0.02 s     Varrier et al. 2014, (48)
 ``path7``            PATH longitudinal, 7 states (reduced, 25 m/s)    Douglas et al. 1996, §9.6
+``msd``              3-mass spring-damper LPV benchmark (k1, m3)      Hallouzi 2008, §3.6
+``b747``             B747 longitudinal FDI example (substitute B)     Hallouzi 2008, §2.4.1
 ===================  ==============================================  ======================
 
 Examples
@@ -30,7 +32,9 @@ from collections.abc import Callable
 
 from fdikit.errors import ModelError
 from fdikit.model import FaultModel
+from fdikit.plants.b747 import b747_longitudinal, b747_model_set
 from fdikit.plants.f16xl import F16XL_DRYDEN_GAIN, f16xl_gust, f16xl_longitudinal
+from fdikit.plants.msd import msd, msd_matrices
 from fdikit.plants.path_longitudinal import path_longitudinal_7, path_longitudinal_7_fault_maps
 from fdikit.plants.path_vehicle import (
     TABLE_2_1_EIGENVALUES_12,
@@ -82,6 +86,10 @@ __all__ = [
     "F16XL_DRYDEN_GAIN",
     "white_speyer",
     "path_longitudinal_7",
+    "msd",
+    "msd_matrices",
+    "b747_longitudinal",
+    "b747_model_set",
     "path_longitudinal_7_fault_maps",
     "WHITE_SPEYER_CASES",
 ]
@@ -96,6 +104,8 @@ PLANTS: dict[str, Callable[..., FaultModel]] = {
     "white-speyer": white_speyer,
     "varrier-lateral": varrier_lateral,
     "path7": path_longitudinal_7,
+    "msd": msd,
+    "b747": b747_longitudinal,
 }
 
 
