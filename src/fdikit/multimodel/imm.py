@@ -1,0 +1,369 @@
+"""Interacting multiple-model (IMM) filter for jump-Markov linear systems.
+
+Hallouzi 2008, §2.3.1, Table 2.1 (after Li & Jilkov 2005), for the JMLS (2.3)–(2.5)::
+
+    x_{k+1} = A^(s_k) x_k + B^(s_k) u_k + w_k,   w_k ~ N(0, Q^(s_k))
+    y_k     = C^(s_k) x_k + D^(s_k) u_k + v_k,   v_k ~ N(0, R^(s_k))
+    Π_ij    = P(s_{k+1} = j | s_k = i)          (row-stochastic)
+
+with the OCR corrections of the research note (§2.4, §5.2 item 1): the mixing covariance uses
+``P^(i)`` (printed ``P^(j)``) and the residual covariance is ``Σ = C P_{k|k−1} Cᵀ + R`` (printed
+without ``P_{k|k−1}``).  Noise means are zero (they are zero in every example of the thesis).
+
+The mode probabilities are propagated **in log space** (log-sum-exp in the Π prediction and in
+the Bayes update) so that they neither underflow nor give 0/0 when every likelihood (2.12) is
+below the smallest double (high-SNR data, outliers, 10⁶-step runs).
+
+Sample convention (predictor form, as the rest of fdikit): the filter holds the per-mode priors
+``x̂^(j)_{k|k−1}, P^(j)_{k|k−1}, μ_{k|k−1}``; ``step(u_k, y_k)`` performs the measurement update and
+mode-probability update with ``y_k`` (step 2 second half, step 3), the fusion (step 4), then the
+mixing (step 1) and the time update with ``u_k`` (step 2 first half) for sample ``k+1``.  This is
+the Table 2.1 cycle with the cut placed after the update instead of before the mixing.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from fdikit.errors import DataError, ModelError
+from fdikit.multimodel.isolation import GroupThresholdLogic, mode_diagnosis
+from fdikit.trace import Trace
+
+__all__ = ["LinearMode", "IMMFilter", "IMMStepper", "IMMStep", "IMMResult"]
+
+_LOG2PI = float(np.log(2.0 * np.pi))
+
+
+@dataclass(frozen=True, eq=False)
+class LinearMode:
+    """One mode of a jump-Markov linear system (Hallouzi 2008, (2.3)–(2.4)), discrete time.
+
+    ``x⁺ = A x + B u + w``, ``y = C x + D u + v`` with ``w ~ N(0, Q)``, ``v ~ N(0, R)``.
+    ``B`` and ``D`` default to zero-column matrices (no input).
+    """
+
+    A: np.ndarray
+    C: np.ndarray
+    Q: np.ndarray
+    R: np.ndarray
+    B: np.ndarray | None = None
+    D: np.ndarray | None = None
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        A = _mat("A", self.A)
+        C = _mat("C", self.C)
+        n, p = A.shape[0], C.shape[0]
+        if A.shape != (n, n):
+            raise ModelError(f"mode {self.name!r}: A has shape {A.shape}; it must be square (n × n)")
+        if C.shape[1] != n:
+            raise ModelError(f"mode {self.name!r}: C has shape {C.shape}; it needs n = {n} columns like A")
+        B = np.zeros((n, 0)) if self.B is None else _mat("B", self.B)
+        m = B.shape[1]
+        D = np.zeros((p, m)) if self.D is None else _mat("D", self.D)
+        Q, R = _mat("Q", self.Q), _mat("R", self.R)
+        for nm, M, shape in (("B", B, (n, m)), ("D", D, (p, m)), ("Q", Q, (n, n)), ("R", R, (p, p))):
+            if M.shape != shape:
+                raise ModelError(f"mode {self.name!r}: {nm} has shape {M.shape}, expected {shape}")
+        if not np.allclose(Q, Q.T) or np.linalg.eigvalsh(Q).min() < -1e-12 * max(1.0, np.abs(Q).max()):
+            raise ModelError(f"mode {self.name!r}: Q must be symmetric positive semidefinite")
+        if not np.allclose(R, R.T) or np.linalg.eigvalsh(R).min() <= 0:
+            raise ModelError(f"mode {self.name!r}: R must be symmetric positive definite (measurement noise)")
+        for nm, M in (("A", A), ("B", B), ("C", C), ("D", D), ("Q", Q), ("R", R)):
+            object.__setattr__(self, nm, M)
+
+    @property
+    def n(self) -> int:
+        return self.A.shape[0]
+
+    @property
+    def m(self) -> int:
+        return self.B.shape[1]
+
+    @property
+    def p(self) -> int:
+        return self.C.shape[0]
+
+
+def _mat(name: str, M) -> np.ndarray:
+    M = np.atleast_2d(np.asarray(M, dtype=float))
+    if M.ndim != 2 or not np.all(np.isfinite(M)):
+        raise ModelError(f"matrix {name} must be a finite 2-D array")
+    return M
+
+
+@dataclass(frozen=True)
+class IMMStep:
+    """Output of one IMM cycle (Table 2.1 step 4, fused values are output only).
+
+    ``x, P`` fused filtered estimate and covariance, ``mu`` mode probabilities ``μ_k``,
+    ``x_modes, P_modes`` mode-matched filtered estimates, ``log_likelihood`` the log predictive
+    density ``log p(y_k | Y_{k−1})`` (nan when invalid), ``valid`` False for a NaN measurement
+    (prediction only: ``x, mu`` are then the predicted values).
+    """
+
+    x: np.ndarray
+    P: np.ndarray
+    mu: np.ndarray
+    x_modes: np.ndarray
+    P_modes: np.ndarray
+    log_likelihood: float
+    valid: bool
+
+
+@dataclass(frozen=True, eq=False)
+class IMMResult:
+    """Batch output of :meth:`IMMFilter.run` (arrays with one row per sample).
+
+    ``x`` (N, n) fused estimates, ``P`` (N, n, n) fused covariances or None, ``mu`` (N, M) mode
+    probabilities, ``log_mu`` (N, M) their logarithms (finite far below the double range of ``mu``),
+    ``x_modes`` (N, M, n) or None, ``log_likelihood`` (N,), ``valid`` (N,).
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    P: np.ndarray | None
+    mu: np.ndarray
+    log_mu: np.ndarray
+    x_modes: np.ndarray | None
+    log_likelihood: np.ndarray
+    valid: np.ndarray
+    modes: tuple[str, ...]
+    nominal: int = 0
+
+    def diagnosis(self, logic: GroupThresholdLogic | None = None):
+        """Mode probabilities as a :class:`~fdikit.diagnosis.Diagnosis` (most probable mode, or ``logic``)."""
+        return mode_diagnosis(self.t, self.mu, self.modes, self.nominal, logic, self.valid)
+
+
+@dataclass(frozen=True, eq=False)
+class IMMFilter:
+    """IMM filter of Hallouzi 2008, §2.3.1, Table 2.1 (corrected; see module docstring).
+
+    Parameters
+    ----------
+    modes : the mode models, sharing n, m, p.
+    transition : Π, (M, M) row-stochastic, ``Π[i, j] = P(s_{k+1}=j | s_k=i)``.
+    mu0 : prior mode probabilities of the first sample (default uniform).
+    x0, P0 : prior state mean and covariance of the first sample, shared ``(n,)``/``(n, n)``
+        or per mode ``(M, n)``/``(M, n, n)`` (default zero and identity).
+    nominal : index of the nominal (fault-free) mode, for the diagnosis.
+    min_probability : floor on the predicted probabilities ``μ_{k|k−1}`` (research note §2.4: a Π
+        with zeros can lock a mode out); 0 disables it.
+
+    Example
+    -------
+    >>> import numpy as np
+    >>> m0 = LinearMode(A=[[1.0]], C=[[1.0]], Q=[[0.01]], R=[[0.1]], name="nominal")
+    >>> m1 = LinearMode(A=[[1.0]], C=[[2.0]], Q=[[0.01]], R=[[0.1]], name="gain fault")
+    >>> imm = IMMFilter([m0, m1], [[0.99, 0.01], [0.01, 0.99]], x0=[1.0], P0=[[0.01]])
+    >>> res = imm.run(np.zeros((50, 0)), 2.0 * np.ones((50, 1)))
+    >>> bool(res.mu[-1, 1] > 0.99), str(res.diagnosis().isolated[-1])
+    (True, 'gain fault')
+    """
+
+    modes: Sequence[LinearMode]
+    transition: np.ndarray
+    mu0: np.ndarray | None = None
+    x0: np.ndarray | None = None
+    P0: np.ndarray | None = None
+    nominal: int = 0
+    min_probability: float = 0.0
+
+    def __post_init__(self) -> None:
+        modes = tuple(self.modes)
+        if not modes or not all(isinstance(md, LinearMode) for md in modes):
+            raise ModelError("IMMFilter needs a non-empty sequence of LinearMode")
+        M = len(modes)
+        n, m, p = modes[0].n, modes[0].m, modes[0].p
+        for md in modes:
+            if (md.n, md.m, md.p) != (n, m, p):
+                raise ModelError(
+                    f"mode {md.name!r} has (n, m, p) = {(md.n, md.m, md.p)} but the first mode has {(n, m, p)}; "
+                    "all modes must share the state, input and output dimensions (pad with zeros)"
+                )
+        Pi = np.atleast_2d(np.asarray(self.transition, dtype=float))
+        if Pi.shape != (M, M) or np.any(Pi < 0) or not np.allclose(Pi.sum(axis=1), 1.0, atol=1e-10):
+            raise ModelError(
+                f"transition matrix Π must be ({M}, {M}), non-negative, with rows summing to 1 "
+                f"(Π[i, j] = P(s_k+1 = j | s_k = i)); got shape {Pi.shape}, row sums {np.round(Pi.sum(axis=1), 6)}"
+            )
+        mu0 = np.full(M, 1.0 / M) if self.mu0 is None else np.asarray(self.mu0, dtype=float).ravel()
+        if mu0.shape != (M,) or np.any(mu0 < 0) or not np.isclose(mu0.sum(), 1.0):
+            raise ModelError(f"mu0 must be {M} non-negative probabilities summing to 1; got {mu0}")
+        x0 = np.zeros(n) if self.x0 is None else np.asarray(self.x0, dtype=float)
+        x0 = np.broadcast_to(x0, (M, n)).copy() if x0.shape in ((n,), (M, n)) else None
+        if x0 is None:
+            raise ModelError(f"x0 must have shape ({n},) or ({M}, {n})")
+        P0 = np.eye(n) if self.P0 is None else np.asarray(self.P0, dtype=float)
+        P0 = np.broadcast_to(P0, (M, n, n)).copy() if P0.shape in ((n, n), (M, n, n)) else None
+        if P0 is None:
+            raise ModelError(f"P0 must have shape ({n}, {n}) or ({M}, {n}, {n})")
+        if not 0 <= self.nominal < M:
+            raise ModelError(f"nominal = {self.nominal} is not a mode index in [0, {M})")
+        if not 0.0 <= self.min_probability < 1.0 / M:
+            raise ModelError(f"min_probability must lie in [0, 1/M) = [0, {1.0 / M:g})")
+        names = tuple(md.name or f"mode{i}" for i, md in enumerate(modes))
+        if len(set(names)) != M:
+            raise ModelError(f"mode names must be unique; got {names}")
+        set_ = object.__setattr__
+        set_(self, "modes", modes)
+        set_(self, "transition", Pi)
+        set_(self, "mu0", mu0)
+        set_(self, "x0", x0)
+        set_(self, "P0", P0)
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(md.name or f"mode{i}" for i, md in enumerate(self.modes))
+
+    def online(self) -> IMMStepper:
+        """A stepper holding the filter state, for sample-by-sample use."""
+        return IMMStepper(self)
+
+    def run(self, u, y=None, t=None, store_covariance: bool = True, store_modes: bool = False) -> IMMResult:
+        """Filter a whole record.
+
+        Parameters
+        ----------
+        u : (N, m) inputs, or a :class:`~fdikit.trace.Trace` (then ``y`` and ``t`` come from it).
+        y : (N, p) measurements; rows with NaN are prediction-only samples (marked invalid).
+        t : (N,) times (default sample index).
+        store_covariance, store_modes : keep the fused covariances / mode-matched estimates.
+        """
+        if isinstance(u, Trace):
+            u, y, t = u.u, u.y, u.t
+        md = self.modes[0]
+        u = np.asarray(u, dtype=float).reshape(-1, md.m) if md.m else np.zeros((np.shape(y)[0], 0))
+        y = np.asarray(y, dtype=float)
+        y = y.reshape(-1, 1) if y.ndim == 1 and md.p == 1 else y
+        N = y.shape[0]
+        if y.shape != (N, md.p) or u.shape[0] != N:
+            raise DataError(f"need y of shape (N, {md.p}) and u of shape (N, {md.m}); got {y.shape} and {u.shape}")
+        if not np.all(np.isfinite(u)):
+            raise DataError("inputs u contain NaN/inf; the IMM cannot predict without the input, clean u first")
+        t = np.arange(N, dtype=float) if t is None else np.asarray(t, dtype=float)
+        M, n = len(self.modes), md.n
+        X = np.empty((N, n))
+        P = np.empty((N, n, n)) if store_covariance else None
+        LMU = np.empty((N, M))
+        XM = np.empty((N, M, n)) if store_modes else None
+        LL = np.empty(N)
+        V = np.empty(N, bool)
+        s = IMMStepper(self)
+        for k in range(N):
+            x, Pk, xm, ll, ok = s._cycle(u[k], y[k])
+            X[k] = x
+            LMU[k] = s.log_mu
+            LL[k] = ll
+            V[k] = ok
+            if P is not None:
+                P[k] = Pk
+            if XM is not None:
+                XM[k] = xm
+        return IMMResult(t=t, x=X, P=P, mu=np.exp(LMU), log_mu=LMU, x_modes=XM, log_likelihood=LL, valid=V,
+                         modes=self.names, nominal=self.nominal)
+
+
+class IMMStepper:
+    """Online IMM: ``step(u_k, y_k)`` → :class:`IMMStep`; NaN in ``y_k`` → prediction only."""
+
+    def __init__(self, imm: IMMFilter) -> None:
+        md = imm.modes
+        self.imm = imm
+        self._A = np.stack([m.A for m in md])
+        self._At = self._A.transpose(0, 2, 1).copy()
+        self._B = np.stack([m.B for m in md])
+        self._C = np.stack([m.C for m in md])
+        self._Ct = self._C.transpose(0, 2, 1).copy()
+        self._D = np.stack([m.D for m in md])
+        self._Q = np.stack([m.Q for m in md])
+        self._R = np.stack([m.R for m in md])
+        with np.errstate(divide="ignore"):
+            self._logPi = np.log(imm.transition)
+            self._logfloor = np.log(imm.min_probability) if imm.min_probability > 0 else -np.inf
+            self.log_mu_pred = np.log(imm.mu0)
+        self.x_pred = imm.x0.copy()
+        self.P_pred = imm.P0.copy()
+        self.log_mu = self.log_mu_pred.copy()
+        self._p = md[0].p
+        self._m = md[0].m
+
+    @property
+    def mu(self) -> np.ndarray:
+        """Current mode probabilities (after the last update)."""
+        return np.exp(self.log_mu)
+
+    def step(self, u, y) -> IMMStep:
+        """One Table 2.1 cycle with ``u_k, y_k`` (see the module docstring for the sample convention)."""
+        u = np.asarray(u, dtype=float).reshape(self._m)
+        y = np.asarray(y, dtype=float).reshape(self._p)
+        if not np.all(np.isfinite(u)):
+            raise DataError("input u_k contains NaN/inf; the IMM cannot predict without the input")
+        x, P, xm, ll, ok = self._cycle(u, y, keep=True)
+        return IMMStep(x=x, P=P, mu=np.exp(self.log_mu), x_modes=xm, P_modes=self._Pf, log_likelihood=ll, valid=ok)
+
+    def _cycle(self, u, y, keep: bool = False):
+        xp, Pp = self.x_pred, self.P_pred
+        ok = bool(np.all(np.isfinite(y)))
+        if ok:
+            # step 2 (measurement update) with Σ = C P_{k|k-1} Cᵀ + R  [Table 2.1 OCR drops P_{k|k-1}]
+            PCt = Pp @ self._Ct                                        # (M, n, p)
+            S = self._C @ PCt + self._R
+            S = 0.5 * (S + S.transpose(0, 2, 1))
+            z = y - (self._C @ xp[:, :, None])[:, :, 0] - (self._D @ u)
+            W = np.linalg.solve(S, np.concatenate([PCt.transpose(0, 2, 1), z[:, :, None]], axis=2))  # S⁻¹[PCᵀ'ᵀ z]
+            Kz = (PCt @ W[:, :, -1:])[:, :, 0]
+            xf = xp + Kz
+            Pf = Pp - PCt @ W[:, :, :-1]
+            Pf = 0.5 * (Pf + Pf.transpose(0, 2, 1))
+            # step 3 in log space: log L = −½ (zᵀ Σ⁻¹ z + log|2πΣ|)   (2.12)
+            logdet = np.linalg.slogdet(S)[1]
+            loglik = -0.5 * (np.einsum("mp,mp->m", z, W[:, :, -1]) + logdet + self._p * _LOG2PI)
+            a = self.log_mu_pred + loglik
+            ll = _logsumexp(a)
+            self.log_mu = a - ll
+        else:  # prediction only
+            xf, Pf, ll = xp, Pp, np.nan
+            self.log_mu = self.log_mu_pred
+        # step 4: fusion (output only)
+        mu = np.exp(self.log_mu)
+        x = mu @ xf
+        d = xf - x
+        nx = xf.shape[1]
+        P = (mu @ Pf.reshape(len(mu), -1)).reshape(nx, nx) + (d.T * mu) @ d
+        if keep:
+            self._Pf = Pf
+        # step 1: mixing with μ_{k|k-1} = Σ_i Π_ij μ_i (log-sum-exp), then step 2 time update with u_k
+        G = self._logPi + self.log_mu[:, None]                         # (i, j)
+        lp = _logsumexp(G, axis=0)
+        reach = np.isfinite(lp)
+        Wm = np.where(reach[None, :], np.exp(G - np.where(reach, lp, 0.0)[None, :]), mu[:, None])  # μ^{i|j}
+        xbar = Wm.T @ xf                                               # (j, n)
+        dd = xf[None, :, :] - xbar[:, None, :]                         # (j, i, n)
+        Pbar = (Wm.T @ Pf.reshape(len(mu), -1)).reshape(Pf.shape)     # Σ_i μ^{i|j} P^(i)  [OCR: P^(j)]
+        Pbar += (dd.transpose(0, 2, 1) * Wm.T[:, None, :]) @ dd        # + Σ_i μ^{i|j} (x̄ − x̂^(i))(x̄ − x̂^(i))ᵀ
+        if self._logfloor > -np.inf:
+            lp = np.maximum(lp, self._logfloor)
+            lp = lp - _logsumexp(lp)
+        self.log_mu_pred = lp
+        self.x_pred = (self._A @ xbar[:, :, None])[:, :, 0] + self._B @ u
+        self.P_pred = self._A @ Pbar @ self._At + self._Q
+        return x, P, xf, ll, ok
+
+
+def _logsumexp(a: np.ndarray, axis: int | None = None):
+    """log Σ exp(a) along ``axis`` (None or 0); −inf for an all −inf slice."""
+    if axis is None:
+        mx = a.max()
+        return mx + float(np.log(np.exp(a - mx).sum())) if mx > -np.inf else -np.inf
+    mx = a.max(axis=0)
+    fin = mx > -np.inf
+    if fin.all():
+        return mx + np.log(np.exp(a - mx).sum(axis=0))
+    m0 = np.where(fin, mx, 0.0)
+    s = np.exp(a - m0).sum(axis=0)
+    return np.where(fin, m0 + np.log(np.where(fin, s, 1.0)), -np.inf)
