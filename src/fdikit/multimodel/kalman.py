@@ -44,6 +44,7 @@ import numpy as np
 import scipy.linalg
 
 from fdikit.errors import DataError, ModelError
+from fdikit.lti import dlsim_blocked
 from fdikit.model import FaultModel
 
 __all__ = [
@@ -414,6 +415,11 @@ class KalmanStep:
     valid: bool
 
 
+#: relative change of P(k+1|k) below which the batch runner switches to the steady-state filter
+_SETTLED = 1e-14
+_TINY = 1e-300
+
+
 @dataclass(frozen=True)
 class KalmanResult:
     """A filtered record of N samples.
@@ -570,8 +576,61 @@ def kalman_filter(model, u, y, x0, P0, *, form: str = "covariance", Q=None, R=No
     """
     kf = KalmanFilter(model, x0, P0, form=form, Q=Q, R=R)
     u, y = _check_record(u, y, kf.model.m, kf.model.p)
-    steps = [kf.step(uk, yk) for uk, yk in zip(u, y, strict=True)]
+    steps, settled = [], 0
+    for k, (uk, yk) in enumerate(zip(u, y, strict=True)):
+        P_before = kf.P
+        steps.append(kf.step(uk, yk))
+        if form == "covariance":
+            change = np.abs(kf.P - P_before).max()
+            settled = settled + 1 if change <= _SETTLED * max(np.abs(kf.P).max(), _TINY) else 0
+            if settled >= 3 and k + 1 < len(y):
+                return _stack_results(_collect(steps, kf.model.n, kf.model.p),
+                                      _steady_run(kf, u[k + 1:], y[k + 1:]))
     return _collect(steps, kf.model.n, kf.model.p)
+
+
+def _steady_run(kf: KalmanFilter, u: np.ndarray, y: np.ndarray) -> KalmanResult:
+    """The rest of the record once ``P(k+1|k)`` has settled: a time-invariant filter, run by the blocked solver.
+
+    With ``P`` constant the gain ``K = P Cᵀ S⁻¹`` is constant and the predictor
+    ``x̂(k+1|k) = A(I − KC) x̂ + (B − AKD) u + AK y`` is an LTI system of ``[u; y]``; its innovation
+    ``e = −C x̂ − D u + y`` and filtered state ``x̂(k|k) = (I − KC) x̂ − KD u + K y`` are outputs.  Equal to the
+    step-by-step recursion to round-off (the covariance has stopped changing to ``_SETTLED``).
+    """
+    m = kf.model
+    n, p, N = m.n, m.p, y.shape[0]
+    B, D, P = m.B, m.D, kf.P
+    S = m.C @ P @ m.C.T + m.R
+    S = 0.5 * (S + S.T)
+    K = np.linalg.solve(S, m.C @ P).T
+    IKC = np.eye(n) - K @ m.C
+    A_f = m.A @ IKC
+    B_f = np.hstack([B - m.A @ K @ D, m.A @ K])
+    C_f = np.vstack([-m.C, IKC])
+    D_f = np.block([[-D, np.eye(p)], [-K @ D, K]])
+    v = np.hstack([u.reshape(N, -1), y])
+    out, states, x_end = dlsim_blocked(A_f, B_f, C_f, D_f, v, kf.x)
+    e, x_filt = out[:, :p], out[:, p:]
+    L = np.linalg.cholesky(S)
+    w = scipy.linalg.solve_triangular(L, e.T, lower=True)
+    ll = -0.5 * (np.sum(w * w, axis=0) + p * np.log(2 * np.pi)) - np.sum(np.log(np.diag(L)))
+    P_filt = IKC @ P @ IKC.T + K @ m.R @ K.T
+    kf.x = x_end
+    return KalmanResult(
+        x_filt=x_filt,
+        P_filt=np.broadcast_to(P_filt, (N, n, n)).copy(),
+        x_pred=np.vstack([states[1:], x_end]),
+        P_pred=np.broadcast_to(P, (N, n, n)).copy(),
+        innovations=e,
+        S=np.broadcast_to(S, (N, p, p)).copy(),
+        log_likelihood=ll,
+        valid=np.ones(N, bool),
+    )
+
+
+def _stack_results(first: KalmanResult, rest: KalmanResult) -> KalmanResult:
+    return KalmanResult(**{f: np.concatenate([getattr(first, f), getattr(rest, f)])
+                           for f in KalmanResult.__dataclass_fields__})
 
 
 def _collect(steps: list[KalmanStep], n: int, p: int) -> KalmanResult:
