@@ -1,0 +1,481 @@
+"""Convex-model (CM) structure and the dual convex-model filter (Hallouzi 2008, §2.2.2, §2.3.2).
+
+The CM structure (2.8)–(2.10) blends ``N`` local models with weights on the simplex,
+
+    x_{k+1} = Σ μ^(i) (A^(i) x_k + B^(i) u_k) + Q^{1/2} w_k,
+    y_k     = Σ μ^(i) (C^(i) x_k + D^(i) u_k) + R^{1/2} v_k,      μ ≥ 0, 1ᵀμ = 1,
+
+with noise common to all models.  The dual CMF (Table 2.2) alternates
+
+1. a square-root covariance Kalman step (2.29)–(2.32) for the model frozen at μ̂_{k−1};
+2. a square-root-information RLS step (2.33)–(2.36) with forgetting λ for the weights,
+   followed by the projection (2.37)–(2.38) onto the simplex.
+
+The augmented EKF (Table 2.3) is in :mod:`fdikit.multimodel.convex_ekf`.  Fault sizes and
+parameters are reconstructed from weights by (3.51)–(3.57) (:func:`fault_size_from_weights`,
+:func:`lv_parameter`, :func:`lv_reciprocal_parameter`, :func:`nearest_model`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from fdikit.errors import DataError, ModelError
+
+__all__ = [
+    "ConvexModelSet",
+    "convex_model_set",
+    "SrcfStep",
+    "srcf_step",
+    "weight_regressors",
+    "rls_weight_step",
+    "project_to_simplex",
+    "ConvexFilterResult",
+    "dual_convex_filter",
+    "fault_size_from_weights",
+    "lv_parameter",
+    "lv_reciprocal_parameter",
+    "estimated_model_vector",
+    "nearest_model",
+]
+
+
+def psd_factor(M: np.ndarray, name: str) -> np.ndarray:
+    """A lower-triangular-ish factor ``F`` with ``F Fᵀ = M`` (Cholesky, eigen-factor if singular)."""
+    M = np.asarray(M, dtype=float)
+    if M.ndim != 2 or M.shape[0] != M.shape[1] or not np.all(np.isfinite(M)):
+        raise ModelError(f"{name} must be a finite square matrix, got shape {M.shape}")
+    if not np.allclose(M, M.T, atol=1e-12 * max(1.0, np.abs(M).max())):
+        raise ModelError(f"{name} must be symmetric; pass (M + M.T) / 2")
+    try:
+        return np.linalg.cholesky(M)
+    except np.linalg.LinAlgError:
+        w, V = np.linalg.eigh(M)
+        if w.min() < -1e-10 * max(1.0, abs(w).max()):
+            raise ModelError(f"{name} must be positive semidefinite (smallest eigenvalue {w.min():.3g})") from None
+        return V * np.sqrt(np.clip(w, 0.0, None))
+
+
+@dataclass(frozen=True)
+class ConvexModelSet:
+    """``N`` local discrete models ``(A, B, C, D)^(i)`` with common noise ``Q``, ``R`` (Hallouzi 2008, (2.8)–(2.10)).
+
+    Attributes
+    ----------
+    A : (N, n, n), B : (N, n, m), C : (N, p, n), D : (N, p, m) local matrices.
+    Q : (n, n) process-noise covariance, R : (p, p) measurement-noise covariance.
+    names : model names.
+    varying : which of (A, B, C, D) differ between models.  A matrix common to all models is treated as
+        a constant, not as ``Σ μ^(i) M = (1ᵀμ) M``: both agree on the simplex, but only the former has a zero
+        derivative in μ, so that the augmented EKF is the linear KF on ``[x; μ]`` when only B varies, as
+        §2.4.2 states.
+    """
+
+    A: np.ndarray
+    B: np.ndarray
+    C: np.ndarray
+    D: np.ndarray
+    Q: np.ndarray
+    R: np.ndarray
+    names: tuple[str, ...]
+    varying: tuple[bool, bool, bool, bool] = (True, True, True, True)
+
+    @property
+    def N(self) -> int:
+        return self.A.shape[0]
+
+    @property
+    def n(self) -> int:
+        return self.A.shape[1]
+
+    @property
+    def m(self) -> int:
+        return self.B.shape[2]
+
+    @property
+    def p(self) -> int:
+        return self.C.shape[1]
+
+    def check_weights(self, mu) -> np.ndarray:
+        mu = np.asarray(mu, dtype=float).ravel()
+        if mu.size != self.N or not np.all(np.isfinite(mu)):
+            raise DataError(f"weights must be {self.N} finite numbers (one per model), got {mu.size}")
+        return mu
+
+    def blend(self, mu) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(A_μ, B_μ, C_μ, D_μ) = Σ μ^(i) (A, B, C, D)^(i)`` (Hallouzi 2008, (2.19)–(2.20))."""
+        mu = self.check_weights(mu)
+        mats = (self.A, self.B, self.C, self.D)
+        return tuple(np.tensordot(mu, M, axes=1) if v else M[0].copy() for M, v in zip(mats, self.varying))
+
+    def weight_columns(self, x, u) -> tuple[np.ndarray, np.ndarray]:
+        """``∂(A_μ x + B_μ u)/∂μ`` (n, N) and ``∂(C_μ x + D_μ u)/∂μ`` (p, N); constant matrices add nothing."""
+        va, vb, vc, vd = self.varying
+        fx = (self.A @ x if va else 0.0) + (self.B @ u if vb else 0.0)
+        hx = (self.C @ x if vc else 0.0) + (self.D @ u if vd else 0.0)
+        return (np.broadcast_to(fx, (self.N, self.n)).T.copy(), np.broadcast_to(hx, (self.N, self.p)).T.copy())
+
+
+def convex_model_set(A, B, C, D=None, Q=None, R=None, names=None) -> ConvexModelSet:
+    """Build a :class:`ConvexModelSet` (Hallouzi 2008, §2.2.2).
+
+    Each of ``A, B, C, D`` is either one matrix shared by all models or a sequence/stack of ``N``
+    matrices; ``N`` is taken from the stacked ones.  ``D`` defaults to zero.
+
+    Example
+    -------
+    >>> ms = convex_model_set(np.eye(1), [[[0.0]], [[2.0]]], np.eye(1), Q=np.eye(1), R=np.eye(1))
+    >>> ms.N, ms.blend([0.25, 0.75])[1]
+    (2, array([[1.5]]))
+    """
+    mats = {"A": A, "B": B, "C": C}
+    arrs = {k: np.asarray(v, dtype=float) for k, v in mats.items()}
+    Ns = {a.shape[0] for a in arrs.values() if a.ndim == 3}
+    if len(Ns) > 1:
+        raise ModelError(f"stacked A, B, C disagree on the number of models {sorted(Ns)}; give N of each")
+    if not Ns:
+        raise ModelError("no model varies: pass at least one of A, B, C as a stack of N >= 2 matrices")
+    N = Ns.pop()
+    stacked = {k: (a if a.ndim == 3 else np.broadcast_to(a, (N, *a.shape)).copy()) for k, a in arrs.items()}
+    for k, a in stacked.items():
+        if a.ndim != 3 or not np.all(np.isfinite(a)):
+            raise ModelError(f"{k} must be finite 2-D matrices (or a stack of them), got shape {a.shape}")
+    A_, B_, C_ = stacked["A"], stacked["B"], stacked["C"]
+    n, m, p = A_.shape[1], B_.shape[2], C_.shape[1]
+    if A_.shape[1:] != (n, n) or B_.shape[1] != n or C_.shape[2] != n:
+        raise ModelError(f"shapes do not fit: A {A_.shape[1:]}, B {B_.shape[1:]}, C {C_.shape[1:]}; "
+                         "need n x n, n x m, p x n")
+    D_ = np.zeros((N, p, m)) if D is None else np.asarray(D, dtype=float)
+    if D_.ndim == 2:
+        D_ = np.broadcast_to(D_, (N, *D_.shape)).copy()
+    if D_.shape != (N, p, m):
+        raise ModelError(f"D must be {p} x {m} (or a stack of {N}), got {D_.shape}")
+    if Q is None or R is None:
+        raise ModelError("give the noise covariances Q (n x n) and R (p x p) of the convex model (2.8)-(2.9)")
+    Q_, R_ = np.asarray(Q, dtype=float), np.asarray(R, dtype=float)
+    if Q_.shape != (n, n) or R_.shape != (p, p):
+        raise ModelError(f"Q must be {n} x {n} and R {p} x {p}, got {Q_.shape} and {R_.shape}")
+    psd_factor(Q_, "Q")
+    if not (np.all(np.isfinite(R_)) and np.allclose(R_, R_.T) and np.linalg.eigvalsh(R_).min() > 0):
+        raise ModelError("R must be symmetric positive definite (the filters invert it)")
+    names = tuple(names) if names is not None else tuple(f"model_{i + 1}" for i in range(N))
+    if len(names) != N:
+        raise ModelError(f"{len(names)} names for {N} models")
+    varying = tuple(bool(np.ptp(M, axis=0).max() > 0) if M.size else False for M in (A_, B_, C_, D_))
+    return ConvexModelSet(A_, B_, C_, D_, Q_, R_, names, varying)
+
+
+@dataclass(frozen=True)
+class SrcfStep:
+    """One square-root covariance filter iteration (Hallouzi 2008, (2.29)–(2.31)).
+
+    ``x_filt = x̂_{k|k}``, ``S_filt S_filtᵀ = P_{k|k}``, ``S_next S_nextᵀ = P_{k+1|k}``; ``Re Reᵀ = C P Cᵀ + R``,
+    ``G1 = P Cᵀ Re^{-T}``, ``G2 = A P Cᵀ Re^{-T}``; ``error = C x̂_{k|k−1} + D u − y`` (the thesis' sign).
+    ``x_pred_free = A x̂_{k|k−1} − G2 Re^{-1} error`` is (2.32) without the ``B u`` term.
+    """
+
+    x_filt: np.ndarray
+    S_filt: np.ndarray
+    S_next: np.ndarray
+    Re: np.ndarray
+    G1: np.ndarray
+    G2: np.ndarray
+    error: np.ndarray
+    x_pred_free: np.ndarray
+
+
+def srcf_step(A, C, D, Q_sqrt, R_sqrt, S_pred, x_pred, u, y) -> SrcfStep:
+    """Square-root Kalman state step of the dual CMF (Hallouzi 2008, Table 2.2, (2.29)–(2.32)).
+
+    The pre-array ``[[C S, −R^{1/2}, 0], [S, 0, 0], [A S, 0, Q^{1/2}]]`` is lower-triangularised by an
+    orthogonal ``U_1`` (QR of its transpose), then ``[V_1 V_2] U_2 = [S_{k+1|k} 0]`` (2.31).  For fixed
+    matrices this equals the conventional Kalman filter (checklist item 2).
+
+    Example
+    -------
+    >>> s = srcf_step(np.eye(1), np.eye(1), np.zeros((1, 1)), np.eye(1), np.eye(1), np.eye(1), [0.0], [0.0], [2.0])
+    >>> round(float(s.x_filt[0]), 12), round(float(s.S_filt[0, 0] ** 2), 12)
+    (1.0, 0.5)
+    """
+    A, C, D = (np.asarray(M, dtype=float) for M in (A, C, D))
+    S = np.asarray(S_pred, dtype=float)
+    n, p = A.shape[0], C.shape[0]
+    x_pred = np.asarray(x_pred, dtype=float).ravel()
+    u = np.atleast_1d(np.asarray(u, dtype=float)).ravel()
+    y = np.asarray(y, dtype=float).ravel()
+    pre = np.zeros((p + 2 * n, p + 2 * n))
+    pre[:p, :n] = C @ S
+    pre[:p, n:n + p] = -np.asarray(R_sqrt, dtype=float)
+    pre[p:p + n, :n] = S
+    pre[p + n:, :n] = A @ S
+    pre[p + n:, n + p:] = np.asarray(Q_sqrt, dtype=float)
+    post = np.linalg.qr(pre.T, mode="r").T  # pre U_1 = post (lower triangular)
+    Re = post[:p, :p]
+    G1 = post[p:p + n, :p]
+    G2 = post[p + n:, :p]
+    S_filt = post[p:p + n, p:p + n]
+    V = post[p + n:, p:]
+    S_next = np.linalg.qr(V.T, mode="r").T[:, :n]  # (2.31)
+    error = C @ x_pred + D @ u - y
+    innov = np.linalg.solve(Re, error)
+    return SrcfStep(
+        x_filt=x_pred - G1 @ innov,  # (2.30)
+        S_filt=S_filt,
+        S_next=S_next,
+        Re=Re,
+        G1=G1,
+        G2=G2,
+        error=error,
+        x_pred_free=A @ x_pred - G2 @ innov,  # (2.32) without B u
+    )
+
+
+def weight_regressors(models: ConvexModelSet, x_prev, u_prev, x_filt, u, y, weighting: str = "whitened"):
+    """Regressor ``Φ`` and target ``Γ`` of the weight step (Hallouzi 2008, (2.33)–(2.34)).
+
+    Rows ``[W_Q [A^(i) x̂_{k−1|k−1} + B^(i) u_{k−1}]_i ; W_R [C^(i) x̂_{k|k} + D^(i) u_k]_i]`` and
+    ``[W_Q x̂_{k|k} ; W_R y_k]``.  ``weighting="whitened"`` (default) uses ``W = Q^{-1/2}, R^{-1/2}``, for
+    which ``‖Φμ − Γ‖²`` is the cost (2.27); ``"inverse"`` uses ``Q^{-1}, R^{-1}`` as printed in (2.33)
+    (research note §2.5: the printed form likely lost the "/2").
+    """
+    if weighting not in ("whitened", "inverse"):
+        raise ModelError(f"weighting must be 'whitened' (Q^-1/2, R^-1/2) or 'inverse' (Q^-1, R^-1), got {weighting!r}")
+    x_prev, x_filt = np.ravel(x_prev).astype(float), np.ravel(x_filt).astype(float)
+    u_prev, u = np.atleast_1d(np.asarray(u_prev, float)).ravel(), np.atleast_1d(np.asarray(u, float)).ravel()
+    y = np.ravel(y).astype(float)
+    if weighting == "whitened":
+        WQ = np.linalg.inv(psd_factor(models.Q, "Q"))
+        WR = np.linalg.inv(np.linalg.cholesky(models.R))
+    else:
+        WQ, WR = np.linalg.inv(models.Q), np.linalg.inv(models.R)
+    state_cols = (models.A @ x_prev + models.B @ u_prev).T  # n x N
+    out_cols = (models.C @ x_filt + models.D @ u).T  # p x N
+    Phi = np.vstack([WQ @ state_cols, WR @ out_cols])
+    Gamma = np.concatenate([WQ @ x_filt, WR @ y])
+    return Phi, Gamma
+
+
+def rls_weight_step(T_prev, xi_prev, Phi, Gamma, lam: float):
+    """Square-root-information RLS step with forgetting (Hallouzi 2008, (2.35)–(2.36)).
+
+    ``[[T_k, ξ_k], [0, ε_k]] = U_3 [[√λ T_{k−1}, √λ ξ_{k−1}], [Φ, Γ]]`` (QR), ``μ̂_k = T_k^{-1} ξ_k``.
+    After k steps ``μ̂_k`` minimises ``λ^k‖T_0μ − ξ_0‖² + Σ_j λ^{k−j} ‖Φ_j μ − Γ_j‖²`` (checklist item 3).
+
+    Returns ``(T_k, ξ_k, μ̂_k)``.
+
+    Example
+    -------
+    >>> T, xi, mu = rls_weight_step(np.zeros((1, 1)), [0.0], [[2.0]], [1.0], 0.9)
+    >>> float(mu[0])
+    0.5
+    """
+    if not 0.0 < lam <= 1.0:
+        raise ModelError(f"forgetting factor lambda must be in (0, 1], got {lam}")
+    T_prev = np.asarray(T_prev, dtype=float)
+    N = T_prev.shape[0]
+    Phi = np.atleast_2d(np.asarray(Phi, dtype=float))
+    top = np.hstack([np.sqrt(lam) * T_prev, np.sqrt(lam) * np.reshape(xi_prev, (N, 1))])
+    bottom = np.hstack([Phi, np.reshape(Gamma, (-1, 1))])
+    Rm = np.linalg.qr(np.vstack([top, bottom]), mode="r")
+    T, xi = Rm[:N, :N], Rm[:N, N]
+    mu = np.linalg.lstsq(T, xi, rcond=None)[0] if abs(np.diag(T)).min() < 1e-300 else np.linalg.solve(T, xi)
+    return T, xi, mu
+
+
+def project_to_simplex(mu, ordering: str = "michelot") -> np.ndarray:
+    """Project weights on ``{μ ≥ 0, 1ᵀμ = 1}`` (Hallouzi 2008, (2.37)–(2.38), W = I).
+
+    Equality projection ``μ^c = μ̂ − 1(1ᵀμ̂ − 1)/N`` then an active-set loop fixing negative weights at 0.
+    ``ordering="michelot"`` (default) checks the signs *after* each equality projection (Michelot 1986): the
+    result is the Euclidean projection on the simplex.  ``"thesis"`` first zeroes the negatives of the
+    unconstrained μ̂, as §2.3.2 words it; it can differ when ``1ᵀμ̂ < 1`` (research note §2.5).
+
+    Example
+    -------
+    >>> project_to_simplex([0.9, 0.5, -0.2]).round(3).tolist()
+    [0.7, 0.3, 0.0]
+    """
+    if ordering not in ("michelot", "thesis"):
+        raise ModelError(f"ordering must be 'michelot' or 'thesis', got {ordering!r}")
+    y = np.asarray(mu, dtype=float).ravel()
+    if y.size == 0 or not np.all(np.isfinite(y)):
+        raise DataError("weights to project must be a non-empty finite vector")
+    free = np.ones(y.size, dtype=bool)
+    if ordering == "thesis":
+        free &= y >= 0
+        if not free.any():
+            free[:] = True
+    while True:
+        out = np.zeros_like(y)
+        out[free] = y[free] - (y[free].sum() - 1.0) / free.sum()
+        neg = free & (out < 0)
+        if not neg.any():
+            return out
+        free &= ~neg
+
+
+@dataclass(frozen=True)
+class ConvexFilterResult:
+    """Output of a convex-model filter run.
+
+    Attributes
+    ----------
+    x : (K, n) filtered states x̂_{k|k}.  P : (K, n, n) their covariances.
+    mu : (K, N) weights used (constrained if the filter projects).  mu_raw : (K, N) before projection.
+    names : model names.
+    """
+
+    x: np.ndarray
+    P: np.ndarray
+    mu: np.ndarray
+    mu_raw: np.ndarray
+    names: tuple[str, ...]
+
+
+def _check_data(models: ConvexModelSet, y, u):
+    y = np.asarray(y, dtype=float)
+    if y.ndim != 2 or y.shape[1] != models.p:
+        raise DataError(f"y must be (K, {models.p}) measurements, got shape {y.shape}")
+    K = y.shape[0]
+    if u is None:
+        u = np.zeros((K, models.m))
+    u = np.asarray(u, dtype=float).reshape(K, -1)
+    if u.shape[1] != models.m:
+        raise DataError(f"u must be (K, {models.m}) inputs, got shape {u.shape}")
+    if not (np.all(np.isfinite(y)) and np.all(np.isfinite(u))):
+        raise DataError("y and u must be finite; drop or interpolate NaN samples first")
+    return y, u
+
+
+def dual_convex_filter(models: ConvexModelSet, y, u, x0, P0, mu0=None, lam: float = 0.9, *,
+                       weighting: str = "whitened", ordering: str = "michelot", constrain: bool = True,
+                       write_back: bool = False, b_after_weights: bool = True,
+                       T0_scale: float = 1e-3) -> ConvexFilterResult:
+    """Run the dual convex-model filter (Hallouzi 2008, §2.3.2, Table 2.2).
+
+    Per sample k: (2.29)–(2.31) with the model at μ̂_{k−1}; then (2.33)–(2.36) and the simplex
+    projection (2.37)–(2.38) give μ̂_k; then (2.32).  ``b_after_weights=True`` evaluates the ``B u_k`` term of
+    (2.32) with ``B_{μ̂_k}`` (as §2.4.2 does when only B switches); ``False`` uses ``B_{μ̂_{k−1}}``.
+
+    Parameters
+    ----------
+    models : the local models.  y : (K, p), u : (K, m) data.  x0, P0 : prior x̂_{0|−1}, P_{0|−1}.
+    mu0 : initial weights (default uniform 1/N).  lam : forgetting factor λ ∈ (0, 1] (thesis: 0.9).
+    weighting : ``"whitened"`` (Q^{-1/2}, default) or ``"inverse"`` (Q^{-1}, as printed in (2.33)).
+    ordering : simplex projection ordering, see :func:`project_to_simplex`.
+    constrain : project the weights on the simplex.  write_back : store ``ξ = T μ^c`` (not stated in the
+    thesis; default no).  T0_scale : ``T_0 = δ I`` and ``ξ_0 = T_0 μ_0`` (initialisation is a thesis gap).
+
+    Notes
+    -----
+    The weight step sees the model mismatch only through the Kalman correction ``x̂_{k|k} − A x̂_{k−1|k−1}``.
+    With a small ``Q`` (low Kalman gain) the weight/state loop is weakly damped: on the §2.4.2 tracking
+    benchmark this implementation oscillates slowly (period ≈ 150 samples) instead of matching the EKF.
+    """
+    y, u = _check_data(models, y, u)
+    N, n = models.N, models.n
+    mu = np.full(N, 1.0 / N) if mu0 is None else models.check_weights(mu0)
+    x_pred = np.asarray(x0, dtype=float).ravel()
+    if x_pred.size != n:
+        raise DataError(f"x0 must have {n} entries, got {x_pred.size}")
+    S_pred = psd_factor(P0, "P0")
+    Q_sqrt, R_sqrt = psd_factor(models.Q, "Q"), np.linalg.cholesky(models.R)
+    T, xi = T0_scale * np.eye(N), T0_scale * mu.copy()
+    K = y.shape[0]
+    xs, Ps, mus, raws = np.zeros((K, n)), np.zeros((K, n, n)), np.zeros((K, N)), np.zeros((K, N))
+    x_prev = None
+    for k in range(K):
+        A, B, C, D = models.blend(mu)
+        step = srcf_step(A, C, D, Q_sqrt, R_sqrt, S_pred, x_pred, u[k], y[k])
+        raw = mu
+        if x_prev is not None:
+            Phi, Gamma = weight_regressors(models, x_prev, u[k - 1], step.x_filt, u[k], y[k], weighting)
+            T, xi, raw = rls_weight_step(T, xi, Phi, Gamma, lam)
+            new = project_to_simplex(raw, ordering) if constrain else raw
+            if write_back:
+                xi = T @ new
+            mu = new
+        B_used = models.blend(mu)[1] if b_after_weights else B
+        x_pred = step.x_pred_free + B_used @ u[k]
+        S_pred = step.S_next
+        xs[k], Ps[k], mus[k], raws[k] = step.x_filt, step.S_filt @ step.S_filt.T, mu, raw
+        x_prev = step.x_filt
+    return ConvexFilterResult(xs, Ps, mus, raws, models.names)
+
+
+# ----------------------------------------------------------------------------- reconstruction (3.51)–(3.57)
+def fault_size_from_weights(mu, faulty_models) -> np.ndarray:
+    """Fault size ``f = 1 − Σ_{i ∈ faulty} μ^(i)`` (Hallouzi 2008, §3.6.2, Fig. 3.9).
+
+    With models at ``f = 0`` and ``f = 1`` only, the weight mass on the ``f = 0`` models is the lost
+    effectiveness: e.g. Table 3.2, ``f_1 = 1 − (μ̂^(2) + μ̂^(4))`` (0-based indices ``[1, 3]``).  ``mu`` is
+    (N,) or (K, N); returns a float or (K,).
+
+    Example
+    -------
+    >>> float(fault_size_from_weights([0.1, 0.2, 0.3, 0.1, 0.2, 0.1], [1, 3]))
+    0.7
+    """
+    mu = np.asarray(mu, dtype=float)
+    idx = np.asarray(faulty_models, dtype=int).ravel()
+    if idx.size == 0 or idx.min() < 0 or idx.max() >= mu.shape[-1]:
+        raise ModelError(f"faulty_models must be indices in 0..{mu.shape[-1] - 1}, got {idx.tolist()}")
+    return 1.0 - mu[..., idx].sum(axis=-1)
+
+
+def lv_parameter(mu, value_at_0: float, value_at_1: float):
+    """Parameter of a limit-value weight, ``θ = θ⁺ + μ (θ⁻ − θ⁺)`` (Hallouzi 2008, (3.54), (3.56)–(3.57)).
+
+    ``value_at_0 = θ⁺`` (e.g. ``k_1^max``; 1 for an effectiveness f), ``value_at_1 = θ⁻`` (``k_1^min``; 0).
+
+    Example
+    -------
+    >>> float(lv_parameter(0.5, 1.75, 0.25)), float(lv_parameter(0.3, 1.0, 0.0))
+    (1.0, 0.7)
+    """
+    return value_at_0 + np.asarray(mu, dtype=float) * (value_at_1 - value_at_0)
+
+
+def lv_reciprocal_parameter(mu, value_at_0: float, value_at_1: float):
+    """Parameter entering as ``1/θ`` (a mass), ``θ = θ⁺θ⁻ / (θ⁻ + μ (θ⁺ − θ⁻))`` (Hallouzi 2008, (3.55)).
+
+    ``1/θ`` is affine in μ, from ``1/θ⁺`` at μ = 0 to ``1/θ⁻`` at μ = 1 (``θ⁺ = m_3^max``, ``θ⁻ = m_3^min``).
+
+    Example
+    -------
+    >>> round(float(lv_reciprocal_parameter(0.1, 1.8, 0.2)), 12)
+    1.0
+    """
+    if value_at_0 <= 0 or value_at_1 <= 0:
+        raise ModelError("a reciprocal LV parameter (mass) needs positive limit values")
+    mu = np.asarray(mu, dtype=float)
+    return value_at_0 * value_at_1 / (value_at_1 + mu * (value_at_0 - value_at_1))
+
+
+def estimated_model_vector(vertices, mu) -> np.ndarray:
+    """Estimated model vector ``M̂_k = [v^(1) … v^(N)] μ̂_k`` (Hallouzi 2008, (3.51)).
+
+    ``vertices`` is (n_q, N): the vectorised local models ``vec([A B; C D])`` (for the CP set, ``U¹ v^(i)``).
+    """
+    V = np.asarray(vertices, dtype=float)
+    mu = np.asarray(mu, dtype=float)
+    if V.ndim != 2 or mu.shape[-1] != V.shape[1]:
+        raise ModelError(f"vertices (n_q, N) and weights (..., N) disagree: {V.shape} vs {mu.shape}")
+    return mu @ V.T
+
+
+def nearest_model(estimate, large_set) -> np.ndarray:
+    """Index of the large-set model closest to the estimate, ``n_s = argmin ‖𝔐^(i) − M̂_k‖₂`` (Hallouzi 2008, (3.52)).
+
+    ``large_set`` is (n_q, N_ℓ); ``estimate`` is (n_q,) or (K, n_q); returns an int array of shape () or (K,).
+    The reported parameters are those of model ``n_s``, hence quantised to the grid of the large set.
+    """
+    M = np.asarray(large_set, dtype=float)
+    E = np.atleast_2d(np.asarray(estimate, dtype=float))
+    if M.ndim != 2 or E.shape[1] != M.shape[0]:
+        raise ModelError(f"estimate (K, n_q) and large_set (n_q, N_l) disagree: {E.shape} vs {M.shape}")
+    d2 = ((E[:, :, None] - M[None, :, :]) ** 2).sum(axis=1)
+    idx = d2.argmin(axis=1)
+    return idx if np.ndim(estimate) == 2 else idx[0]

@@ -1,0 +1,109 @@
+"""Augmented EKF for the convex-model structure (Hallouzi 2008, §2.3.3, Table 2.3).
+
+The weights follow a random walk ``μ_k = μ_{k−1} + w_μ`` with covariance ``Q^μ`` (2.39) and are
+estimated jointly with the state on ``z = [x; μ]`` (2.40)–(2.41):
+
+    x_{k+1} = A_μ x_k + B_μ u_k + w_k,     μ_{k+1} = μ_k + w_μ,     y_k = C_μ x_k + D_μ u_k + v_k.
+
+The Jacobians (2.52)–(2.53) are ``Ā = [[A_μ, [A^(i)x + B^(i)u]_i], [0, I]]`` and
+``C̄ = [C_μ, [C^(i)x + D^(i)u]_i]``, where a matrix shared by all models is a constant (zero derivative;
+see :class:`~fdikit.multimodel.convex.ConvexModelSet`).  When only B (and D) vary the model is linear
+in z, and the EKF is exactly a linear Kalman filter on ``[x; μ]`` (§2.4.2; checklist item 4).  The weight
+part is projected on the simplex after each update "in the same manner as the dual CMF"; P is left
+unchanged (a thesis gap).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fdikit.errors import DataError, ModelError
+from fdikit.multimodel.convex import (
+    ConvexFilterResult,
+    ConvexModelSet,
+    _check_data,
+    project_to_simplex,
+)
+
+__all__ = ["augmented_jacobians", "augmented_ekf"]
+
+
+def augmented_jacobians(models: ConvexModelSet, x, mu, u) -> tuple[np.ndarray, np.ndarray]:
+    """Jacobians ``(Ā, C̄)`` of the augmented CM model at ``(x, μ, u)`` (Hallouzi 2008, (2.52)–(2.53)).
+
+    Example
+    -------
+    >>> from fdikit.multimodel.convex import convex_model_set
+    >>> ms = convex_model_set([[[0.5]], [[1.0]]], np.zeros((1, 1)), np.eye(1), Q=np.eye(1), R=np.eye(1))
+    >>> Abar, Cbar = augmented_jacobians(ms, [2.0], [0.5, 0.5], [0.0])
+    >>> Abar.tolist(), Cbar.tolist()
+    ([[0.75, 1.0, 2.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], [[1.0, 0.0, 0.0]])
+    """
+    x = np.ravel(x).astype(float)
+    mu = models.check_weights(mu)
+    u = np.atleast_1d(np.asarray(u, dtype=float)).ravel()
+    A, _, C, _ = models.blend(mu)
+    N, n = models.N, models.n
+    Abar = np.zeros((n + N, n + N))
+    Abar[:n, :n] = A
+    Fmu, Hmu = models.weight_columns(x, u)
+    Abar[:n, n:] = Fmu
+    Abar[n:, n:] = np.eye(N)
+    Cbar = np.hstack([C, Hmu])
+    return Abar, Cbar
+
+
+def augmented_ekf(models: ConvexModelSet, y, u, x0, P0, mu0=None, Q_mu=None, P_mu0=None, *,
+                  constrain: bool = True, ordering: str = "michelot") -> ConvexFilterResult:
+    """Run the augmented EKF on ``[x; μ]`` (Hallouzi 2008, §2.3.3, Table 2.3, (2.46)–(2.53)).
+
+    Per sample k ≥ 1 the time update (2.46)–(2.48) with ``u_{k−1}``, then for every k the measurement
+    update (2.49)–(2.51) (Joseph form, symmetrised) and, if ``constrain``, the simplex projection of μ̂.
+    ``x0, P0`` are the prior ``x̂_{0|−1}, P_{0|−1}``.
+
+    Parameters
+    ----------
+    Q_mu : (N, N) random-walk covariance Q^μ, the main tuning knob (thesis §2.4.2: 1e-2 I).
+    mu0 : initial weights (default uniform).  P_mu0 : their covariance (default ``I/12``, the variance of a
+    uniform weight on [0, 1]; the thesis gives none).
+    """
+    y, u = _check_data(models, y, u)
+    N, n = models.N, models.n
+    mu = np.full(N, 1.0 / N) if mu0 is None else models.check_weights(mu0)
+    x = np.asarray(x0, dtype=float).ravel()
+    if x.size != n:
+        raise DataError(f"x0 must have {n} entries, got {x.size}")
+    if Q_mu is None:
+        raise ModelError("give Q_mu, the (N x N) random-walk covariance of the weights (2.39), e.g. 1e-2 * I")
+    Q_mu = np.asarray(Q_mu, dtype=float)
+    P_mu0 = np.eye(N) / 12.0 if P_mu0 is None else np.asarray(P_mu0, dtype=float)
+    P0 = np.asarray(P0, dtype=float)
+    if Q_mu.shape != (N, N) or P_mu0.shape != (N, N) or P0.shape != (n, n):
+        raise ModelError(f"need Q_mu and P_mu0 of {N} x {N} and P0 of {n} x {n}; "
+                         f"got {Q_mu.shape}, {P_mu0.shape}, {P0.shape}")
+    Qa = np.zeros((n + N, n + N))
+    Qa[:n, :n], Qa[n:, n:] = models.Q, Q_mu
+    P = np.zeros((n + N, n + N))
+    P[:n, :n], P[n:, n:] = P0, P_mu0
+    I = np.eye(n + N)
+    K = y.shape[0]
+    xs, Ps, mus, raws = np.zeros((K, n)), np.zeros((K, n, n)), np.zeros((K, N)), np.zeros((K, N))
+    for k in range(K):
+        if k > 0:
+            Abar, _ = augmented_jacobians(models, x, mu, u[k - 1])
+            A, B, _, _ = models.blend(mu)
+            x = A @ x + B @ u[k - 1]  # (2.46); μ̂_{k|k−1} = μ̂_{k−1|k−1} (2.47)
+            P = Abar @ P @ Abar.T + Qa  # (2.48)
+        _, Cbar = augmented_jacobians(models, x, mu, u[k])
+        _, _, C, D = models.blend(mu)
+        e = y[k] - C @ x - D @ u[k]
+        S = Cbar @ P @ Cbar.T + models.R
+        G = np.linalg.solve(S, Cbar @ P).T  # (2.49)
+        z = np.concatenate([x, mu]) + G @ e  # (2.50)
+        ImKC = I - G @ Cbar
+        P = ImKC @ P @ ImKC.T + G @ models.R @ G.T  # (2.51), Joseph form
+        P = 0.5 * (P + P.T)
+        x, raw = z[:n], z[n:]
+        mu = project_to_simplex(raw, ordering) if constrain else raw
+        xs[k], Ps[k], mus[k], raws[k] = x, P[:n, :n], mu, raw
+    return ConvexFilterResult(xs, Ps, mus, raws, models.names)

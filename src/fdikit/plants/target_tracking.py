@@ -1,0 +1,98 @@
+"""The maneuvering-target tracking benchmark of Hallouzi 2008, §2.4.2, (2.65)–(2.68).
+
+A constant-velocity target in the plane, ``x = [p_x, v_x, p_y, v_y]`` (m, m/s), sampled at
+``T_s = 1`` s and measured fully (``C = I_4``).  Only the input matrix switches, with a scalar input
+``u ≡ 1`` (an acceleration of 1 m/s² along (−1, 1)/√2 or (1, −1)/√2)::
+
+    A = [[1, T_s, 0, 0], [0, 1, 0, 0], [0, 0, 1, T_s], [0, 0, 0, 1]],   C = I_4          (2.65)
+    B^(1) = 0 (straight),  B^(2) = √2 [−0.25, −0.5, 0.25, 0.5]ᵀ (left),  B^(3) = −B^(2) (right)   (2.66)
+    Q = 1e-3 I_4,  R = diag(2.5e4, 1, 2.5e4, 1)                                          (2.67)
+    Π = 0.98 on the diagonal, 0.01 elsewhere                                             (2.68)
+
+The convex-model filters use only the two turn models (straight flight is ``0.5 B^(2) + 0.5 B^(3)``);
+the IMM uses all three.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fdikit.errors import ModelError
+from fdikit.multimodel.convex import ConvexModelSet, convex_model_set
+
+__all__ = [
+    "TS",
+    "Q_TRACKING",
+    "R_TRACKING",
+    "PI_TRACKING",
+    "X0_TRACKING",
+    "tracking_A",
+    "tracking_B",
+    "tracking_convex_set",
+    "tracking_imm_modes",
+]
+
+#: Sample time T_s [s] (§2.4.2).
+TS = 1.0
+#: Process-noise covariance (2.67).
+Q_TRACKING = 1e-3 * np.eye(4)
+#: Measurement-noise covariance (2.67); about 20 dB SNR on all four measurements.
+R_TRACKING = np.diag([2.5e4, 1.0, 2.5e4, 1.0])
+#: IMM transition matrix (2.68).
+PI_TRACKING = np.full((3, 3), 0.01) + 0.97 * np.eye(3)
+#: Initial target state [p_x, v_x, p_y, v_y] (§2.4.2).
+X0_TRACKING = np.array([-500.0, 0.0, -500.0, 5.0])
+
+_NAMES = ("straight", "left_turn", "right_turn")
+
+
+def tracking_A(dt: float = TS) -> np.ndarray:
+    """The constant-velocity transition matrix (Hallouzi 2008, (2.65)).
+
+    Example
+    -------
+    >>> tracking_A(0.5)[0].tolist()
+    [1.0, 0.5, 0.0, 0.0]
+    """
+    if not dt > 0:
+        raise ModelError(f"sample time dt must be positive, got {dt}")
+    A = np.eye(4)
+    A[0, 1] = A[2, 3] = dt
+    return A
+
+
+def tracking_B(model: str) -> np.ndarray:
+    """Input matrix (4, 1) of ``"straight"``, ``"left_turn"`` or ``"right_turn"`` (Hallouzi 2008, (2.66)).
+
+    Example
+    -------
+    >>> (tracking_B("left_turn").ravel() / np.sqrt(2)).tolist()
+    [-0.25, -0.5, 0.25, 0.5]
+    """
+    left = np.sqrt(2.0) * np.array([[-0.25], [-0.5], [0.25], [0.5]])
+    table = {"straight": 0.0 * left, "left_turn": left, "right_turn": -left}
+    if model not in table:
+        raise ModelError(f"unknown tracking model {model!r}; choose one of {_NAMES}")
+    return table[model]
+
+
+def tracking_convex_set(dt: float = TS) -> ConvexModelSet:
+    """The two-model convex set {left turn, right turn} of §2.4.2 (``Q``, ``R`` of (2.67)).
+
+    Example
+    -------
+    >>> ms = tracking_convex_set()
+    >>> ms.names, bool(np.allclose(ms.blend([0.5, 0.5])[1], 0))
+    (('left_turn', 'right_turn'), True)
+    """
+    B = np.stack([tracking_B("left_turn"), tracking_B("right_turn")])
+    return convex_model_set(tracking_A(dt), B, np.eye(4), Q=Q_TRACKING, R=R_TRACKING,
+                            names=("left_turn", "right_turn"))
+
+
+def tracking_imm_modes(dt: float = TS) -> list:
+    """The three IMM modes (straight, left, right) of §2.4.2 as :class:`~fdikit.multimodel.imm.LinearMode`."""
+    from fdikit.multimodel.imm import LinearMode
+
+    A = tracking_A(dt)
+    return [LinearMode(A=A, C=np.eye(4), Q=Q_TRACKING, R=R_TRACKING, B=tracking_B(nm), name=nm) for nm in _NAMES]
