@@ -80,3 +80,13 @@ def test_compare_evaluators_command(tmp_path):
     assert len(rows) == 1 + 16 * len(names)  # header + (15 faulty + 1 healthy runs) x evaluators
     # the calibrated threshold bank isolates every fault with no false alarm (as in tests/monitors)
     assert "| threshold (5 of 10) | 16 | 1 | 0 |" in md
+
+
+def test_target_tracking_command(tmp_path):
+    out = tmp_path / "tt"
+    res = runner.invoke(app, ["target-tracking", "--runs", "2", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    summary = (out / "summary.md").read_text()
+    assert summary.count("\n") == 2 + 3  # header, rule, one row per filter
+    assert "imm" in summary and "ekf" in summary
+    assert (out / "rmse.png").stat().st_size > 1000

@@ -143,6 +143,37 @@ def compare_evaluators(
     console.print(f"wrote {out / 'comparison.md'} and {out / 'scores.csv'} in {time.perf_counter() - start:.0f} s")
 
 
+@app.command("target-tracking")
+def target_tracking(
+    runs: int = typer.Option(100, help="Monte-Carlo runs (Hallouzi 2008 §2.4.2 uses 100)."),
+    seed: int = typer.Option(0, help="Seed of the first run."),
+    out: Path = typer.Option(Path("out/target_tracking"), help="Folder for summary.md and rmse.png."),
+) -> None:
+    """Convex-model filters vs the IMM on the maneuvering-target benchmark (Hallouzi 2008, §2.4.2)."""
+    from fdikit.scenarios.target_tracking import plot_target_tracking, target_tracking_monte_carlo
+
+    start = time.perf_counter()
+    try:
+        result = target_tracking_monte_carlo(runs=runs, seed=seed)
+    except FdiError as exc:
+        _fail(exc)
+    out.mkdir(parents=True, exist_ok=True)
+    intervals = list(next(iter(result.summary.values())))
+    table = Table(title=f"mean RMSE per interval over {runs} runs: position [m] / velocity [m/s] / B")
+    table.add_column("filter", no_wrap=True)
+    for iv in intervals:
+        table.add_column(str(iv), justify="right")
+    lines = ["| filter | " + " | ".join(map(str, intervals)) + " |", "|---" * (len(intervals) + 1) + "|"]
+    for name, per in result.summary.items():
+        cells = [f"{v['position']:.1f} / {v['velocity']:.2f} / {v['B']:.2f}" for v in per.values()]
+        table.add_row(name, *cells)
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    console.print(table)
+    (out / "summary.md").write_text("\n".join(lines) + "\n")
+    plot_target_tracking(result, out / "rmse.png")
+    console.print(f"wrote {out / 'summary.md'} and {out / 'rmse.png'} in {time.perf_counter() - start:.0f} s")
+
+
 def main() -> None:  # pragma: no cover
     app()
 
