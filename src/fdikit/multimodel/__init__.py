@@ -5,9 +5,13 @@ convex-model filters and model-set design.
   forms) and EKF, returning innovations, their covariances and log-likelihoods;
 * :mod:`fdikit.multimodel.imm` — the IMM filter for jump-Markov linear systems (Table 2.1, corrected);
 * :mod:`fdikit.multimodel.isolation` — the Table 4.7 isolation logic on mode probabilities;
-* :mod:`fdikit.multimodel.model_set` — model-set design (Ch. 3, App. B).
+* :mod:`fdikit.multimodel.model_set` — model-set design (Ch. 3, App. B);
+* :mod:`fdikit.multimodel.convex`, :mod:`fdikit.multimodel.convex_ekf` — convex-model filters (dual filter and
+  augmented EKF) and fault-size reconstruction from the weights.
 """
 
+from fdikit.multimodel.convex import ConvexFilterResult, convex_model_set, dual_convex_filter
+from fdikit.multimodel.convex_ekf import augmented_ekf
 from fdikit.multimodel.ekf import ExtendedKalmanFilter, NonlinearGaussianModel, extended_kalman_filter
 from fdikit.multimodel.imm import IMMFilter, IMMResult, LinearMode
 from fdikit.multimodel.isolation import GroupThresholdLogic, table_4_7_logic
@@ -15,6 +19,7 @@ from fdikit.multimodel.kalman import KalmanFilter, KalmanResult, LinearGaussianM
 from fdikit.multimodel.model_set import cp_model_set, limit_value_model_set, od_model_set
 
 __all__ = [
+    "ConvexFilterResult",
     "ExtendedKalmanFilter",
     "GroupThresholdLogic",
     "IMMFilter",
@@ -24,7 +29,10 @@ __all__ = [
     "LinearGaussianModel",
     "LinearMode",
     "NonlinearGaussianModel",
+    "augmented_ekf",
+    "convex_model_set",
     "cp_model_set",
+    "dual_convex_filter",
     "extended_kalman_filter",
     "kalman_filter",
     "limit_value_model_set",

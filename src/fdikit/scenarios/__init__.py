@@ -3,9 +3,12 @@
 * :mod:`fdikit.scenarios.vanderploeg` — the single-track steering-fault cases S1–S8 of van der Ploeg
   2018, Ch. 4 (:func:`vanderploeg_case`, :func:`lateral_run`, :func:`cornering_run`);
 * :mod:`fdikit.scenarios.varrier` — the lateral-acceleration sensor fault of Varrier et al. 2014, §5
-  (:func:`varrier_trace`, the ϖ score :func:`min_max_ratio`).
+  (:func:`varrier_trace`, the ϖ score :func:`min_max_ratio`);
+* :mod:`fdikit.scenarios.target_tracking` — the maneuvering-target benchmark of Hallouzi 2008, §2.4.2
+  (:func:`target_tracking_trace`, :func:`target_tracking_monte_carlo`).
 """
 
+from fdikit.scenarios.target_tracking import target_tracking_monte_carlo, target_tracking_trace
 from fdikit.scenarios.vanderploeg import cornering_run, lateral_run, true_steering_faults, vanderploeg_case
 from fdikit.scenarios.varrier import min_max_ratio, varrier_comparison, varrier_trace
 
@@ -13,6 +16,8 @@ __all__ = [
     "cornering_run",
     "lateral_run",
     "min_max_ratio",
+    "target_tracking_monte_carlo",
+    "target_tracking_trace",
     "true_steering_faults",
     "vanderploeg_case",
     "varrier_comparison",
