@@ -20,7 +20,7 @@ import time
 
 import numpy as np
 
-from fdikit.multimodel.imm import IMMFilter, LinearMode
+from fdikit.multimodel.imm import IMMFilter
 from fdikit.multimodel.kalman import LinearGaussianModel, kalman_filter
 from timing import best
 
@@ -29,7 +29,7 @@ def _modes(rng, M=3, n=4, p=2):
     A0 = rng.normal(size=(n, n))
     A0 *= 0.9 / max(abs(np.linalg.eigvals(A0)))
     B, C = rng.normal(size=(n, 1)), rng.normal(size=(p, n))
-    return [LinearMode(A=A0, B=B * (1 - 0.4 * i), C=C, Q=0.01 * np.eye(n), R=0.1 * np.eye(p), name=f"m{i}")
+    return [LinearGaussianModel(A=A0, B=B * (1 - 0.4 * i), C=C, Q=0.01 * np.eye(n), R=0.1 * np.eye(p), name=f"m{i}")
             for i in range(M)]
 
 

@@ -9,7 +9,8 @@ import pytest
 from filterpy.kalman import IMMEstimator, KalmanFilter
 
 from fdikit.errors import DataError, ModelError
-from fdikit.multimodel.imm import IMMFilter, LinearMode
+from fdikit.multimodel.imm import IMMFilter
+from fdikit.multimodel.kalman import LinearGaussianModel
 from fdikit.trace import Trace
 
 
@@ -52,7 +53,7 @@ def _kf(A, B, C, D, Q, R, u, y, x0, P0):
 def test_one_mode_equals_kalman_filter():
     s = _system()
     u, y = _simulate(**s, N=200)
-    imm = IMMFilter([LinearMode(**s)], [[1.0]], x0=np.ones(3), P0=2 * np.eye(3))
+    imm = IMMFilter([LinearGaussianModel(**s)], [[1.0]], x0=np.ones(3), P0=2 * np.eye(3))
     res = imm.run(u, y)
     xk, Pk = _kf(**s, u=u, y=y, x0=np.ones(3), P0=2 * np.eye(3))
     assert np.max(abs(res.x - xk)) < 1e-10
@@ -65,7 +66,7 @@ def test_identical_modes_equal_kf_and_mu_follows_prior_through_pi():
     u, y = _simulate(**s, N=100)
     Pi = np.array([[0.7, 0.2, 0.1], [0.05, 0.9, 0.05], [0.3, 0.3, 0.4]])
     mu0 = np.array([0.6, 0.3, 0.1])
-    modes = [LinearMode(**s, name=f"m{i}") for i in range(3)]
+    modes = [LinearGaussianModel(**s, name=f"m{i}") for i in range(3)]
     res = IMMFilter(modes, Pi, mu0=mu0, x0=np.zeros(3), P0=np.eye(3)).run(u, y)
     xk, Pk = _kf(**s, u=u, y=y, x0=np.zeros(3), P0=np.eye(3))
     assert np.max(abs(res.x - xk)) < 1e-10
@@ -82,8 +83,8 @@ def _filterpy_pair(seed=5, N=300):
     for i in range(3):
         A = base["A"] + 0.05 * i * np.eye(4)
         C = base["C"] * (1.0 - 0.3 * i)
-        modes.append(LinearMode(A=A, B=base["B"] * (1 + i), C=C, D=np.zeros((2, 1)), Q=(0.02 + 0.03 * i) * np.eye(4),
-                                R=(0.1 + 0.05 * i) * np.eye(2), name=f"m{i}"))
+        modes.append(LinearGaussianModel(A=A, B=base["B"] * (1 + i), C=C, D=np.zeros((2, 1)),
+                                         Q=(0.02 + 0.03 * i) * np.eye(4), R=(0.1 + 0.05 * i) * np.eye(2), name=f"m{i}"))
     Pi = np.array([[0.95, 0.03, 0.02], [0.05, 0.9, 0.05], [0.1, 0.1, 0.8]])
     mu_init = np.array([0.5, 0.3, 0.2])
     x_init, P_init = rng.normal(size=4), 0.5 * np.eye(4)
@@ -125,8 +126,8 @@ def test_switching_system_mode_probability_follows_true_mode():
     A = np.array([[0.95, 0.1], [0.0, 0.9]])
     B = np.array([[0.0], [1.0]])
     Q, R = 0.01 * np.eye(2), 0.01 * np.eye(1)
-    nominal = LinearMode(A=A, B=B, C=[[1.0, 0.0]], Q=Q, R=R, name="nominal")
-    fault = LinearMode(A=A, B=0.2 * B, C=[[1.0, 0.0]], Q=Q, R=R, name="actuator loss")   # 80 % effectiveness loss
+    nominal = LinearGaussianModel(A=A, B=B, C=[[1.0, 0.0]], Q=Q, R=R, name="nominal")
+    fault = LinearGaussianModel(A=A, B=0.2 * B, C=[[1.0, 0.0]], Q=Q, R=R, name="actuator loss")  # 80 % loss
     Pi = np.array([[0.99, 0.01], [0.01, 0.99]])
     N = 2000
     s = np.zeros(N, int)
@@ -151,8 +152,8 @@ def test_switching_system_mode_probability_follows_true_mode():
 
 def test_log_space_survives_outliers_and_long_runs():
     # static modes (A = 0): y ~ N(D u, Q + R), so the states cannot adapt to the data
-    far = LinearMode(A=[[0.0]], C=[[1.0]], B=[[0.0]], D=[[1.0]], Q=[[1e-6]], R=[[1e-4]], name="far")
-    near = LinearMode(A=[[0.0]], C=[[1.0]], B=[[0.0]], D=[[0.0]], Q=[[1e-6]], R=[[1e-4]], name="near")
+    far = LinearGaussianModel(A=[[0.0]], C=[[1.0]], B=[[0.0]], D=[[1.0]], Q=[[1e-6]], R=[[1e-4]], name="far")
+    near = LinearGaussianModel(A=[[0.0]], C=[[1.0]], B=[[0.0]], D=[[0.0]], Q=[[1e-6]], R=[[1e-4]], name="near")
     N = 20000
     y = 1e-2 * np.random.default_rng(0).normal(size=(N, 1))
     y[5000] = 1e3                                       # every likelihood underflows: log L ≈ −5e9
@@ -171,7 +172,7 @@ def test_nan_measurement_is_prediction_only_and_online_equals_batch():
     u, y = _simulate(**s, N=60)
     y[[10, 11, 30]] = np.nan
     y[40, 0] = np.nan
-    imm = IMMFilter([LinearMode(**s)], [[1.0]], x0=np.zeros(3), P0=np.eye(3))
+    imm = IMMFilter([LinearGaussianModel(**s)], [[1.0]], x0=np.zeros(3), P0=np.eye(3))
     res = imm.run(u, y)
     xk, Pk = _kf(**s, u=u, y=y, x0=np.zeros(3), P0=np.eye(3))
     assert np.max(abs(res.x - xk)) < 1e-10 and np.max(abs(res.P - Pk)) < 1e-10
@@ -185,12 +186,12 @@ def test_nan_measurement_is_prediction_only_and_online_equals_batch():
 
 def test_bad_input_raises_clear_errors():
     s = _system()
-    md = LinearMode(**s)
+    md = LinearGaussianModel(**s)
     with pytest.raises(ModelError, match="rows summing to 1"):
         IMMFilter([md, md], [[0.9, 0.2], [0.1, 0.9]])
     with pytest.raises(ModelError, match="share the state"):
-        IMMFilter([md, LinearMode(A=np.eye(2), C=np.eye(2), Q=np.eye(2), R=np.eye(2))], np.eye(2))
-    with pytest.raises(ModelError, match="R must be symmetric positive definite"):
-        LinearMode(A=np.eye(2), C=np.eye(2), Q=np.eye(2), R=np.zeros((2, 2)))
+        IMMFilter([md, LinearGaussianModel(A=np.eye(2), C=np.eye(2), Q=np.eye(2), R=np.eye(2))], np.eye(2))
+    with pytest.raises(ModelError, match="R must be positive definite"):
+        LinearGaussianModel(A=np.eye(2), C=np.eye(2), Q=np.eye(2), R=np.zeros((2, 2)))
     with pytest.raises(DataError, match="NaN"):
         IMMFilter([md], [[1.0]]).run(np.full((5, 1), np.nan), np.zeros((5, 2)))

@@ -30,69 +30,12 @@ import numpy as np
 
 from fdikit.errors import DataError, ModelError
 from fdikit.multimodel.isolation import GroupThresholdLogic, mode_diagnosis
+from fdikit.multimodel.kalman import LinearGaussianModel
 from fdikit.trace import Trace
 
-__all__ = ["LinearMode", "IMMFilter", "IMMStepper", "IMMStep", "IMMResult"]
+__all__ = ["IMMFilter", "IMMStepper", "IMMStep", "IMMResult"]
 
 _LOG2PI = float(np.log(2.0 * np.pi))
-
-
-@dataclass(frozen=True, eq=False)
-class LinearMode:
-    """One mode of a jump-Markov linear system (Hallouzi 2008, (2.3)–(2.4)), discrete time.
-
-    ``x⁺ = A x + B u + w``, ``y = C x + D u + v`` with ``w ~ N(0, Q)``, ``v ~ N(0, R)``.
-    ``B`` and ``D`` default to zero-column matrices (no input).
-    """
-
-    A: np.ndarray
-    C: np.ndarray
-    Q: np.ndarray
-    R: np.ndarray
-    B: np.ndarray | None = None
-    D: np.ndarray | None = None
-    name: str = ""
-
-    def __post_init__(self) -> None:
-        A = _mat("A", self.A)
-        C = _mat("C", self.C)
-        n, p = A.shape[0], C.shape[0]
-        if A.shape != (n, n):
-            raise ModelError(f"mode {self.name!r}: A has shape {A.shape}; it must be square (n × n)")
-        if C.shape[1] != n:
-            raise ModelError(f"mode {self.name!r}: C has shape {C.shape}; it needs n = {n} columns like A")
-        B = np.zeros((n, 0)) if self.B is None else _mat("B", self.B)
-        m = B.shape[1]
-        D = np.zeros((p, m)) if self.D is None else _mat("D", self.D)
-        Q, R = _mat("Q", self.Q), _mat("R", self.R)
-        for nm, M, shape in (("B", B, (n, m)), ("D", D, (p, m)), ("Q", Q, (n, n)), ("R", R, (p, p))):
-            if M.shape != shape:
-                raise ModelError(f"mode {self.name!r}: {nm} has shape {M.shape}, expected {shape}")
-        if not np.allclose(Q, Q.T) or np.linalg.eigvalsh(Q).min() < -1e-12 * max(1.0, np.abs(Q).max()):
-            raise ModelError(f"mode {self.name!r}: Q must be symmetric positive semidefinite")
-        if not np.allclose(R, R.T) or np.linalg.eigvalsh(R).min() <= 0:
-            raise ModelError(f"mode {self.name!r}: R must be symmetric positive definite (measurement noise)")
-        for nm, M in (("A", A), ("B", B), ("C", C), ("D", D), ("Q", Q), ("R", R)):
-            object.__setattr__(self, nm, M)
-
-    @property
-    def n(self) -> int:
-        return self.A.shape[0]
-
-    @property
-    def m(self) -> int:
-        return self.B.shape[1]
-
-    @property
-    def p(self) -> int:
-        return self.C.shape[0]
-
-
-def _mat(name: str, M) -> np.ndarray:
-    M = np.atleast_2d(np.asarray(M, dtype=float))
-    if M.ndim != 2 or not np.all(np.isfinite(M)):
-        raise ModelError(f"matrix {name} must be a finite 2-D array")
-    return M
 
 
 @dataclass(frozen=True)
@@ -157,15 +100,15 @@ class IMMFilter:
     Example
     -------
     >>> import numpy as np
-    >>> m0 = LinearMode(A=[[1.0]], C=[[1.0]], Q=[[0.01]], R=[[0.1]], name="nominal")
-    >>> m1 = LinearMode(A=[[1.0]], C=[[2.0]], Q=[[0.01]], R=[[0.1]], name="gain fault")
+    >>> m0 = LinearGaussianModel(A=[[1.0]], C=[[1.0]], Q=[[0.01]], R=[[0.1]], name="nominal")
+    >>> m1 = LinearGaussianModel(A=[[1.0]], C=[[2.0]], Q=[[0.01]], R=[[0.1]], name="gain fault")
     >>> imm = IMMFilter([m0, m1], [[0.99, 0.01], [0.01, 0.99]], x0=[1.0], P0=[[0.01]])
     >>> res = imm.run(np.zeros((50, 0)), 2.0 * np.ones((50, 1)))
     >>> bool(res.mu[-1, 1] > 0.99), str(res.diagnosis().isolated[-1])
     (True, 'gain fault')
     """
 
-    modes: Sequence[LinearMode]
+    modes: Sequence[LinearGaussianModel]
     transition: np.ndarray
     mu0: np.ndarray | None = None
     x0: np.ndarray | None = None
@@ -175,8 +118,8 @@ class IMMFilter:
 
     def __post_init__(self) -> None:
         modes = tuple(self.modes)
-        if not modes or not all(isinstance(md, LinearMode) for md in modes):
-            raise ModelError("IMMFilter needs a non-empty sequence of LinearMode")
+        if not modes or not all(isinstance(md, LinearGaussianModel) for md in modes):
+            raise ModelError("IMMFilter needs a non-empty sequence of LinearGaussianModel")
         M = len(modes)
         n, m, p = modes[0].n, modes[0].m, modes[0].p
         for md in modes:

@@ -349,6 +349,7 @@ class LinearGaussianModel:
     ``Q = cov(w)`` (n x n) and ``R = cov(v)`` (p x p) are the state-space covariances
     (the thesis's ``(Q)^{1/2} w̄`` with unit-variance ``w̄``).  Build from a discrete
     :class:`~fdikit.model.FaultModel` with :meth:`from_fault_model` (uses ``A, Bu, C, Du``).
+    ``name`` labels the model as one mode of a bank (the IMM's hypotheses).
     """
 
     A: np.ndarray
@@ -357,8 +358,9 @@ class LinearGaussianModel:
     D: np.ndarray
     Q: np.ndarray
     R: np.ndarray
+    name: str = ""
 
-    def __init__(self, A, C, Q, R, B=None, D=None) -> None:
+    def __init__(self, A, C, Q, R, B=None, D=None, name: str = "") -> None:
         A = _as_matrix("A", A)
         n = A.shape[0]
         if A.shape != (n, n):
@@ -371,10 +373,11 @@ class LinearGaussianModel:
         R = _check_psd("R", _as_matrix("R", R, p, p))
         if p and np.linalg.eigvalsh(R)[0] <= 1e-14 * max(1.0, float(np.max(np.abs(R)))):
             raise ModelError("R must be positive definite (the innovation covariance must be invertible)")
-        for name, val in zip("ABCDQR", (A, B, C, D, Q, R), strict=True):
+        object.__setattr__(self, "name", str(name))
+        for key, val in zip("ABCDQR", (A, B, C, D, Q, R), strict=True):
             val = np.array(val)
             val.setflags(write=False)
-            object.__setattr__(self, name, val)
+            object.__setattr__(self, key, val)
 
     @classmethod
     def from_fault_model(cls, model: FaultModel, Q, R) -> LinearGaussianModel:

@@ -91,8 +91,9 @@ def tracking_convex_set(dt: float = TS) -> ConvexModelSet:
 
 
 def tracking_imm_modes(dt: float = TS) -> list:
-    """The three IMM modes (straight, left, right) of §2.4.2 as :class:`~fdikit.multimodel.imm.LinearMode`."""
-    from fdikit.multimodel.imm import LinearMode
+    """The three IMM modes (straight, left, right) of §2.4.2 as :class:`~fdikit.multimodel.imm.LinearGaussianModel`."""
+    from fdikit.multimodel.kalman import LinearGaussianModel
 
     A = tracking_A(dt)
-    return [LinearMode(A=A, C=np.eye(4), Q=Q_TRACKING, R=R_TRACKING, B=tracking_B(nm), name=nm) for nm in _NAMES]
+    return [LinearGaussianModel(A=A, C=np.eye(4), Q=Q_TRACKING, R=R_TRACKING, B=tracking_B(nm), name=nm)
+            for nm in _NAMES]
