@@ -17,13 +17,13 @@ from fdikit.multimodel.convex import (
     fault_size_from_weights,
     lv_parameter,
     lv_reciprocal_parameter,
-    nearest_model,
     project_to_simplex,
     rls_weight_step,
-    srcf_step,
     weight_regressors,
 )
 from fdikit.multimodel.convex_ekf import augmented_ekf, augmented_jacobians
+from fdikit.multimodel.kalman_steps import srcf_step
+from fdikit.multimodel.model_set import nearest_model
 
 
 def _random_set(rng, N=3, n=3, m=2, p=2):
@@ -52,19 +52,20 @@ def test_srcf_step_equals_conventional_kalman_filter():
     A, B, C, D = ms.blend(mu)
     P = np.cov(rng.standard_normal((3, 20))) + 0.1 * np.eye(3)
     x, u, y = rng.standard_normal(3), rng.standard_normal(2), rng.standard_normal(2)
-    s = srcf_step(A, C, D, np.linalg.cholesky(ms.Q), np.linalg.cholesky(ms.R), np.linalg.cholesky(P), x, u, y)
+    x_filt, S_filt, x_free, S_next, e, Re, _ = srcf_step(x, np.linalg.cholesky(P), y, A, C, D=D, u=u,
+                                                         Q_sqrt=np.linalg.cholesky(ms.Q),
+                                                         R_sqrt=np.linalg.cholesky(ms.R))
     kf = KalmanFilter(dim_x=3, dim_z=2, dim_u=2)
     kf.x, kf.P, kf.F, kf.H, kf.Q, kf.R, kf.B = x.copy(), P.copy(), A, C, ms.Q, ms.R, B
     kf.update(y - D @ u)
     Sig = C @ P @ C.T + ms.R
-    assert np.allclose(s.Re @ s.Re.T, Sig, atol=1e-12)
-    assert np.allclose(s.G1, P @ C.T @ np.linalg.inv(s.Re).T, atol=1e-12)
-    assert np.allclose(s.G2, A @ P @ C.T @ np.linalg.inv(s.Re).T, atol=1e-12)
-    assert np.allclose(s.x_filt, kf.x, atol=1e-12)
-    assert np.allclose(s.S_filt @ s.S_filt.T, kf.P, atol=1e-12)
+    assert np.allclose(Re @ Re.T, Sig, atol=1e-12)
+    assert np.allclose(e, y - C @ x - D @ u, atol=1e-12)
+    assert np.allclose(x_filt, kf.x, atol=1e-12)
+    assert np.allclose(S_filt @ S_filt.T, kf.P, atol=1e-12)
     kf.predict(u=u)
-    assert np.allclose(s.x_pred_free + B @ u, kf.x, atol=1e-12)
-    assert np.allclose(s.S_next @ s.S_next.T, kf.P, atol=1e-12)
+    assert np.allclose(x_free + B @ u, kf.x, atol=1e-12)  # the dual filter adds B u after the weight step
+    assert np.allclose(S_next @ S_next.T, kf.P, atol=1e-12)
 
 
 def test_dual_filter_with_frozen_weights_is_a_kalman_filter():
@@ -225,7 +226,7 @@ def test_fault_size_and_nearest_model_reconstruction():
     grid = np.linspace(0, 1, 21)
     large = a[:, None] + b[:, None] * grid
     est = estimated_model_vector(np.column_stack([a, a + b]), np.array([[0.7, 0.3], [0.26, 0.74]]))
-    assert np.allclose(grid[nearest_model(est, large)], [0.3, 0.75])
+    assert np.allclose(grid[nearest_model(large, est)], [0.3, 0.75])
     with pytest.raises(ModelError, match="indices"):
         fault_size_from_weights(mu, [6])
 

@@ -24,17 +24,8 @@ from fdikit.multimodel.ekf import (
     extended_kalman_filter,
     numerical_jacobian,
 )
-from fdikit.multimodel.kalman import (
-    KalmanFilter,
-    LinearGaussianModel,
-    kalman_filter,
-    kf_predict,
-    kf_update,
-    psd_sqrt,
-    srcf_step,
-    srkf_predict,
-    srkf_update,
-)
+from fdikit.multimodel.kalman import KalmanFilter, LinearGaussianModel, kalman_filter
+from fdikit.multimodel.kalman_steps import kf_predict, kf_update, psd_sqrt, srcf_step, srkf_predict, srkf_update
 
 
 def random_model(seed: int, n: int = 4, m: int = 2, p: int = 2) -> LinearGaussianModel:

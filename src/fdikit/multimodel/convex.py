@@ -13,7 +13,8 @@ with noise common to all models.  The dual CMF (Table 2.2) alternates
 
 The augmented EKF (Table 2.3) is in :mod:`fdikit.multimodel.convex_ekf`.  Fault sizes and
 parameters are reconstructed from weights by (3.51)–(3.57) (:func:`fault_size_from_weights`,
-:func:`lv_parameter`, :func:`lv_reciprocal_parameter`, :func:`nearest_model`).
+:func:`lv_parameter`, :func:`lv_reciprocal_parameter`; the nearest grid model (3.52) is
+:func:`fdikit.multimodel.model_set.nearest_model`).
 """
 
 from __future__ import annotations
@@ -23,12 +24,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from fdikit.errors import DataError, ModelError
+from fdikit.multimodel.kalman_steps import psd_sqrt, srcf_step
 
 __all__ = [
     "ConvexModelSet",
     "convex_model_set",
-    "SrcfStep",
-    "srcf_step",
     "weight_regressors",
     "rls_weight_step",
     "project_to_simplex",
@@ -38,24 +38,7 @@ __all__ = [
     "lv_parameter",
     "lv_reciprocal_parameter",
     "estimated_model_vector",
-    "nearest_model",
 ]
-
-
-def psd_factor(M: np.ndarray, name: str) -> np.ndarray:
-    """A lower-triangular-ish factor ``F`` with ``F Fᵀ = M`` (Cholesky, eigen-factor if singular)."""
-    M = np.asarray(M, dtype=float)
-    if M.ndim != 2 or M.shape[0] != M.shape[1] or not np.all(np.isfinite(M)):
-        raise ModelError(f"{name} must be a finite square matrix, got shape {M.shape}")
-    if not np.allclose(M, M.T, atol=1e-12 * max(1.0, np.abs(M).max())):
-        raise ModelError(f"{name} must be symmetric; pass (M + M.T) / 2")
-    try:
-        return np.linalg.cholesky(M)
-    except np.linalg.LinAlgError:
-        w, V = np.linalg.eigh(M)
-        if w.min() < -1e-10 * max(1.0, abs(w).max()):
-            raise ModelError(f"{name} must be positive semidefinite (smallest eigenvalue {w.min():.3g})") from None
-        return V * np.sqrt(np.clip(w, 0.0, None))
 
 
 @dataclass(frozen=True)
@@ -157,7 +140,7 @@ def convex_model_set(A, B, C, D=None, Q=None, R=None, names=None) -> ConvexModel
     Q_, R_ = np.asarray(Q, dtype=float), np.asarray(R, dtype=float)
     if Q_.shape != (n, n) or R_.shape != (p, p):
         raise ModelError(f"Q must be {n} x {n} and R {p} x {p}, got {Q_.shape} and {R_.shape}")
-    psd_factor(Q_, "Q")
+    psd_sqrt(Q_, "Q")
     if not (np.all(np.isfinite(R_)) and np.allclose(R_, R_.T) and np.linalg.eigvalsh(R_).min() > 0):
         raise ModelError("R must be symmetric positive definite (the filters invert it)")
     names = tuple(names) if names is not None else tuple(f"model_{i + 1}" for i in range(N))
@@ -165,71 +148,6 @@ def convex_model_set(A, B, C, D=None, Q=None, R=None, names=None) -> ConvexModel
         raise ModelError(f"{len(names)} names for {N} models")
     varying = tuple(bool(np.ptp(M, axis=0).max() > 0) if M.size else False for M in (A_, B_, C_, D_))
     return ConvexModelSet(A_, B_, C_, D_, Q_, R_, names, varying)
-
-
-@dataclass(frozen=True)
-class SrcfStep:
-    """One square-root covariance filter iteration (Hallouzi 2008, (2.29)–(2.31)).
-
-    ``x_filt = x̂_{k|k}``, ``S_filt S_filtᵀ = P_{k|k}``, ``S_next S_nextᵀ = P_{k+1|k}``; ``Re Reᵀ = C P Cᵀ + R``,
-    ``G1 = P Cᵀ Re^{-T}``, ``G2 = A P Cᵀ Re^{-T}``; ``error = C x̂_{k|k−1} + D u − y`` (the thesis' sign).
-    ``x_pred_free = A x̂_{k|k−1} − G2 Re^{-1} error`` is (2.32) without the ``B u`` term.
-    """
-
-    x_filt: np.ndarray
-    S_filt: np.ndarray
-    S_next: np.ndarray
-    Re: np.ndarray
-    G1: np.ndarray
-    G2: np.ndarray
-    error: np.ndarray
-    x_pred_free: np.ndarray
-
-
-def srcf_step(A, C, D, Q_sqrt, R_sqrt, S_pred, x_pred, u, y) -> SrcfStep:
-    """Square-root Kalman state step of the dual CMF (Hallouzi 2008, Table 2.2, (2.29)–(2.32)).
-
-    The pre-array ``[[C S, −R^{1/2}, 0], [S, 0, 0], [A S, 0, Q^{1/2}]]`` is lower-triangularised by an
-    orthogonal ``U_1`` (QR of its transpose), then ``[V_1 V_2] U_2 = [S_{k+1|k} 0]`` (2.31).  For fixed
-    matrices this equals the conventional Kalman filter (checklist item 2).
-
-    Example
-    -------
-    >>> s = srcf_step(np.eye(1), np.eye(1), np.zeros((1, 1)), np.eye(1), np.eye(1), np.eye(1), [0.0], [0.0], [2.0])
-    >>> round(float(s.x_filt[0]), 12), round(float(s.S_filt[0, 0] ** 2), 12)
-    (1.0, 0.5)
-    """
-    A, C, D = (np.asarray(M, dtype=float) for M in (A, C, D))
-    S = np.asarray(S_pred, dtype=float)
-    n, p = A.shape[0], C.shape[0]
-    x_pred = np.asarray(x_pred, dtype=float).ravel()
-    u = np.atleast_1d(np.asarray(u, dtype=float)).ravel()
-    y = np.asarray(y, dtype=float).ravel()
-    pre = np.zeros((p + 2 * n, p + 2 * n))
-    pre[:p, :n] = C @ S
-    pre[:p, n:n + p] = -np.asarray(R_sqrt, dtype=float)
-    pre[p:p + n, :n] = S
-    pre[p + n:, :n] = A @ S
-    pre[p + n:, n + p:] = np.asarray(Q_sqrt, dtype=float)
-    post = np.linalg.qr(pre.T, mode="r").T  # pre U_1 = post (lower triangular)
-    Re = post[:p, :p]
-    G1 = post[p:p + n, :p]
-    G2 = post[p + n:, :p]
-    S_filt = post[p:p + n, p:p + n]
-    V = post[p + n:, p:]
-    S_next = np.linalg.qr(V.T, mode="r").T[:, :n]  # (2.31)
-    error = C @ x_pred + D @ u - y
-    innov = np.linalg.solve(Re, error)
-    return SrcfStep(
-        x_filt=x_pred - G1 @ innov,  # (2.30)
-        S_filt=S_filt,
-        S_next=S_next,
-        Re=Re,
-        G1=G1,
-        G2=G2,
-        error=error,
-        x_pred_free=A @ x_pred - G2 @ innov,  # (2.32) without B u
-    )
 
 
 def weight_regressors(models: ConvexModelSet, x_prev, u_prev, x_filt, u, y, weighting: str = "whitened"):
@@ -246,7 +164,7 @@ def weight_regressors(models: ConvexModelSet, x_prev, u_prev, x_filt, u, y, weig
     u_prev, u = np.atleast_1d(np.asarray(u_prev, float)).ravel(), np.atleast_1d(np.asarray(u, float)).ravel()
     y = np.ravel(y).astype(float)
     if weighting == "whitened":
-        WQ = np.linalg.inv(psd_factor(models.Q, "Q"))
+        WQ = np.linalg.inv(psd_sqrt(models.Q, "Q"))
         WR = np.linalg.inv(np.linalg.cholesky(models.R))
     else:
         WQ, WR = np.linalg.inv(models.Q), np.linalg.inv(models.R)
@@ -380,28 +298,29 @@ def dual_convex_filter(models: ConvexModelSet, y, u, x0, P0, mu0=None, lam: floa
     x_pred = np.asarray(x0, dtype=float).ravel()
     if x_pred.size != n:
         raise DataError(f"x0 must have {n} entries, got {x_pred.size}")
-    S_pred = psd_factor(P0, "P0")
-    Q_sqrt, R_sqrt = psd_factor(models.Q, "Q"), np.linalg.cholesky(models.R)
+    S_pred = psd_sqrt(P0, "P0")
+    Q_sqrt, R_sqrt = psd_sqrt(models.Q, "Q"), np.linalg.cholesky(models.R)
     T, xi = T0_scale * np.eye(N), T0_scale * mu.copy()
     K = y.shape[0]
     xs, Ps, mus, raws = np.zeros((K, n)), np.zeros((K, n, n)), np.zeros((K, N)), np.zeros((K, N))
     x_prev = None
     for k in range(K):
         A, B, C, D = models.blend(mu)
-        step = srcf_step(A, C, D, Q_sqrt, R_sqrt, S_pred, x_pred, u[k], y[k])
+        x_filt, S_filt, x_free, S_next, *_ = srcf_step(x_pred, S_pred, y[k], A, C, D=D, u=u[k], Q_sqrt=Q_sqrt,
+                                                       R_sqrt=R_sqrt)  # (2.29)–(2.32), B u added below
         raw = mu
         if x_prev is not None:
-            Phi, Gamma = weight_regressors(models, x_prev, u[k - 1], step.x_filt, u[k], y[k], weighting)
+            Phi, Gamma = weight_regressors(models, x_prev, u[k - 1], x_filt, u[k], y[k], weighting)
             T, xi, raw = rls_weight_step(T, xi, Phi, Gamma, lam)
             new = project_to_simplex(raw, ordering) if constrain else raw
             if write_back:
                 xi = T @ new
             mu = new
         B_used = models.blend(mu)[1] if b_after_weights else B
-        x_pred = step.x_pred_free + B_used @ u[k]
-        S_pred = step.S_next
-        xs[k], Ps[k], mus[k], raws[k] = step.x_filt, step.S_filt @ step.S_filt.T, mu, raw
-        x_prev = step.x_filt
+        x_pred = x_free + B_used @ u[k]
+        S_pred = S_next
+        xs[k], Ps[k], mus[k], raws[k] = x_filt, S_filt @ S_filt.T, mu, raw
+        x_prev = x_filt
     return ConvexFilterResult(xs, Ps, mus, raws, models.names)
 
 
@@ -464,18 +383,3 @@ def estimated_model_vector(vertices, mu) -> np.ndarray:
     if V.ndim != 2 or mu.shape[-1] != V.shape[1]:
         raise ModelError(f"vertices (n_q, N) and weights (..., N) disagree: {V.shape} vs {mu.shape}")
     return mu @ V.T
-
-
-def nearest_model(estimate, large_set) -> np.ndarray:
-    """Index of the large-set model closest to the estimate, ``n_s = argmin ‖𝔐^(i) − M̂_k‖₂`` (Hallouzi 2008, (3.52)).
-
-    ``large_set`` is (n_q, N_ℓ); ``estimate`` is (n_q,) or (K, n_q); returns an int array of shape () or (K,).
-    The reported parameters are those of model ``n_s``, hence quantised to the grid of the large set.
-    """
-    M = np.asarray(large_set, dtype=float)
-    E = np.atleast_2d(np.asarray(estimate, dtype=float))
-    if M.ndim != 2 or E.shape[1] != M.shape[0]:
-        raise ModelError(f"estimate (K, n_q) and large_set (n_q, N_l) disagree: {E.shape} vs {M.shape}")
-    d2 = ((E[:, :, None] - M[None, :, :]) ** 2).sum(axis=1)
-    idx = d2.argmin(axis=1)
-    return idx if np.ndim(estimate) == 2 else idx[0]

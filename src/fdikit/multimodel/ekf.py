@@ -34,16 +34,8 @@ import numpy as np
 import scipy.linalg
 
 from fdikit.errors import DataError, ModelError
-from fdikit.multimodel.kalman import (
-    KalmanResult,
-    KalmanStep,
-    _as_matrix,
-    _as_vector,
-    _check_psd,
-    _check_record,
-    _collect,
-    gaussian_log_likelihood,
-)
+from fdikit.multimodel.kalman import KalmanResult, KalmanStep, _check_record, _collect
+from fdikit.multimodel.kalman_steps import _as_matrix, _as_vector, _check_psd, gaussian_log_likelihood
 
 __all__ = [
     "NonlinearGaussianModel",

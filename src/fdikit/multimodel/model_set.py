@@ -440,16 +440,20 @@ def limit_value_model_set(matrices: Callable[..., Sequence], upper: Mapping[str,
 
 
 # ------------------------------------------------------------------------------------ reconstruction
-def nearest_model(models, estimate) -> int:
+def nearest_model(models, estimate):
     """Index ``n_s = argmin_i ‖𝔐^{(i)} − M̂‖₂`` of the large-set model nearest an estimate, (3.52).
 
-    ``estimate`` is a model vector, e.g. ``M̃_r μ̂`` (OD) or ``U¹ V μ̂`` (CP, (3.51)).
+    ``estimate`` is a model vector (n_q,), e.g. ``M̃_r μ̂`` (OD) or ``U¹ V μ̂`` (CP, (3.51)), or a sequence of
+    them (K, n_q); returns an int, or an int array (K,).  The reported parameters are those of model
+    ``n_s``, hence quantised to the grid of the large set.
     """
     M = _as_model_matrix(models)
-    x = np.asarray(estimate, float).ravel()
-    if x.size != M.shape[0]:
-        raise ModelError(f"the estimate has {x.size} entries, the model vectors {M.shape[0]}")
-    return int(np.argmin(np.linalg.norm(M - x[:, None], axis=0)))
+    E = np.atleast_2d(np.asarray(estimate, float))
+    if E.shape[1] != M.shape[0]:
+        raise ModelError(f"the estimate has {E.shape[1]} entries, the model vectors {M.shape[0]}")
+    d2 = ((E[:, :, None] - M[None, :, :]) ** 2).sum(axis=1)
+    idx = d2.argmin(axis=1)
+    return idx if np.ndim(estimate) == 2 else int(idx[0])
 
 
 def minimum_mismatch_points(distribution, n_models: int) -> np.ndarray:
