@@ -5,14 +5,19 @@
 * :mod:`fdikit.scenarios.varrier` — the lateral-acceleration sensor fault of Varrier et al. 2014, §5
   (:func:`varrier_trace`, the ϖ score :func:`min_max_ratio`);
 * :mod:`fdikit.scenarios.target_tracking` — the maneuvering-target benchmark of Hallouzi 2008, §2.4.2
-  (:func:`target_tracking_trace`, :func:`target_tracking_monte_carlo`).
+  (:func:`target_tracking_trace`, :func:`target_tracking_monte_carlo`);
+* :mod:`fdikit.scenarios.b747` — the B747 linear FDI benchmark of Hallouzi 2008, §2.4.1
+  (:func:`b747_trace`, :func:`b747_monte_carlo`).
 """
 
+from fdikit.scenarios.b747 import b747_monte_carlo, b747_trace
 from fdikit.scenarios.target_tracking import target_tracking_monte_carlo, target_tracking_trace
 from fdikit.scenarios.vanderploeg import cornering_run, lateral_run, true_steering_faults, vanderploeg_case
 from fdikit.scenarios.varrier import min_max_ratio, varrier_comparison, varrier_trace
 
 __all__ = [
+    "b747_monte_carlo",
+    "b747_trace",
     "cornering_run",
     "lateral_run",
     "min_max_ratio",
