@@ -6,9 +6,10 @@ import scipy.linalg
 import scipy.optimize
 
 from fdikit.errors import ModelError
+from fdikit.metrics import vaf
 from fdikit.multimodel.model_set import vectorize
 from fdikit.plants.msd import msd_matrices
-from fdikit.scenarios.msd import msd_od_model_set, run_msd_filter, simulate_msd, vaf
+from fdikit.scenarios.msd import msd_od_model_set, run_msd_filter, simulate_msd
 
 DT = 0.01
 

@@ -27,7 +27,7 @@ from fdikit.errors import DataError
 from fdikit.faults import NO_FAULT
 from fdikit.trace import Trace
 
-__all__ = ["Score", "Summary", "score", "summarize", "confusion_matrix", "MISSED"]
+__all__ = ["Score", "Summary", "score", "summarize", "confusion_matrix", "vaf", "MISSED"]
 
 #: Column of the confusion matrix for a faulty trace that was never detected.
 MISSED = "missed"
@@ -149,3 +149,31 @@ def summarize(scores: Iterable[Score]) -> Summary:
         isolation_accuracy=sum(bool(s.isolation_correct) for s in detected) / len(detected) if detected else nan,
         confusion=confusion_matrix(scores),
     )
+
+
+def vaf(reference, estimate):
+    """Variance accounted for, ``max(0, 1 − var(y − ŷ)/var(y)) · 100 %`` (Hallouzi 2008, (3.53); the fit
+    measure of van der Ploeg 2018, Sec. 4-3-4, after Verhaegen & Verdult).
+
+    ``reference`` and ``estimate`` have the same shape: (N,) gives a float, (N, k) one value per column.
+
+    Raises
+    ------
+    DataError
+        If the shapes differ, there are fewer than 2 samples, or a reference column is constant.
+
+    Examples
+    --------
+    >>> float(vaf([0.0, 1.0, 2.0, 3.0], [0.0, 1.0, 2.0, 4.0]))
+    85.0
+    """
+    y, yh = np.asarray(reference, dtype=float), np.asarray(estimate, dtype=float)
+    if y.shape != yh.shape or y.ndim == 0 or y.shape[0] < 2:
+        raise DataError(f"vaf needs two equally long signals of 2+ samples, got shapes {y.shape} and {yh.shape}")
+    y2, e2 = y.reshape(y.shape[0], -1), (y - yh).reshape(y.shape[0], -1)
+    var = y2.var(axis=0)
+    if np.any(var == 0):
+        raise DataError("vaf is undefined for a constant reference signal (zero variance)")
+    out = np.maximum(1.0 - e2.var(axis=0) / var, 0.0) * 100.0
+    return float(out[0]) if y.ndim == 1 else out
+

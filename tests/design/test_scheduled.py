@@ -12,10 +12,10 @@ from fdikit.design.scheduled import (
     lpv_parity_row,
     lpv_rank_test,
     scheduled_parity_filter,
-    vaf,
 )
 from fdikit.errors import DataError, DesignError, ModelError
 from fdikit.faults import Bias, FaultScenario, Noise, ScaleFactor
+from fdikit.metrics import vaf
 from fdikit.plants.single_track import single_track, single_track_lpv
 from fdikit.simulate import simulate, simulate_scheduled, time_grid
 from fdikit.trace import Trace

@@ -59,7 +59,6 @@ __all__ = [
     "lpv_parity_row",
     "lpv_rank_test",
     "scheduled_parity_filter",
-    "vaf",
 ]
 
 Family = Callable[[float], FaultModel]
@@ -100,14 +99,6 @@ def lpv_parity_row(H_bar: np.ndarray, F_column: np.ndarray, gamma: float | None 
         M = np.eye(H.shape[1]) + gamma * np.einsum("kij,klj->kil", H, H)
         out = 0.5 * np.linalg.solve(M, f[..., None])[..., 0]
     return out[0] if single else out
-
-
-def vaf(reference: np.ndarray, estimate: np.ndarray) -> float:
-    """Variance accounted for, ``max(0, 1 − var(y − ŷ)/var(y)) · 100 %`` (Verhaegen & Verdult, thesis ref. [37])."""
-    y, yh = np.asarray(reference, dtype=float).ravel(), np.asarray(estimate, dtype=float).ravel()
-    if y.shape != yh.shape or y.size < 2:
-        raise DataError(f"vaf needs two equally long signals of 2+ samples, got {y.size} and {yh.size}")
-    return float(max(0.0, 1.0 - np.var(y - yh) / np.var(y)) * 100.0)
 
 
 @dataclass(frozen=True, eq=False)

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fdikit.errors import ModelError
+from fdikit.metrics import vaf
 from fdikit.multimodel.convex import convex_model_set, dual_convex_filter, fault_size_from_weights
 from fdikit.multimodel.convex_ekf import augmented_ekf
 from fdikit.multimodel.model_set import od_model_set, unvectorize
@@ -37,7 +38,7 @@ from fdikit.plants.msd import MSD_SAMPLE_TIME, msd_matrices, msd_model_vectors, 
 
 __all__ = [
     "MSD_STATES",
-    "vaf",
+
     "msd_profile",
     "MSDSimulation",
     "simulate_msd",
@@ -48,28 +49,6 @@ __all__ = [
 ]
 
 MSD_STATES = ("x1", "x2", "x3", "v1", "v2", "v3")
-
-
-def vaf(x, x_hat) -> np.ndarray:
-    """Variance accounted for, per column, in percent (Hallouzi 2008, (3.53)).
-
-    ``vaf = max{1 − var(x − x̂)/var(x), 0} × 100 %``.
-
-    Examples
-    --------
-    >>> vaf([[0.0], [1.0], [2.0], [3.0]], [[0.0], [1.0], [2.0], [4.0]]).round(1).tolist()
-    [85.0]
-    """
-    x = np.asarray(x, float)
-    x_hat = np.asarray(x_hat, float)
-    if x.shape != x_hat.shape:
-        raise ModelError(f"VAF needs signals of the same shape, got {x.shape} and {x_hat.shape}")
-    x2 = x.reshape(x.shape[0], -1)
-    e2 = (x - x_hat).reshape(x.shape[0], -1)
-    var = x2.var(axis=0)
-    if np.any(var == 0):
-        raise ModelError("VAF is undefined for a constant reference signal; excite every state")
-    return np.maximum(1.0 - e2.var(axis=0) / var, 0.0) * 100.0
 
 
 def msd_profile(t, f1_size: float = 0.5, f2_size: float = 0.5) -> np.ndarray:
