@@ -7,10 +7,13 @@
 * :mod:`fdikit.scenarios.target_tracking` — the maneuvering-target benchmark of Hallouzi 2008, §2.4.2
   (:func:`target_tracking_trace`, :func:`target_tracking_monte_carlo`);
 * :mod:`fdikit.scenarios.b747` — the B747 linear FDI benchmark of Hallouzi 2008, §2.4.1
-  (:func:`b747_trace`, :func:`b747_monte_carlo`).
+  (:func:`b747_trace`, :func:`b747_monte_carlo`);
+* :mod:`fdikit.scenarios.msd` — the LPV mass–spring–damper run of Hallouzi 2008, §3.6.2
+  (:func:`simulate_msd`, :func:`run_msd_filter`).
 """
 
 from fdikit.scenarios.b747 import b747_monte_carlo, b747_trace
+from fdikit.scenarios.msd import run_msd_filter, simulate_msd
 from fdikit.scenarios.target_tracking import target_tracking_monte_carlo, target_tracking_trace
 from fdikit.scenarios.vanderploeg import cornering_run, lateral_run, true_steering_faults, vanderploeg_case
 from fdikit.scenarios.varrier import min_max_ratio, varrier_comparison, varrier_trace
@@ -21,6 +24,8 @@ __all__ = [
     "cornering_run",
     "lateral_run",
     "min_max_ratio",
+    "run_msd_filter",
+    "simulate_msd",
     "target_tracking_monte_carlo",
     "target_tracking_trace",
     "true_steering_faults",
