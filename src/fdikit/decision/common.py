@@ -1,12 +1,14 @@
-"""Pieces every evaluator shares: k-of-n persistence, holding decisions over bad samples, cached isolation."""
+"""Pieces every evaluator shares: k-of-n persistence, holding decisions over bad samples, cached isolation,
+residual names checked against the fit."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from fdikit.diagnosis import isolate
+from fdikit.errors import DataError
 
-__all__ = ["k_of_n", "held", "isolate_cached"]
+__all__ = ["k_of_n", "held", "isolate_cached", "checked_names"]
 
 
 def k_of_n(exceed: np.ndarray, k: int, n: int) -> np.ndarray:
@@ -39,3 +41,12 @@ def isolate_cached(cache: dict, fired: np.ndarray, isolates, groups=None) -> str
     if label is None:
         label = cache[key] = str(isolate(fired[None, :], isolates, groups)[0])
     return label
+
+
+def checked_names(q: int, residuals, fitted) -> tuple[str, ...]:
+    """Names of ``q`` residuals: those of ``residuals``, else the fitted ones, else ``r0 …``; raises
+    :class:`DataError` when their number is not ``q``."""
+    names = residuals.names if residuals is not None else (fitted or tuple(f"r{i}" for i in range(q)))
+    if len(names) != q:
+        raise DataError(f"got {q} residuals, the evaluator was fitted on {len(names)} ({list(names)})")
+    return names

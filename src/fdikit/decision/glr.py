@@ -40,7 +40,7 @@ import numpy as np
 import scipy.linalg
 from scipy.stats import chi2
 
-from fdikit.decision.common import held, isolate_cached
+from fdikit.decision.common import checked_names, held, isolate_cached
 from fdikit.diagnosis import Diagnosis, StepDecision, isolate
 from fdikit.errors import DataError, ModelError
 from fdikit.residuals import Residuals
@@ -319,9 +319,7 @@ class GlrEvaluator:
         return self
 
     def _ready(self, q: int, residuals: Residuals | None = None):
-        names = residuals.names if residuals is not None else (self.names or tuple(f"r{i}" for i in range(q)))
-        if len(names) != q:
-            raise DataError(f"got {q} residuals, the evaluator was fitted on {len(names)} ({list(names)})")
+        names = checked_names(q, residuals, self.names)
         if self.threshold is None:
             raise ModelError(
                 "the GLR has no threshold; pass threshold= (see glr_threshold) or call "

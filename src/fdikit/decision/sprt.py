@@ -42,7 +42,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from fdikit.decision.common import held, isolate_cached, k_of_n
+from fdikit.decision.common import checked_names, held, isolate_cached, k_of_n
 from fdikit.decision.glr import BlockLayout, as_covariance, fit_moments
 from fdikit.diagnosis import Diagnosis, StepDecision, isolate
 from fdikit.errors import DataError, ModelError
@@ -200,9 +200,7 @@ class SprtEvaluator:
         return self
 
     def _ready(self, q: int, residuals: Residuals | None = None):
-        names = residuals.names if residuals is not None else (self.names or tuple(f"r{i}" for i in range(q)))
-        if len(names) != q:
-            raise DataError(f"got {q} residuals, the evaluator was fitted on {len(names)} ({list(names)})")
+        names = checked_names(q, residuals, self.names)
         if self.shift.size not in (1, q):
             raise DataError(f"{self.shift.size} shift values for {q} residuals")
         delta = np.array(np.broadcast_to(self.shift, (q,)))
