@@ -50,36 +50,53 @@ def test_trace_profile_and_snr():
     assert np.allclose(dv, 51 * 0.5 * np.array([-0.5, 0.5]) * np.sqrt(2), atol=1.0)
 
 
-def test_ekf_interpolates_and_beats_imm_in_the_half_turn(mc):
-    """Item 17: in [100, 150] the EKF's weights approach (0.75, 0.25) and its velocity and B RMSE beat the IMM's.
+@pytest.mark.parametrize("cm", ["ekf", "dual_cmf"])
+def test_convex_filters_interpolate_and_beat_imm_in_the_half_turn(mc, cm):
+    """Item 17: in [100, 150] both CM filters' weights approach (0.75, 0.25) and their velocity and B RMSE beat
+    the IMM's.
 
-    Measured (8 runs, seed 0): velocity RMSE EKF ≈ 0.57 vs IMM ≈ 1.07 m/s; B RMSE 0.17 vs 0.46.
+    Measured (8 runs, seed 0): velocity RMSE EKF 0.56, dual CMF 0.71, IMM 1.08 m/s; B RMSE 0.17, 0.25, 0.46;
+    mean weights over [120, 150] (0.751, 0.249) and (0.748, 0.252).
     """
     s = mc.summary
-    assert s["ekf"]["left_half"]["velocity"] < 0.75 * s["imm"]["left_half"]["velocity"]
-    assert s["ekf"]["left_half"]["B"] < 0.6 * s["imm"]["left_half"]["B"]
-    assert np.abs(mc.cm_weights["ekf"][120:151].mean(axis=0) - [0.75, 0.25]).max() < 0.05
-    assert np.abs(mc.cm_weights["ekf"][270:301].mean(axis=0) - [0.0, 1.0]).max() < 0.1
+    assert s[cm]["left_half"]["velocity"] < 0.75 * s["imm"]["left_half"]["velocity"]
+    assert s[cm]["left_half"]["B"] < 0.6 * s["imm"]["left_half"]["B"]
+    assert np.abs(mc.cm_weights[cm][120:151].mean(axis=0) - [0.75, 0.25]).max() < 0.03
+    assert np.abs(mc.cm_weights[cm][270:301].mean(axis=0) - [0.0, 1.0]).max() < 0.1
+    w = mc.mean_weights[cm]
+    assert np.allclose(w.sum(axis=1), 1.0) and w.min() >= 0
 
 
 def test_imm_chatters_in_the_half_turn_and_wins_elsewhere(mc):
     """Item 17: the IMM switches between models in [100, 150]; it has the lowest velocity RMSE outside it."""
-    assert mc.chatter["imm"] > 2 * mc.chatter["ekf"]  # measured ≈ 0.14 vs 0.05 per sample
+    assert mc.chatter["imm"] > 2 * mc.chatter["ekf"]  # measured ≈ 0.14 vs 0.05 per sample (dual CMF 0.05)
+    assert mc.chatter["imm"] > 2 * mc.chatter["dual_cmf"]
     for name in ("straight_1", "straight_2", "right", "straight_3"):
-        assert mc.summary["imm"][name]["velocity"] < mc.summary["ekf"][name]["velocity"]
+        for cm in ("ekf", "dual_cmf"):
+            assert mc.summary["imm"][name]["velocity"] < mc.summary[cm][name]["velocity"]
+
+
+def test_printed_dual_cmf_weight_step_fails_on_this_benchmark():
+    """Erratum behind the corrected dual CMF: Table 2.2 as printed weights the Kalman correction by Q⁻¹ and
+    follows the position rows' noise (velocity RMSE 4.0 m/s in straight flight, 8 runs; corrected form 0.70)."""
+    from fdikit.multimodel.convex import dual_convex_filter
+
+    ms = tracking_convex_set()
+    worse = []
+    for seed in range(2):
+        tr = target_tracking_trace(seed)
+        x0 = tr.x[0]
+        for form in ("thesis", "corrected"):
+            r = dual_convex_filter(ms, tr.y, tr.u, x0, R_TRACKING, lam=0.9, form=form)
+            worse.append(np.sqrt(((tr.x[:100, [1, 3]] - r.x[:100, [1, 3]]) ** 2).sum(axis=1).mean()))
+    thesis, corrected = np.array(worse[0::2]), np.array(worse[1::2])
+    assert np.all(thesis > 3 * corrected), (thesis, corrected)
 
 
 def test_position_rmse_about_equal_for_ekf_and_imm(mc):
     """Fig. 2.4: position RMSE about the same for the filters (EKF vs IMM within 10 % per interval)."""
     for name, v in mc.summary["ekf"].items():
         assert abs(v["position"] / mc.summary["imm"][name]["position"] - 1) < 0.1
-
-
-def test_dual_cmf_weights_track_the_half_turn_on_average(mc):
-    """The dual CMF (λ = 0.9) mean weight over [100, 150] is near 0.75; weights stay on the simplex."""
-    w = mc.mean_weights["dual_cmf"]
-    assert np.allclose(w.sum(axis=1), 1.0) and w.min() >= 0
-    assert abs(w[100:151, 0].mean() - 0.75) < 0.1
 
 
 def test_monte_carlo_bad_input_and_plot(tmp_path, mc):

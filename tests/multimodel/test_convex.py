@@ -68,14 +68,15 @@ def test_srcf_step_equals_conventional_kalman_filter():
     assert np.allclose(S_next @ S_next.T, kf.P, atol=1e-12)
 
 
-def test_dual_filter_with_frozen_weights_is_a_kalman_filter():
-    """Item 2 over a run: with λ-step disabled by constant exact weights the state path is the KF's."""
+@pytest.mark.parametrize("form", ["corrected", "thesis"])
+def test_dual_filter_with_frozen_weights_is_a_kalman_filter(form):
+    """Item 2 over a run: with identical local models (any weights) the state path is the KF's, in both forms."""
     rng = np.random.default_rng(1)
     ms = _random_set(rng, N=2)
     ms1 = convex_model_set(ms.A[[0, 0]], ms.B[[0, 0]], ms.C[[0, 0]], ms.D[[0, 0]], Q=ms.Q, R=ms.R)
     K = 60
     u, y = rng.standard_normal((K, 2)), rng.standard_normal((K, 2))
-    res = dual_convex_filter(ms1, y, u, np.zeros(3), np.eye(3), mu0=[0.5, 0.5], lam=0.9)
+    res = dual_convex_filter(ms1, y, u, np.zeros(3), np.eye(3), mu0=[0.5, 0.5], lam=0.9, form=form)
     kf = KalmanFilter(dim_x=3, dim_z=2, dim_u=2)
     kf.x, kf.P, kf.F, kf.H, kf.Q, kf.R, kf.B = np.zeros(3), np.eye(3), ms.A[0], ms.C[0], ms.Q, ms.R, ms.B[0]
     for k in range(K):
@@ -243,3 +244,93 @@ def test_bad_input_is_named():
         convex_model_set(np.eye(2), np.ones((2, 2, 1)), np.eye(2), Q=np.eye(2), R=np.zeros((2, 2)))
     with pytest.raises(ModelError, match="no model varies"):
         convex_model_set(np.eye(2), np.ones((2, 1)), np.eye(2), Q=np.eye(2), R=np.eye(2))
+
+
+def _brute_force_weighted_simplex(y, W):
+    """Exact QP optimum by enumerating the supports (each solved by its KKT system)."""
+    import itertools
+
+    N, best, best_cost = y.size, None, np.inf
+    for r in range(1, N + 1):
+        for S in itertools.combinations(range(N), r):
+            S = list(S)
+            K = np.zeros((r + 1, r + 1))
+            K[:r, :r], K[:r, r], K[r, :r] = 2 * W[np.ix_(S, S)], 1.0, 1.0
+            rhs = np.concatenate([2 * W[S] @ y, [1.0]])
+            m = np.zeros(N)
+            m[S] = np.linalg.lstsq(K, rhs, rcond=None)[0][:r]
+            cost = (m - y) @ W @ (m - y)
+            if m.min() >= -1e-12 and abs(m.sum() - 1) < 1e-9 and cost < best_cost - 1e-15:
+                best, best_cost = m, cost
+    return best, best_cost
+
+
+def test_weighted_simplex_projection_is_the_qp_optimum():
+    """(2.37) with W = TᵀT: the active-set result equals the exact optimum over all supports; W = I gives the
+    Euclidean (sort-based) projection."""
+    from fdikit.multimodel.simplex import project_to_simplex_weighted
+
+    rng = np.random.default_rng(3)
+    for t in range(200):
+        N = int(rng.integers(2, 6))
+        G = rng.standard_normal((N, N))
+        W = G @ G.T + 1e-3 * np.eye(N) if t % 4 else np.diag(rng.uniform(0.1, 10, N))
+        y = 2 * rng.standard_normal(N)
+        m = project_to_simplex_weighted(y, W, ridge=0.0)
+        ref, cost = _brute_force_weighted_simplex(y, W)
+        assert m.min() >= 0 and abs(m.sum() - 1) < 1e-12
+        assert (m - y) @ W @ (m - y) <= cost * (1 + 1e-9) + 1e-12
+        assert np.allclose(m, ref, atol=1e-7)
+        assert np.allclose(project_to_simplex_weighted(y, np.eye(N)), _sort_simplex(y), atol=1e-12)
+
+
+def test_affine_projection_is_the_equality_projection_2_38():
+    """(2.38) with D = 1ᵀ, d = 1: μ^c = μ̂ − W⁻¹1 (1ᵀμ̂ − 1)/(1ᵀW⁻¹1); negative weights are allowed."""
+    from fdikit.multimodel.simplex import project_to_affine
+
+    rng = np.random.default_rng(4)
+    G = rng.standard_normal((4, 4))
+    W = G @ G.T + 0.1 * np.eye(4)
+    y = rng.standard_normal(4)
+    Wi1 = np.linalg.solve(W, np.ones(4))
+    assert np.allclose(project_to_affine(y, W, ridge=0.0), y - Wi1 * (y.sum() - 1) / Wi1.sum(), atol=1e-12)
+    assert np.allclose(project_to_affine(y), y - (y.sum() - 1) / 4, atol=1e-15)
+
+
+def test_innovation_regressors_are_the_whitened_prediction_error():
+    """Corrected weight step: ‖Φμ − Γ‖² is the whitened one-step prediction error of the blended model at any μ
+    when C, D are common (exact), and to first order in μ − μ̄ when C varies."""
+    from fdikit.multimodel.convex import innovation_regressors
+    from fdikit.multimodel.kalman_steps import psd_sqrt
+
+    rng = np.random.default_rng(5)
+    ms = _random_set(rng)
+    ms_ab = convex_model_set(ms.A, ms.B, ms.C[0], ms.D[0], Q=ms.Q, R=ms.R)
+    x, u0, u1, y = rng.standard_normal(3), rng.standard_normal(2), rng.standard_normal(2), rng.standard_normal(2)
+    S = np.linalg.cholesky(np.eye(3) * 0.3)
+    Qs, Rs = psd_sqrt(ms.Q), np.linalg.cholesky(ms.R)
+    mu_bar = np.array([0.2, 0.5, 0.3])
+    for models, tol in ((ms_ab, 1e-12), (ms, 1e-5)):
+        Phi, Gamma, F, x_bar, S_bar = innovation_regressors(models, x, S, u0, u1, y, mu_bar, Qs, Rs)
+        _, _, C, D = models.blend(mu_bar)
+        Re = np.linalg.cholesky(C @ S_bar @ S_bar.T @ C.T + models.R)
+        for d in (np.zeros(3), 1e-3 * np.array([1.0, -2.0, 1.0])):
+            mu = mu_bar + d
+            A, B, C, D = models.blend(mu)
+            e = y - C @ (A @ x + B @ u0) - D @ u1
+            assert np.allclose(Phi @ mu - Gamma, -np.linalg.solve(Re, e), atol=tol)
+
+
+def test_dual_cmf_options_and_prior():
+    """The prior (regularised forgetting) keeps the weights near μ0 without data; bad options are named."""
+    ms = convex_model_set(np.eye(2) * 0.9, [[[1.0], [0.0]], [[0.0], [1.0]]], np.eye(2), Q=1e-4 * np.eye(2),
+                          R=1e-4 * np.eye(2))
+    y, u = np.zeros((50, 2)), np.zeros((50, 1))  # no excitation: the weights are not identifiable
+    r = dual_convex_filter(ms, y, u, np.zeros(2), np.eye(2), mu0=[1.0, 0.0], lam=0.9, prior_std=0.3)
+    assert np.allclose(r.mu[-1], [1.0, 0.0], atol=1e-9)
+    with pytest.raises(ModelError, match="form"):
+        dual_convex_filter(ms, y, u, np.zeros(2), np.eye(2), form="dual")
+    with pytest.raises(ModelError, match="metric"):
+        dual_convex_filter(ms, y, u, np.zeros(2), np.eye(2), metric="euclid")
+    with pytest.raises(ModelError, match="constrain"):
+        dual_convex_filter(ms, y, u, np.zeros(2), np.eye(2), constrain="box")

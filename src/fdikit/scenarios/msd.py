@@ -236,7 +236,7 @@ def run_msd_filter(sim: MSDSimulation, model_set: MSDModelSet | None = None, fil
     if filter == "ekf":
         res = augmented_ekf(cms, sim.y, sim.u, x0, P0, Q_mu=q_mu * np.eye(cms.N), constrain=constrain)
     elif filter == "dual_cmf":
-        res = dual_convex_filter(cms, sim.y, sim.u, x0, P0, lam=lam, constrain=constrain)
+        res = dual_convex_filter(cms, sim.y, sim.u, x0, P0, lam=lam, constrain=constrain or "affine")
     else:
         raise ModelError(f"filter must be 'ekf' or 'dual_cmf', got {filter!r}")
     par = ms.parameters
