@@ -204,6 +204,7 @@ class B747MonteCarloResult:
 
 
 def b747_monte_carlo(runs: int = 100, seed: int | None = 0, *, lam: float = 0.85, q_mu: float = 1e-2,
+                     prior_std: float | None = 0.3,
                      filters=_FILTERS, n_samples: int = N_SAMPLES, a35: str = "corrected") -> B747MonteCarloResult:
     """Monte-Carlo comparison of the dual CMF, the augmented EKF and the IMM (Hallouzi 2008, §2.4.1).
 
@@ -211,6 +212,10 @@ def b747_monte_carlo(runs: int = 100, seed: int | None = 0, *, lam: float = 0.85
     ----------
     runs : number of runs (thesis: 100).  seed : master seed (runs use ``SeedSequence(seed).spawn``).
     lam : dual-CMF forgetting factor (thesis 0.85).  q_mu : EKF ``Q^μ = q_mu I_5`` (thesis 1e-2).
+    prior_std : the corrected dual CMF's weight prior (:func:`~fdikit.multimodel.convex.dual_convex_filter`;
+        not in the thesis).  At the start the states are near zero and the sensor-fault models cannot be
+        told from the nominal one; without a prior the weights wander there (weight RMSE 0.93 in [0, 199]
+        over 10 runs, against 0.14 with σ = 0.3).
     filters : subset of ``("dual_cmf", "ekf", "imm")``.  The IMM uses Π of (2.63) and ``Q``, ``R`` of §2.4.1.
     """
     filters = tuple(filters)
@@ -237,7 +242,7 @@ def b747_monte_carlo(runs: int = 100, seed: int | None = 0, *, lam: float = 0.85
         tr = b747_trace(np.random.default_rng(child), n_samples, a35=a35)
         for f in filters:
             if f == "dual_cmf":
-                r = dual_convex_filter(ms, tr.y, tr.u, np.zeros(5), _P0, mu0=mu_nom, lam=lam)
+                r = dual_convex_filter(ms, tr.y, tr.u, np.zeros(5), _P0, mu0=mu_nom, lam=lam, prior_std=prior_std)
             elif f == "ekf":
                 r = augmented_ekf(ms, tr.y, tr.u, np.zeros(5), _P0, mu0=mu_nom, Q_mu=q_mu * np.eye(5))
             else:
