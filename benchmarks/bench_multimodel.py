@@ -21,7 +21,7 @@ import time
 import numpy as np
 
 from fdikit.multimodel.imm import IMMFilter
-from fdikit.multimodel.kalman import LinearGaussianModel, kalman_filter
+from fdikit.multimodel.kalman import KalmanFilter, LinearGaussianModel, kalman_filter
 from timing import best
 
 
@@ -82,9 +82,17 @@ def main() -> None:
     rows.append(("KF (1 mode)", "filterpy KalmanFilter", N / t_fp))
     rows.append(("KF (1 mode)", "fdikit kalman_filter (Joseph form)", N / t_kf))
 
+    def online_kf():
+        f = KalmanFilter(lg, np.zeros(md.n), np.eye(md.n))
+        for k in range(N):
+            f.step(u[k], y[k])
+
+    t_on, _ = best(online_kf, a.repeat)
+    rows.append(("KF (1 mode)", "fdikit KalmanFilter.step (online)", N / t_on))
+
     imm = IMMFilter(modes, Pi)
     t_imm, _ = best(lambda: imm.run(u, y), a.repeat)
-    rows.append(("IMM (3 modes)", "fdikit IMMFilter.run", N / t_imm))
+    rows.append(("IMM (3 modes)", "fdikit IMMFilter.run", N / t_imm))  # rows[4]
 
     def fp_imm():
         from filterpy.kalman import IMMEstimator
@@ -104,7 +112,8 @@ def main() -> None:
     for f, impl, sps in rows:
         print(f"| {f} | {impl} | {sps:,.0f} | {1e6 / sps:.1f} |")
     print(f"\nspeed ratio fdikit / filterpy: KF as a 1-mode IMM {rows[0][2] / rows[1][2]:.2f}×, "
-          f"kalman_filter {rows[2][2] / rows[1][2]:.2f}×, IMM {rows[3][2] / rows[4][2]:.2f}×")
+          f"kalman_filter {rows[2][2] / rows[1][2]:.2f}×, online step {rows[3][2] / rows[1][2]:.2f}×, "
+          f"IMM {rows[4][2] / rows[5][2]:.2f}×")
 
     if a.long:
         # long run: data from mode 0; mode 2 (input gain 0.2) is very unlikely and, with Π = I, cannot be revived
