@@ -66,11 +66,7 @@ def project_to_simplex_weighted(mu, W, ridge: float = 1e-9) -> np.ndarray:
     """
     y = _weights(mu)
     N = y.size
-    W = np.asarray(W, dtype=float)
-    if W.shape != (N, N) or not np.all(np.isfinite(W)):
-        raise ModelError(f"the projection metric W must be a finite {N} x {N} matrix, got shape {W.shape}")
-    W = 0.5 * (W + W.T)
-    W = W + ridge * max(np.trace(W) / N, np.finfo(float).tiny) * np.eye(N)
+    W = _metric(W, N, ridge)
     m = project_to_simplex(y)
     free = m > 0
     for _ in range(10 * N + 10):
@@ -107,11 +103,7 @@ def project_to_affine(mu, W=None, ridge: float = 1e-9) -> np.ndarray:
     """
     y = _weights(mu)
     N = y.size
-    W = np.eye(N) if W is None else np.asarray(W, dtype=float)
-    if W.shape != (N, N) or not np.all(np.isfinite(W)):
-        raise ModelError(f"the projection metric W must be a finite {N} x {N} matrix, got shape {W.shape}")
-    W = 0.5 * (W + W.T)
-    W = W + ridge * max(np.trace(W) / N, np.finfo(float).tiny) * np.eye(N)
+    W = _metric(np.eye(N) if W is None else W, N, ridge)
     return _equality_projection(y, W, np.ones(N, dtype=bool))[0]
 
 
@@ -128,6 +120,15 @@ def _equality_projection(y: np.ndarray, W: np.ndarray, free: np.ndarray) -> tupl
     m = np.zeros_like(y)
     m[idx] = a - half_nu * b
     return m, 2.0 * half_nu
+
+
+def _metric(W, N: int, ridge: float) -> np.ndarray:
+    """Symmetrised ``W`` plus ``ridge · tr(W)/N · I`` (so a singular information matrix still has an inverse)."""
+    W = np.asarray(W, dtype=float)
+    if W.shape != (N, N) or not np.all(np.isfinite(W)):
+        raise ModelError(f"the projection metric W must be a finite {N} x {N} matrix, got shape {W.shape}")
+    W = 0.5 * (W + W.T)
+    return W + ridge * max(np.trace(W) / N, np.finfo(float).tiny) * np.eye(N)
 
 
 def _weights(mu) -> np.ndarray:
