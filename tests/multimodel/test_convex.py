@@ -333,4 +333,4 @@ def test_dual_cmf_options_and_prior():
     with pytest.raises(ModelError, match="metric"):
         dual_convex_filter(ms, y, u, np.zeros(2), np.eye(2), metric="euclid")
     with pytest.raises(ModelError, match="constrain"):
-        dual_convex_filter(ms, y, u, np.zeros(2), np.eye(2), constrain="box")
+        dual_convex_filter(ms, y, u, np.zeros(2), np.eye(2), constrain="cube")

@@ -26,11 +26,12 @@ import scipy.linalg
 
 from fdikit.errors import DataError, ModelError
 from fdikit.multimodel.kalman_steps import _tria, psd_sqrt, srcf_step, srkf_predict, srkf_update
-from fdikit.multimodel.simplex import project_to_affine, project_to_simplex, project_to_simplex_weighted
+from fdikit.multimodel.simplex import constrain_weights, project_to_simplex
 
 __all__ = [
     "ConvexModelSet",
     "convex_model_set",
+    "limit_value_convex_set",
     "weight_regressors",
     "innovation_regressors",
     "rls_weight_step",
@@ -57,6 +58,9 @@ class ConvexModelSet:
         a constant, not as ``Σ μ^(i) M = (1ᵀμ) M``: both agree on the simplex, but only the former has a zero
         derivative in μ, so that the augmented EKF is the linear KF on ``[x; μ]`` when only B varies, as
         §2.4.2 states.
+    offset : ``(A⁺, B⁺, C⁺, D⁺)`` added to every blend, for the limit-value structure (3.39)–(3.40)
+        ``M(μ) = M⁺ + Σ μ_j M^Δ_j`` (the local "models" are then the changes ``M^Δ_j``; see
+        :func:`limit_value_convex_set`).  ``None`` for a convex model.
     """
 
     A: np.ndarray
@@ -67,6 +71,7 @@ class ConvexModelSet:
     R: np.ndarray
     names: tuple[str, ...]
     varying: tuple[bool, bool, bool, bool] = (True, True, True, True)
+    offset: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
 
     @property
     def N(self) -> int:
@@ -94,7 +99,8 @@ class ConvexModelSet:
         """``(A_μ, B_μ, C_μ, D_μ) = Σ μ^(i) (A, B, C, D)^(i)`` (Hallouzi 2008, (2.19)–(2.20))."""
         mu = self.check_weights(mu)
         mats = (self.A, self.B, self.C, self.D)
-        return tuple(np.tensordot(mu, M, axes=1) if v else M[0].copy() for M, v in zip(mats, self.varying))
+        out = tuple(np.tensordot(mu, M, axes=1) if v else M[0].copy() for M, v in zip(mats, self.varying))
+        return out if self.offset is None else tuple(o + M for o, M in zip(self.offset, out))
 
     def weight_columns(self, x, u) -> tuple[np.ndarray, np.ndarray]:
         """``∂(A_μ x + B_μ u)/∂μ`` (n, N) and ``∂(C_μ x + D_μ u)/∂μ`` (p, N); constant matrices add nothing."""
@@ -151,6 +157,32 @@ def convex_model_set(A, B, C, D=None, Q=None, R=None, names=None) -> ConvexModel
         raise ModelError(f"{len(names)} names for {N} models")
     varying = tuple(bool(np.ptp(M, axis=0).max() > 0) if M.size else False for M in (A_, B_, C_, D_))
     return ConvexModelSet(A_, B_, C_, D_, Q_, R_, names, varying)
+
+
+def limit_value_convex_set(lv, Q, R) -> ConvexModelSet:
+    """The limit-value model (Hallouzi 2008, (3.39)–(3.40), (3.44)) as a :class:`ConvexModelSet` with an offset.
+
+    ``lv`` is a :class:`~fdikit.multimodel.model_set.LimitValueModelSet`.  Each weight ``μ_j ∈ [0, 1]`` scales
+    its change ``M^Δ_j``; there is no sum constraint (filter with ``constrain="box"``), and the Jacobian
+    columns of the augmented EKF are ``A^Δ_j x + B^Δ_j u`` and ``C^Δ_j x + D^Δ_j u`` (research note §2.6).
+
+    Example
+    -------
+    >>> from fdikit.multimodel.model_set import limit_value_model_set
+    >>> lv = limit_value_model_set(lambda a: ([[a]], [[1.0]], [[1.0]]), {"a": -1.0}, {"a": -3.0})
+    >>> ms = limit_value_convex_set(lv, Q=[[1.0]], R=[[1.0]])
+    >>> float(ms.blend([0.5])[0][0, 0]), ms.names
+    (-2.0, ('a',))
+    """
+    deltas = lv.deltas
+    if not deltas:
+        raise ModelError("the limit-value model set has no varying parameter")
+    stacks = [np.stack([d[i] for d in deltas]) for i in range(4)]
+    ms = convex_model_set(stacks[0], stacks[1], stacks[2], stacks[3], Q=Q, R=R, names=lv.names)
+    # a matrix that no parameter changes has all-zero deltas: its blend is the offset alone
+    varying = tuple(bool(np.abs(M).max() > 0) if M.size else False for M in stacks)
+    return ConvexModelSet(*stacks, ms.Q, ms.R, ms.names, varying,
+                          tuple(np.asarray(o, dtype=float) for o in lv.offset))
 
 
 def weight_regressors(models: ConvexModelSet, x_prev, u_prev, x_filt, u, y, weighting: str = "whitened"):
@@ -298,8 +330,8 @@ def dual_convex_filter(models: ConvexModelSet, y, u, x0, P0, mu0=None, lam: floa
     weighting : thesis form only: ``"whitened"`` (Q^{-1/2}, default) or ``"inverse"`` (Q^{-1}, as printed
         in (2.33)).  ordering : Euclidean projection ordering, see :func:`project_to_simplex`.
     metric : ``"information"`` (W = TᵀT) or ``"identity"`` (W = I, the thesis); default by ``form``.
-    constrain : ``True`` projects the weights on the simplex; ``"affine"`` only on ``1ᵀμ = 1`` (for OD model
-        sets, whose weights may be negative); ``False`` leaves them free.
+    constrain : see :func:`~fdikit.multimodel.simplex.constrain_weights`: ``True`` (the simplex), ``"affine"``
+        (``1ᵀμ = 1`` only, for OD sets, whose weights may be negative), ``"box"`` (limit-value sets) or ``False``.
     write_back : store ``ξ = T μ^c`` (not stated in the thesis); default by ``form``.
     T0_scale : ``T_0 = δ I`` and ``ξ_0 = T_0 μ_0`` (a thesis gap).
     prior_std : regularised forgetting: each step adds the rows ``√(1−λ)/σ [I, μ_0]``, so the weight
@@ -320,8 +352,8 @@ def dual_convex_filter(models: ConvexModelSet, y, u, x0, P0, mu0=None, lam: floa
     if metric not in ("information", "identity"):
         raise ModelError(f"metric must be 'information' (W = T'T) or 'identity' (W = I), got {metric!r}")
     write_back = (form == "corrected") if write_back is None else write_back
-    if constrain not in (True, False, "affine"):
-        raise ModelError(f"constrain must be True (simplex), 'affine' (sum one) or False, got {constrain!r}")
+    if constrain not in (True, False, "simplex", "affine", "box"):
+        raise ModelError(f"constrain must be True/'simplex', 'affine', 'box' or False, got {constrain!r}")
     y, u = _check_data(models, y, u)
     N, n = models.N, models.n
     mu = np.full(N, 1.0 / N) if mu0 is None else models.check_weights(mu0)
@@ -340,15 +372,7 @@ def dual_convex_filter(models: ConvexModelSet, y, u, x0, P0, mu0=None, lam: floa
         if prior is not None:  # regularised forgetting: the information never falls below I / prior_std²
             Phi, Gamma = np.vstack([Phi, prior * np.eye(N)]), np.concatenate([Gamma, prior * mu_prior])
         T, xi, raw = rls_weight_step(T, xi, Phi, Gamma, lam)
-        W = T.T @ T if metric == "information" else None
-        if not constrain:
-            new = raw
-        elif constrain == "affine":
-            new = project_to_affine(raw, W)
-        elif W is not None:
-            new = project_to_simplex_weighted(raw, W)
-        else:
-            new = project_to_simplex(raw, ordering)
+        new = constrain_weights(raw, constrain, T.T @ T if metric == "information" else None, ordering)
         if write_back:
             xi = T @ new
         return raw, new

@@ -22,8 +22,8 @@ from fdikit.multimodel.convex import (
     ConvexFilterResult,
     ConvexModelSet,
     _check_data,
-    project_to_simplex,
 )
+from fdikit.multimodel.simplex import constrain_weights
 
 __all__ = ["augmented_jacobians", "augmented_ekf"]
 
@@ -54,7 +54,7 @@ def augmented_jacobians(models: ConvexModelSet, x, mu, u) -> tuple[np.ndarray, n
 
 
 def augmented_ekf(models: ConvexModelSet, y, u, x0, P0, mu0=None, Q_mu=None, P_mu0=None, *,
-                  constrain: bool = True, ordering: str = "michelot") -> ConvexFilterResult:
+                  constrain: bool | str = True, ordering: str = "michelot") -> ConvexFilterResult:
     """Run the augmented EKF on ``[x; μ]`` (Hallouzi 2008, §2.3.3, Table 2.3, (2.46)–(2.53)).
 
     Per sample k ≥ 1 the time update (2.46)–(2.48) with ``u_{k−1}``, then for every k the measurement
@@ -66,6 +66,8 @@ def augmented_ekf(models: ConvexModelSet, y, u, x0, P0, mu0=None, Q_mu=None, P_m
     Q_mu : (N, N) random-walk covariance Q^μ, the main tuning knob (thesis §2.4.2: 1e-2 I).
     mu0 : initial weights (default uniform).  P_mu0 : their covariance (default ``I/12``, the variance of a
     uniform weight on [0, 1]; the thesis gives none).
+    constrain : weight constraint after each update, see :func:`~fdikit.multimodel.simplex.constrain_weights`
+        (``True``: the simplex; ``"box"`` for limit-value sets, §3.6; ``"affine"``; ``False``).
     """
     y, u = _check_data(models, y, u)
     N, n = models.N, models.n
@@ -104,6 +106,6 @@ def augmented_ekf(models: ConvexModelSet, y, u, x0, P0, mu0=None, Q_mu=None, P_m
         P = ImKC @ P @ ImKC.T + G @ models.R @ G.T  # (2.51), Joseph form
         P = 0.5 * (P + P.T)
         x, raw = z[:n], z[n:]
-        mu = project_to_simplex(raw, ordering) if constrain else raw
+        mu = constrain_weights(raw, constrain, ordering=ordering)
         xs[k], Ps[k], mus[k], raws[k] = x, P[:n, :n], mu, raw
     return ConvexFilterResult(xs, Ps, mus, raws, models.names)

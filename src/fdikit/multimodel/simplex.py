@@ -15,7 +15,7 @@ import numpy as np
 
 from fdikit.errors import DataError, ModelError
 
-__all__ = ["project_to_simplex", "project_to_simplex_weighted", "project_to_affine"]
+__all__ = ["project_to_simplex", "project_to_simplex_weighted", "project_to_affine", "constrain_weights"]
 
 
 def project_to_simplex(mu, ordering: str = "michelot") -> np.ndarray:
@@ -136,3 +136,26 @@ def _weights(mu) -> np.ndarray:
     if y.size == 0 or not np.all(np.isfinite(y)):
         raise DataError("weights to project must be a non-empty finite vector")
     return y
+
+
+def constrain_weights(mu, constrain, W=None, ordering: str = "michelot") -> np.ndarray:
+    """Apply a weight constraint of the convex-model filters (Hallouzi 2008, (2.37)–(2.38), §2.6 of the note).
+
+    ``constrain``: ``True`` or ``"simplex"`` (μ ≥ 0, 1ᵀμ = 1; with ``W`` the weighted projection, else the
+    Euclidean one with the given ``ordering``), ``"affine"`` (1ᵀμ = 1 only, for OD sets), ``"box"``
+    (each μ_j clipped to [0, 1], for limit-value sets, (3.39)) or ``False`` (unchanged).
+
+    Example
+    -------
+    >>> constrain_weights([1.2, -0.1], "box").tolist(), constrain_weights([0.7, 0.5], "affine").tolist()
+    ([1.0, 0.0], [0.6, 0.4])
+    """
+    if constrain is False:
+        return _weights(mu)
+    if constrain is True or constrain == "simplex":
+        return project_to_simplex(mu, ordering) if W is None else project_to_simplex_weighted(mu, W)
+    if constrain == "affine":
+        return project_to_affine(mu, W)
+    if constrain == "box":
+        return np.clip(_weights(mu), 0.0, 1.0)
+    raise ModelError(f"constrain must be True/'simplex', 'affine', 'box' or False, got {constrain!r}")
