@@ -9,11 +9,13 @@
 * :mod:`fdikit.scenarios.b747` — the B747 linear FDI benchmark of Hallouzi 2008, §2.4.1
   (:func:`b747_trace`, :func:`b747_monte_carlo`);
 * :mod:`fdikit.scenarios.msd` — the LPV mass–spring–damper run of Hallouzi 2008, §3.6.2
-  (:func:`simulate_msd`, :func:`run_msd_filter`).
+  (:func:`simulate_msd`, :func:`run_msd_filter`); :mod:`fdikit.scenarios.msd_model_sets` — the same run on the
+  OD, CP and LV model sets (Table 3.3, :func:`msd_table_3_3`).
 """
 
 from fdikit.scenarios.b747 import b747_monte_carlo, b747_trace
 from fdikit.scenarios.msd import run_msd_filter, simulate_msd
+from fdikit.scenarios.msd_model_sets import msd_table_3_3
 from fdikit.scenarios.target_tracking import target_tracking_monte_carlo, target_tracking_trace
 from fdikit.scenarios.vanderploeg import cornering_run, lateral_run, true_steering_faults, vanderploeg_case
 from fdikit.scenarios.varrier import min_max_ratio, varrier_comparison, varrier_trace
@@ -24,6 +26,7 @@ __all__ = [
     "cornering_run",
     "lateral_run",
     "min_max_ratio",
+    "msd_table_3_3",
     "run_msd_filter",
     "simulate_msd",
     "target_tracking_monte_carlo",
