@@ -334,3 +334,23 @@ def test_dual_cmf_options_and_prior():
         dual_convex_filter(ms, y, u, np.zeros(2), np.eye(2), metric="euclid")
     with pytest.raises(ModelError, match="constrain"):
         dual_convex_filter(ms, y, u, np.zeros(2), np.eye(2), constrain="cube")
+
+
+def test_covariance_projection_is_a_perfect_measurement_update():
+    """Simon & Chia (2002) with W = P⁻¹: the equality projection of z = [x; μ] equals a Kalman update with the
+    noise-free measurement 1ᵀμ = 1 (independent formula), and leaves no variance along 1ᵀμ."""
+    from fdikit.multimodel.convex_ekf import _covariance_projection
+
+    rng = np.random.default_rng(7)
+    n, N = 3, 3
+    G = rng.standard_normal((n + N, n + N))
+    P = G @ G.T + 0.1 * np.eye(n + N)
+    z = np.concatenate([rng.standard_normal(n), [0.5, 0.4, 0.3]])
+    zc, Pc = _covariance_projection(z, P, n, nonnegative=False)
+    H = np.concatenate([np.zeros(n), np.ones(N)])[None, :]
+    K = P @ H.T / (H @ P @ H.T + 1e-14)
+    np.testing.assert_allclose(zc, z + (K * (1.0 - H @ z)).ravel(), atol=1e-9)
+    np.testing.assert_allclose(Pc, P - K @ H @ P, atol=1e-9)
+    assert abs(zc[n:].sum() - 1) < 1e-12 and np.abs(Pc @ H.T).max() < 1e-10
+    zc, _ = _covariance_projection(np.concatenate([z[:n], [1.2, 0.3, -0.4]]), P, n, nonnegative=True)
+    assert zc[n:].min() >= 0 and abs(zc[n:].sum() - 1) < 1e-9

@@ -54,7 +54,8 @@ def augmented_jacobians(models: ConvexModelSet, x, mu, u) -> tuple[np.ndarray, n
 
 
 def augmented_ekf(models: ConvexModelSet, y, u, x0, P0, mu0=None, Q_mu=None, P_mu0=None, *,
-                  constrain: bool | str = True, ordering: str = "michelot") -> ConvexFilterResult:
+                  constrain: bool | str = True, ordering: str = "michelot",
+                  projection: str = "euclidean") -> ConvexFilterResult:
     """Run the augmented EKF on ``[x; μ]`` (Hallouzi 2008, §2.3.3, Table 2.3, (2.46)–(2.53)).
 
     Per sample k ≥ 1 the time update (2.46)–(2.48) with ``u_{k−1}``, then for every k the measurement
@@ -68,7 +69,15 @@ def augmented_ekf(models: ConvexModelSet, y, u, x0, P0, mu0=None, Q_mu=None, P_m
     uniform weight on [0, 1]; the thesis gives none).
     constrain : weight constraint after each update, see :func:`~fdikit.multimodel.simplex.constrain_weights`
         (``True``: the simplex; ``"box"`` for limit-value sets, §3.6; ``"affine"``; ``False``).
+    projection : ``"euclidean"`` (default; §2.3.2 with W = I, the covariance left unchanged, as the thesis
+        implies) or ``"covariance"``: Simon & Chia's (2002) projection with ``W = P⁻¹`` on the whole augmented
+        state, i.e. ``1ᵀμ = 1`` applied as a noise-free measurement: ``z ← z − P Dᵀ(D P Dᵀ)⁻¹(D z − 1)``,
+        ``P ← P − P Dᵀ(D P Dᵀ)⁻¹ D P`` with ``D = [0, 1ᵀ]``, so the states move with the weights they are
+        correlated with and the filter keeps no variance along ``1ᵀμ``.  Negative weights are then zeroed by
+        the same projection (active set, §2.3.2), leaving ``P`` unchanged for them.
     """
+    if projection not in ("euclidean", "covariance"):
+        raise ModelError(f"projection must be 'euclidean' (W = I) or 'covariance' (W = P^-1), got {projection!r}")
     y, u = _check_data(models, y, u)
     N, n = models.N, models.n
     mu = np.full(N, 1.0 / N) if mu0 is None else models.check_weights(mu0)
@@ -105,7 +114,40 @@ def augmented_ekf(models: ConvexModelSet, y, u, x0, P0, mu0=None, Q_mu=None, P_m
         ImKC = I - G @ Cbar
         P = ImKC @ P @ ImKC.T + G @ models.R @ G.T  # (2.51), Joseph form
         P = 0.5 * (P + P.T)
-        x, raw = z[:n], z[n:]
-        mu = constrain_weights(raw, constrain, ordering=ordering)
+        raw = z[n:].copy()
+        if projection == "covariance" and constrain in (True, "simplex", "affine"):
+            z, P = _covariance_projection(z, P, n, nonnegative=constrain != "affine")
+            x, mu = z[:n], z[n:]
+        else:
+            x, mu = z[:n], constrain_weights(raw, constrain, ordering=ordering)
         xs[k], Ps[k], mus[k], raws[k] = x, P[:n, :n], mu, raw
     return ConvexFilterResult(xs, Ps, mus, raws, models.names)
+
+
+def _covariance_projection(z: np.ndarray, P: np.ndarray, n: int, nonnegative: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Simon & Chia (2002) projection of ``z = [x; μ]`` on ``1ᵀμ = 1`` (and ``μ ≥ 0``) with ``W = P⁻¹``."""
+    N = z.size - n
+    D = np.zeros((1, n + N))
+    D[0, n:] = 1.0
+    G = np.linalg.solve(D @ P @ D.T, D @ P).T
+    z = z - G @ (D @ z - 1.0)
+    P = P - G @ D @ P
+    P = 0.5 * (P + P.T)
+    if not nonnegative:
+        return z, P
+    base, rows = z.copy(), [D[0]]
+    for _ in range(N):
+        neg = np.flatnonzero(z[n:] < 0)
+        if neg.size == 0:
+            break
+        for i in neg:
+            e = np.zeros(n + N)
+            e[n + i] = 1.0
+            rows.append(e)
+        Dk = np.array(rows)
+        d = np.zeros(len(rows))
+        d[0] = 1.0
+        M = Dk @ P @ Dk.T + 1e-12 * np.trace(P) * np.eye(len(rows))  # P has no variance along 1ᵀμ any more
+        z = base - P @ Dk.T @ np.linalg.solve(M, Dk @ base - d)
+    z[n:] = np.maximum(z[n:], 0.0)
+    return z, P
