@@ -68,7 +68,9 @@ def test_trace_reproduces_noise_and_model():
     w = tr.x[k + 1] - ms.A[0] @ tr.x[k] - Bk @ tr.u[k]
     assert np.abs(w).max() < 5e-3  # only process noise (std 1e-3) remains
     snr = b747_snr(tr)
-    assert snr[1] > 35 and snr[3] > 35  # V and h reach the thesis's 35 dB; q and α do not (see report)
+    assert np.all(snr > 31), snr  # thesis ≈ 35 dB on all four; measured (mean of 5 runs) 43 / 47 / 34 / 57 dB
+    white = b747_snr(b747_trace(3, input_tau=None, input_std=[0.3, 0.3, 2e3, 2e3, 2e3, 2e3]))
+    assert white[2] < 15  # white control noise leaves α at about 9 dB
 
 
 def test_monte_carlo_ranking_and_state_rmse():

@@ -303,6 +303,17 @@ def convex_weights(vertices, point) -> np.ndarray | None:
     return res.x[:k]
 
 
+def _nnls_convex_weights(V: np.ndarray, X: np.ndarray) -> tuple[np.ndarray, float]:
+    """Convex weights ``W ≥ 0``, ``1ᵀW = 1ᵀ`` with ``V W ≈ X`` by NNLS (sum row weighted 1e6); worst residual."""
+    scale = 1e6 * max(1.0, float(np.abs(V).max()))
+    Aa = np.vstack([V, np.full((1, V.shape[1]), scale)])
+    W = np.empty((V.shape[1], X.shape[1]))
+    for j in range(X.shape[1]):
+        W[:, j] = scipy.optimize.nnls(Aa, np.concatenate([X[:, j], [scale]]))[0]
+    W /= W.sum(axis=0, keepdims=True)
+    return W, float(np.abs(V @ W - X).max())
+
+
 def _distance_to_hull(points: np.ndarray, v: np.ndarray) -> float:
     """``d(v, conv(points))`` (3.27)–(3.28) by a small simplex-constrained least squares (SLSQP)."""
     k = points.shape[1]
@@ -312,7 +323,8 @@ def _distance_to_hull(points: np.ndarray, v: np.ndarray) -> float:
     return float(np.sqrt(max(res.fun, 0.0)))
 
 
-def cp_model_set(models, rank: int | None = None, min_gap: float = 10.0) -> CPModelSet:
+def cp_model_set(models, rank: int | None = None, min_gap: float = 10.0, n_vertices: int | None = None,
+                 optimize: bool = True) -> CPModelSet:
     """Enclosing-simplex model-set design, a substitute for Kanev's optimiser in Hallouzi 2008, §3.4.
 
     Steps (3.31)–(3.33) as in the thesis: SVD ``M_ℓ = U Σ Vᵀ``, ``n_g`` from the singular-value gap
@@ -327,6 +339,11 @@ def cp_model_set(models, rank: int | None = None, min_gap: float = 10.0) -> CPMo
     ``a_j = min λ_j ≤ 0`` the new vertex ``j`` has ``λ_k = a_k`` (k ≠ j), ``λ_j = 1 − Σ_{k≠j} a_k``.
     Every facet touches a sample, every sample is inside (check: :func:`convex_weights`), and
     ``N_h = d + 1`` vertices (the thesis's ``N_h ≥ n_g + 1`` counts the linear rank).
+
+    With ``optimize`` (default) this simplex is the feasible start of a local minimisation of ``J_CP`` over
+    ``n_vertices`` vertices (default ``d + 1``) subject to the enclosure (3.30)
+    (:func:`~fdikit.multimodel.enclosing_polytope.fit_enclosing_polytope`); the weights of the samples are then
+    found by LP.  If the optimiser loses the enclosure, the simplex is returned.
 
     Raises
     ------
@@ -360,7 +377,25 @@ def cp_model_set(models, rank: int | None = None, min_gap: float = 10.0) -> CPMo
             hull_points = local[:, scipy.spatial.ConvexHull(local.T).vertices]
         except scipy.spatial.QhullError:  # pragma: no cover - degenerate hull, fall back to all samples
             hull_points = local
-    cost = float(sum(_distance_to_hull(hull_points, vertices_local[:, j]) ** 2 for j in range(d + 1)))
+    n_h = d + 1 if n_vertices is None else int(n_vertices)
+    if n_h < d + 1:
+        raise DesignError(f"n_vertices must be at least d + 1 = {d + 1} to enclose a {d}-dimensional set")
+    if optimize or n_h > d + 1:
+        from fdikit.multimodel.enclosing_polytope import fit_enclosing_polytope
+
+        V_opt, ok = fit_enclosing_polytope(hull_points, vertices_local, n_h)
+        if n_h == d + 1:  # a simplex: barycentric coordinates, exact
+            w_opt = np.linalg.solve(np.vstack([V_opt, np.ones(n_h)]), np.vstack([local, np.ones(local.shape[1])]))
+            resid = max(0.0, -float(w_opt.min()))
+            w_opt = np.clip(w_opt, 0.0, None)
+        else:
+            w_opt, resid = _nnls_convex_weights(V_opt, local)
+        if ok and resid <= 1e-8 * max(1.0, float(np.abs(local).max())):
+            vertices_local, weights = V_opt, w_opt
+            vertices = centre + Ua[:, :d] @ vertices_local
+        elif n_h > d + 1:
+            raise DesignError(f"the polytope fit with {n_h} vertices lost the enclosure; try fewer vertices")
+    cost = float(sum(_distance_to_hull(hull_points, vertices_local[:, j]) ** 2 for j in range(vertices_local.shape[1])))
     return CPModelSet(basis, coords, vertices, basis @ vertices, weights, cost)
 
 

@@ -59,7 +59,7 @@ def _grid(grid_levels: int, fault_values) -> np.ndarray:
                               np.asarray(fault_values, float))
 
 
-def msd_cp_model_set(dt: float, grid_levels: int = 5, fault_values=(0.0, 0.5, 1.0)
+def msd_cp_model_set(dt: float, grid_levels: int = 5, fault_values=(0.0, 0.5, 1.0), n_vertices: int | None = None
                      ) -> tuple[CPModelSet, np.ndarray, np.ndarray]:
     """CP model set of the MSD (§3.4, (3.31)–(3.33)) on the OD run's grid; returns ``(cp, grid, vectors)``.
 
@@ -67,7 +67,7 @@ def msd_cp_model_set(dt: float, grid_levels: int = 5, fault_values=(0.0, 0.5, 1.
     """
     grid = _grid(grid_levels, fault_values)
     vectors = msd_model_vectors(grid, dt=dt)
-    return cp_model_set(vectors), grid, vectors
+    return cp_model_set(vectors, n_vertices=n_vertices), grid, vectors
 
 
 def msd_lv_model_set(dt: float) -> LimitValueModelSet:
