@@ -400,3 +400,27 @@ def test_batch_runner_switches_to_the_steady_state_filter_exactly(inputs):
     ll = np.array([s.log_likelihood for s in steps])
     np.testing.assert_allclose(fast.log_likelihood, ll, rtol=1e-12, atol=1e-12)
     assert fast.valid.all()
+
+
+def test_online_step_switches_to_the_steady_filter_and_back():
+    """Once P(k+1|k) has settled the online step uses the constant gain: same numbers as the recursion to
+    round-off; a NaN sample (skipped update) sends it back to the recursion."""
+    from fdikit.multimodel.kalman import KalmanFilter, LinearGaussianModel
+
+    rng = np.random.default_rng(3)
+    A = np.array([[0.9, 0.2], [0.0, 0.8]])
+    md = LinearGaussianModel(A=A, C=np.array([[1.0, 0.0]]), Q=0.01 * np.eye(2), R=np.array([[0.1]]),
+                             B=np.array([[0.0], [1.0]]))
+    u, y = rng.standard_normal((400, 1)), rng.standard_normal((400, 1))
+    y[300] = np.nan
+    fast, ref = KalmanFilter(md, np.zeros(2), np.eye(2)), KalmanFilter(md, np.zeros(2), np.eye(2))
+    ref._track_settling = lambda *a: None  # the plain recursion throughout
+    switched = []
+    for k in range(400):
+        a, b = fast.step(u[k], y[k]), ref.step(u[k], y[k])
+        switched.append(fast._steady is not None)
+        np.testing.assert_allclose(a.x_filt, b.x_filt, rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(a.P_pred, b.P_pred, rtol=1e-12, atol=1e-14)
+        if b.valid:
+            assert abs(a.log_likelihood - b.log_likelihood) < 1e-10
+    assert switched[299] and not switched[300] and switched[-1]
