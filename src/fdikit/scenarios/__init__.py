@@ -10,10 +10,14 @@
   (:func:`b747_trace`, :func:`b747_monte_carlo`);
 * :mod:`fdikit.scenarios.msd` — the LPV mass–spring–damper run of Hallouzi 2008, §3.6.2
   (:func:`simulate_msd`, :func:`run_msd_filter`); :mod:`fdikit.scenarios.msd_model_sets` — the same run on the
-  OD, CP and LV model sets (Table 3.3, :func:`msd_table_3_3`).
+  OD, CP and LV model sets (Table 3.3, :func:`msd_table_3_3`), and the OD vs minimum-mismatch conditioning
+  (Table 3.4, :func:`~fdikit.scenarios.msd.msd_observability_comparison`);
+* :mod:`fdikit.scenarios.example_3_1` — Table 3.1 of Hallouzi 2008, pair conditioning vs observability
+  (:func:`example_3_1`).
 """
 
 from fdikit.scenarios.b747 import b747_monte_carlo, b747_trace
+from fdikit.scenarios.example_3_1 import example_3_1
 from fdikit.scenarios.msd import run_msd_filter, simulate_msd
 from fdikit.scenarios.msd_model_sets import msd_table_3_3
 from fdikit.scenarios.target_tracking import target_tracking_monte_carlo, target_tracking_trace
@@ -21,6 +25,7 @@ from fdikit.scenarios.vanderploeg import cornering_run, lateral_run, true_steeri
 from fdikit.scenarios.varrier import min_max_ratio, varrier_comparison, varrier_trace
 
 __all__ = [
+    "example_3_1",
     "b747_monte_carlo",
     "b747_trace",
     "cornering_run",
