@@ -90,3 +90,16 @@ def test_target_tracking_command(tmp_path):
     assert summary.count("\n") == 2 + 3  # header, rule, one row per filter
     assert "imm" in summary and "ekf" in summary
     assert (out / "rmse.png").stat().st_size > 1000
+
+
+def test_multiple_model_command(tmp_path):
+    """One command runs items 17–20 and writes the summary and three plots (tiny sizes here)."""
+    out = tmp_path / "mm"
+    res = runner.invoke(app, ["multiple-model", "--runs", "2", "--msd-dt", "0.02", "--model-sets", "3",
+                              "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    text = (out / "summary.md").read_text()
+    for part in ("Item 17", "Item 18", "Item 19", "Item 20", "Table 3.4"):
+        assert part in text
+    for png in ("target_tracking.png", "b747.png", "msd.png"):
+        assert (out / png).stat().st_size > 10_000

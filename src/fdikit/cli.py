@@ -174,6 +174,38 @@ def target_tracking(
     console.print(f"wrote {out / 'summary.md'} and {out / 'rmse.png'} in {time.perf_counter() - start:.0f} s")
 
 
+@app.command("multiple-model")
+def multiple_model(
+    runs: int = typer.Option(100, help="Monte-Carlo runs of the tracking and B747 parts (Hallouzi 2008 uses 100)."),
+    seed: int = typer.Option(0, help="Master seed."),
+    msd_dt: float = typer.Option(0.01, help="MSD sample time [s] (thesis 2.5e-3; at most 0.02)."),
+    model_sets: int = typer.Option(15, help="Random model sets of Example 3.1 (thesis: 15)."),
+    out: Path = typer.Option(Path("out/multiple_model"), help="Folder for summary.md and the plots."),
+) -> None:
+    """Hallouzi 2008 items 17–20: target tracking, B747, Example 3.1 and the MSD model sets, with plots."""
+    from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
+
+    from fdikit.scenarios.multiple_model_report import multiple_model_report
+
+    start = time.perf_counter()
+    with Progress(SpinnerColumn(), TextColumn("{task.description}"), TimeElapsedColumn(), console=console) as bar:
+        task = bar.add_task("starting", total=4)
+
+        def step(name: str) -> None:
+            if bar.tasks[task].description != "starting":
+                bar.advance(task)
+            bar.update(task, description=name)
+
+        try:
+            summary = multiple_model_report(out, runs=runs, seed=seed, msd_dt=msd_dt, model_sets=model_sets,
+                                            progress=step)
+        except FdiError as exc:
+            _fail(exc)
+        bar.advance(task)
+    console.print(summary.read_text())
+    console.print(f"wrote {summary} and the plots in {time.perf_counter() - start:.0f} s")
+
+
 def main() -> None:  # pragma: no cover
     app()
 
