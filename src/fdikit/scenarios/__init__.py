@@ -25,10 +25,10 @@ from fdikit.scenarios.vanderploeg import cornering_run, lateral_run, true_steeri
 from fdikit.scenarios.varrier import min_max_ratio, varrier_comparison, varrier_trace
 
 __all__ = [
-    "example_3_1",
     "b747_monte_carlo",
     "b747_trace",
     "cornering_run",
+    "example_3_1",
     "lateral_run",
     "min_max_ratio",
     "msd_table_3_3",
