@@ -9,10 +9,9 @@ import scipy.spatial
 from scipy.stats import norm
 
 from fdikit.errors import DesignError, ModelError
+from fdikit.multimodel.cp_design import convex_weights, cp_model_set
 from fdikit.multimodel.model_set import (
     affine_weights,
-    convex_weights,
-    cp_model_set,
     first_order_discretize,
     gap_rank,
     limit_value_model_set,

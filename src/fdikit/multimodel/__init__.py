@@ -12,11 +12,12 @@ convex-model filters and model-set design.
 
 from fdikit.multimodel.convex import ConvexFilterResult, convex_model_set, dual_convex_filter
 from fdikit.multimodel.convex_ekf import augmented_ekf
+from fdikit.multimodel.cp_design import cp_model_set
 from fdikit.multimodel.ekf import ExtendedKalmanFilter, NonlinearGaussianModel, extended_kalman_filter
 from fdikit.multimodel.imm import IMMFilter, IMMResult
 from fdikit.multimodel.isolation import GroupThresholdLogic, table_4_7_logic
 from fdikit.multimodel.kalman import KalmanFilter, KalmanResult, LinearGaussianModel, kalman_filter
-from fdikit.multimodel.model_set import cp_model_set, limit_value_model_set, od_model_set
+from fdikit.multimodel.model_set import limit_value_model_set, od_model_set
 
 __all__ = [
     "ConvexFilterResult",

@@ -4,7 +4,7 @@ The same simulated run (:func:`fdikit.scenarios.msd.simulate_msd`) is filtered b
 on three model sets:
 
 * **OD** (§3.3.2): :func:`fdikit.scenarios.msd.run_msd_filter`;
-* **CP** (§3.4): the enclosing simplex of :func:`~fdikit.multimodel.model_set.cp_model_set` on the
+* **CP** (§3.4): the enclosing simplex of :func:`~fdikit.multimodel.cp_design.cp_model_set` on the
   same large set; the weights are projected on the simplex (every large-set model is a convex combination of
   the vertices); parameters are reconstructed by the nearest large-set model (3.51)–(3.52), hence quantised to
   the grid, as in Figs 3.7–3.8;
@@ -35,14 +35,8 @@ from fdikit.multimodel.convex import (
     lv_reciprocal_parameter,
 )
 from fdikit.multimodel.convex_ekf import augmented_ekf
-from fdikit.multimodel.model_set import (
-    CPModelSet,
-    LimitValueModelSet,
-    cp_model_set,
-    limit_value_model_set,
-    nearest_model,
-    unvectorize,
-)
+from fdikit.multimodel.cp_design import CPModelSet, cp_model_set
+from fdikit.multimodel.model_set import LimitValueModelSet, limit_value_model_set, nearest_model, unvectorize
 from fdikit.plants.msd import MSD_RANGES, msd_matrices, msd_model_vectors, msd_parameter_grid
 from fdikit.scenarios.msd import MSD_STATES, MSDSimulation, run_msd_filter
 
@@ -64,7 +58,7 @@ def msd_cp_model_set(dt: float, grid_levels: int = 5, fault_values=(0.0, 0.5, 1.
     """CP model set of the MSD (§3.4, (3.31)–(3.33)) on the OD run's grid; returns ``(cp, grid, vectors)``.
 
     ``grid`` (N_ℓ, 4) holds the large set's ``(k1, m3, f1, f2)`` and ``vectors`` its model vectors (n_q, N_ℓ).
-    ``optimize`` minimises J_CP (3.29) (:func:`~fdikit.multimodel.model_set.cp_model_set`).  Default ``False``:
+    ``optimize`` minimises J_CP (3.29) (:func:`~fdikit.multimodel.cp_design.cp_model_set`).  Default ``False``:
     the facet-parallel enclosing simplex (J_CP = 20.4) filters better than the J_CP-optimal simplex (0.27) on
     this run — with the latter f2 reads 0.85 in its 0.5 fault and the v2 VAF falls to 76–92 % (seeds 0–2);
     six vertices (the thesis's N_h, J_CP = 0.076) leave one weight direction unidentifiable and give v2 VAF
