@@ -64,11 +64,13 @@ def plot_msd(sim, runs: dict, path) -> None:
     """Figs 3.7–3.11 style: k1, m3, f1, f2 reconstructed by the OD, CP and LV sets against the truth."""
     plt = _pyplot()
     fig, axes = plt.subplots(4, 1, figsize=(8, 9), sharex=True)
+    limits = ((0.0, 2.0), (0.0, 2.2), (-0.1, 1.3), (-0.1, 1.3))  # a blend near 1/m3 = 0 sends m3 off the chart
     for j, (ax, name) in enumerate(zip(axes, ("k1", "m3", "f1", "f2"))):
         ax.plot(sim.t, sim.params[:, j], "k--", lw=1, label="true")
         for key, run in runs.items():
             ax.plot(sim.t, run.params[:, j], lw=0.8, label=key.upper())
         ax.set_ylabel(name)
+        ax.set_ylim(*limits[j])
         ax.legend(fontsize=7, loc="upper right")
     axes[-1].set_xlabel("t [s]")
     axes[0].set_title("Hallouzi 2008 §3.6.2: parameters from the weights (augmented EKF)")
