@@ -354,6 +354,8 @@ def dual_convex_filter(models: ConvexModelSet, y, u, x0, P0, mu0=None, lam: floa
     write_back = (form == "corrected") if write_back is None else write_back
     if constrain not in (True, False, "simplex", "affine", "box"):
         raise ModelError(f"constrain must be True/'simplex', 'affine', 'box' or False, got {constrain!r}")
+    if form == "thesis" and models.offset is not None:
+        raise ModelError("the printed weight step (2.33) has no offset term; use form='corrected' for limit-value sets")
     y, u = _check_data(models, y, u)
     N, n = models.N, models.n
     mu = np.full(N, 1.0 / N) if mu0 is None else models.check_weights(mu0)

@@ -135,15 +135,16 @@ def _covariance_projection(z: np.ndarray, P: np.ndarray, n: int, nonnegative: bo
     P = 0.5 * (P + P.T)
     if not nonnegative:
         return z, P
-    base, rows = z.copy(), [D[0]]
+    base, rows, fixed = z.copy(), [D[0]], set()
     for _ in range(N):
-        neg = np.flatnonzero(z[n:] < 0)
-        if neg.size == 0:
+        neg = [i for i in np.flatnonzero(z[n:] < 0) if i not in fixed]
+        if not neg:
             break
         for i in neg:
             e = np.zeros(n + N)
             e[n + i] = 1.0
             rows.append(e)
+            fixed.add(i)
         Dk = np.array(rows)
         d = np.zeros(len(rows))
         d[0] = 1.0
