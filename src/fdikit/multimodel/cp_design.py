@@ -189,7 +189,7 @@ def fit_enclosing_polytope(hull: np.ndarray, start: np.ndarray, n_vertices: int,
     V0 = np.asarray(start, dtype=float)
     k0 = V0.shape[1]
     if n_vertices < k0:
-        raise ValueError(f"n_vertices ({n_vertices}) must be at least the start's {k0} vertices")
+        raise DesignError(f"n_vertices ({n_vertices}) must be at least the {k0} vertices of the start polytope")
     centre = H.mean(axis=1, keepdims=True)
     scale = float(np.abs(H - centre).max()) or 1.0
     Hs, Vs = (H - centre) / scale, (V0 - centre) / scale
