@@ -17,10 +17,10 @@ import fdikit.decision.bnn as bnn_module
 from fdikit.decision.bnn import (
     BnnEvaluator,
     BnnNetwork,
-    GaussianMlEvaluator,
     quasi_newton,
     robbins_monro_steps,
 )
+from fdikit.decision.gaussian_ml import GaussianMlEvaluator
 from fdikit.errors import DataError, ModelError
 from fdikit.residuals import Residuals
 

@@ -5,8 +5,9 @@ Every evaluator has ``fit`` (fault-free or labelled residuals), ``run(residuals)
 previous decision) and ``reset()``.
 """
 
-from fdikit.decision.bnn import BnnEvaluator, GaussianMlEvaluator
+from fdikit.decision.bnn import BnnEvaluator
 from fdikit.decision.cusum import CusumEvaluator, cusum_arl, cusum_design
+from fdikit.decision.gaussian_ml import GaussianMlEvaluator
 from fdikit.decision.glr import GlrEvaluator, glr_threshold
 from fdikit.decision.mhsprt import MhsprtEvaluator
 from fdikit.decision.shiryayev import shiryayev_threshold

@@ -33,7 +33,8 @@ def path_evaluator_comparison(
     import numpy as np
 
     from fdikit.decision import CusumEvaluator, GlrEvaluator, SprtEvaluator, ThresholdEvaluator, Whitened
-    from fdikit.decision.bnn import BnnEvaluator, GaussianMlEvaluator
+    from fdikit.decision.bnn import BnnEvaluator
+    from fdikit.decision.gaussian_ml import GaussianMlEvaluator
     from fdikit.decision.mhsprt import MhsprtEvaluator
 
     bank = path_bank()
