@@ -27,7 +27,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 
 from fdikit.errors import DataError, ModelError
 from fdikit.lti import dlsim_blocked
@@ -123,7 +122,7 @@ class KalmanStep:
     valid: bool
 
 
-#: relative change of P(k+1|k) below which the batch runner switches to the steady-state filter
+#: relative change of P(k+1|k) below which the filter switches to the steady-state filter
 _SETTLED = 1e-14
 _TINY = 1e-300
 
@@ -322,16 +321,11 @@ def kalman_filter(model, u, y, x0, P0, *, form: str = "covariance", Q=None, R=No
     """
     kf = KalmanFilter(model, x0, P0, form=form, Q=Q, R=R)
     u, y = _check_record(u, y, kf.model.m, kf.model.p)
-    steps, settled = [], 0
+    steps = []
     for k, (uk, yk) in enumerate(zip(u, y, strict=True)):
-        P_before = kf.P
         steps.append(kf.step(uk, yk))
-        if form == "covariance":
-            change = np.abs(kf.P - P_before).max()
-            settled = settled + 1 if change <= _SETTLED * max(np.abs(kf.P).max(), _TINY) else 0
-            if settled >= 3 and k + 1 < len(y):
-                return _stack_results(_collect(steps, kf.model.n, kf.model.p),
-                                      _steady_run(kf, u[k + 1:], y[k + 1:]))
+        if kf._steady is not None and k + 1 < len(y):  # P(k+1|k) has settled (KalmanFilter._track_settling)
+            return _stack_results(_collect(steps, kf.model.n, kf.model.p), _steady_run(kf, u[k + 1:], y[k + 1:]))
     return _collect(steps, kf.model.n, kf.model.p)
 
 
@@ -345,10 +339,8 @@ def _steady_run(kf: KalmanFilter, u: np.ndarray, y: np.ndarray) -> KalmanResult:
     """
     m = kf.model
     n, p, N = m.n, m.p, y.shape[0]
-    B, D, P = m.B, m.D, kf.P
-    S = m.C @ P @ m.C.T + m.R
-    S = 0.5 * (S + S.T)
-    K = np.linalg.solve(S, m.C @ P).T
+    B, D = m.B, m.D
+    K, L_inv, const, P_filt, P, S = kf._steady
     IKC = np.eye(n) - K @ m.C
     A_f = m.A @ IKC
     B_f = np.hstack([B - m.A @ K @ D, m.A @ K])
@@ -357,10 +349,8 @@ def _steady_run(kf: KalmanFilter, u: np.ndarray, y: np.ndarray) -> KalmanResult:
     v = np.hstack([u.reshape(N, -1), y])
     out, states, x_end = dlsim_blocked(A_f, B_f, C_f, D_f, v, kf.x)
     e, x_filt = out[:, :p], out[:, p:]
-    L = np.linalg.cholesky(S)
-    w = scipy.linalg.solve_triangular(L, e.T, lower=True)
-    ll = -0.5 * (np.sum(w * w, axis=0) + p * np.log(2 * np.pi)) - np.sum(np.log(np.diag(L)))
-    P_filt = IKC @ P @ IKC.T + K @ m.R @ K.T
+    w = L_inv @ e.T
+    ll = const - 0.5 * np.sum(w * w, axis=0)
     kf.x = x_end
     return KalmanResult(
         x_filt=x_filt,
