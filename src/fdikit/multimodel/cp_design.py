@@ -76,6 +76,11 @@ def convex_weights(vertices, point) -> np.ndarray | None:
     return res.x[:k]
 
 
+def _barycentric(V: np.ndarray, X: np.ndarray) -> np.ndarray:
+    """Barycentric coordinates of the columns of ``X`` (d × K) in the simplex ``V`` (d × (d+1))."""
+    return np.linalg.solve(np.vstack([V, np.ones(V.shape[1])]), np.vstack([X, np.ones(X.shape[1])]))
+
+
 def _nnls_convex_weights(V: np.ndarray, X: np.ndarray) -> tuple[np.ndarray, float]:
     """Convex weights ``W ≥ 0``, ``1ᵀW = 1ᵀ`` with ``V W ≈ X`` by NNLS (sum row weighted 1e6); worst residual."""
     scale = 1e6 * max(1.0, float(np.abs(V).max()))
@@ -115,8 +120,9 @@ def cp_model_set(models, rank: int | None = None, min_gap: float = 10.0, n_verti
 
     With ``optimize`` (default) this simplex is the feasible start of a local minimisation of ``J_CP`` over
     ``n_vertices`` vertices (default ``d + 1``) subject to the enclosure (3.30)
-    (:func:`fit_enclosing_polytope`); the weights of the samples are then
-    found by LP.  If the optimiser loses the enclosure, the simplex is returned.
+    (:func:`fit_enclosing_polytope`); the weights of the samples are then barycentric (a simplex) or
+    non-negative least squares (more vertices).  If the optimiser loses the enclosure, the simplex is returned
+    (with more than ``d + 1`` vertices requested: :class:`DesignError`).
 
     Raises
     ------
@@ -136,8 +142,7 @@ def cp_model_set(models, rank: int | None = None, min_gap: float = 10.0, n_verti
     local = Ua[:, :d].T @ (coords - centre)  # d × N_ℓ coordinates in the affine hull
     _, _, piv = scipy.linalg.qr(np.vstack([local, np.ones(local.shape[1])]), mode="economic", pivoting=True)
     base = local[:, piv[: d + 1]]
-    T = np.vstack([base, np.ones(d + 1)])
-    lam = np.linalg.solve(T, np.vstack([local, np.ones(local.shape[1])]))  # barycentric, (d+1) × N_ℓ
+    lam = _barycentric(base, local)  # (d+1) × N_ℓ
     a = np.minimum(lam.min(axis=1), 0.0)
     bary = np.tile(a[:, None], (1, d + 1))
     np.fill_diagonal(bary, 1.0 - (a.sum() - a))
@@ -156,7 +161,7 @@ def cp_model_set(models, rank: int | None = None, min_gap: float = 10.0, n_verti
     if optimize or n_h > d + 1:
         V_opt, ok = fit_enclosing_polytope(hull_points, vertices_local, n_h)
         if n_h == d + 1:  # a simplex: barycentric coordinates, exact
-            w_opt = np.linalg.solve(np.vstack([V_opt, np.ones(n_h)]), np.vstack([local, np.ones(local.shape[1])]))
+            w_opt = _barycentric(V_opt, local)
             resid = max(0.0, -float(w_opt.min()))
             w_opt = np.clip(w_opt, 0.0, None)
         else:
@@ -181,8 +186,9 @@ def fit_enclosing_polytope(hull: np.ndarray, start: np.ndarray, n_vertices: int,
                            tol: float = 1e-10) -> tuple[np.ndarray, bool]:
     """Locally minimise ``J_CP`` (3.29) over ``n_vertices`` vertices enclosing the points ``hull`` (d × h).
 
-    ``start`` (d × k, k ≤ n_vertices) must enclose ``hull``; further vertices start at the hull point farthest
-    from the centroid with zero weight.  Returns ``(vertices, converged)``, the vertices d × n_vertices.
+    ``start`` (d × k, k ≤ n_vertices) must enclose ``hull``; further vertices start as copies of the start
+    vertices farthest from the hull, each taking the hull points on one side of the hull's principal direction.
+    Returns ``(vertices, converged)``, the vertices d × n_vertices.
     """
     H = np.asarray(hull, dtype=float)
     d, h = H.shape
