@@ -288,3 +288,17 @@ def test_observability_matrix_of_a_linear_system_is_the_kalman_matrix():
     O = np.vstack([C, C @ A, C @ A @ A])
     np.testing.assert_allclose(J, O, atol=1e-8)
     assert cond == pytest.approx(np.linalg.cond(O), rel=1e-6)
+
+
+def test_pair_observability_of_identical_models_is_singular():
+    """Two identical local models make the weight unobservable (cond = inf); distinct ones give a finite
+    condition number equal to the direct Jacobian's (3.7)–(3.9)."""
+    from fdikit.multimodel.model_set import pair_observability
+
+    A, B, C = np.array([[0.9, 0.2], [-0.1, 0.8]]), np.array([0.1, 0.3]), np.array([[1.0, 0.0]])
+    assert pair_observability((A, B), (A, B), C, [np.array([0.5, -0.2])], [0.3], [1.0]) == np.inf
+    A2 = A + 0.1
+    x, m = np.array([0.5, -0.2]), 0.3
+    step = lambda z, u: np.concatenate([z[2] * (A @ z[:2] + B * u[0]) + (1 - z[2]) * (A2 @ z[:2] + B * u[0]), z[2:]])  # noqa: E731
+    direct = observability_condition(step, lambda z: C @ z[:2], np.append(x, m), np.ones((2, 1)))[0]
+    assert pair_observability((A, B), (A2, B), C, [x], [m], [1.0]) == pytest.approx(direct, rel=1e-12)

@@ -39,6 +39,7 @@ __all__ = [
     "nearest_model",
     "minimum_mismatch_points",
     "observability_condition",
+    "pair_observability",
 ]
 
 
@@ -397,3 +398,29 @@ def observability_condition(step: Callable[[np.ndarray, np.ndarray], np.ndarray]
     sv = np.linalg.svd(J, compute_uv=False)
     cond = float(sv[0] / sv[-1]) if sv[-1] > 0 and sv.size >= n else float("inf")
     return cond, J
+
+
+def pair_observability(first, second, C, states, weights, u) -> float:
+    """Mean condition number (3.9) of the observability matrix of a 2-model MM along a state realization.
+
+    The MM is ``x⁺ = μ (A₁x + B₁u) + (1 − μ)(A₂x + B₂u)``, ``y = C x``, with the weight appended to the state as a
+    constant (``z = [x; μ]``, one free weight: research note §5 [GAP]); ``first``, ``second`` are ``(A, B)``;
+    ``states`` (K, n) and ``weights`` (K,) are the points ``(x_k, μ_k)`` where the matrix is evaluated; the
+    input ``u`` (m,) is held constant over the ``n`` steps of (3.8).  Used for Example 3.1 and Table 3.4.
+    """
+    (A1, B1), (A2, B2) = [(np.asarray(A, float), np.atleast_2d(np.asarray(B, float))) for A, B in (first, second)]
+    C = np.atleast_2d(np.asarray(C, float))
+    n = A1.shape[0]
+    u = np.atleast_1d(np.asarray(u, float))
+    B1 = B1.reshape(n, -1)
+    B2 = B2.reshape(n, -1)
+
+    def step(z, uk):
+        x, m = z[:n], z[n]
+        return np.concatenate([m * (A1 @ x + B1 @ uk) + (1 - m) * (A2 @ x + B2 @ uk), z[n:]])
+
+    U = np.tile(u, (n, 1))
+    conds = [observability_condition(step, lambda z: C @ z[:n], np.append(x, m), U)[0]
+             for x, m in zip(np.asarray(states, float), np.asarray(weights, float))]
+    return float(np.mean(conds))
+

@@ -25,7 +25,7 @@ import numpy as np
 import scipy.stats
 
 from fdikit.errors import ModelError
-from fdikit.multimodel.model_set import observability_condition
+from fdikit.multimodel.model_set import pair_observability
 
 __all__ = ["PAIRS", "Example31Result", "example_3_1_models", "example_3_1"]
 
@@ -94,18 +94,10 @@ def _pair_conditions(models, n_steps: int, samples: int) -> tuple[np.ndarray, np
     V = np.stack([_vec(*m) for m in models], axis=1)
     obs, basis = [], []
     for q, r in PAIRS:
-        (Aq, Bq), (Ar, Br) = models[q], models[r]
-
-        def step(z, u, Aq=Aq, Bq=Bq, Ar=Ar, Br=Br):
-            a = z[2]
-            return np.concatenate([a * (Aq @ z[:2] + Bq * u[0]) + (1 - a) * (Ar @ z[:2] + Br * u[0]), z[2:]])
-
         d = V[:, q] - V[:, r]
-        conds = []
-        for k in range(n_steps - samples, n_steps):
-            a = d @ (V @ W[k] - V[:, r]) / (d @ d)  # the affine pair weight closest to the true blend
-            conds.append(observability_condition(step, lambda z: _C @ z[:2], np.append(X[k], a), np.ones((2, 1)))[0])
-        obs.append(np.mean(conds))
+        ks = range(n_steps - samples, n_steps)
+        a = [d @ (V @ W[k] - V[:, r]) / (d @ d) for k in ks]  # the affine pair weight closest to the true blend
+        obs.append(pair_observability(models[q], models[r], _C, [X[k] for k in ks], a, [1.0]))
         basis.append(np.linalg.cond(V[:, [q, r]]))
     return np.array(obs), np.array(basis)
 

@@ -36,8 +36,8 @@ from fdikit.multimodel.convex_ekf import augmented_ekf
 from fdikit.multimodel.model_set import (
     first_order_discretize,
     minimum_mismatch_points,
-    observability_condition,
     od_model_set,
+    pair_observability,
     unvectorize,
 )
 from fdikit.plants.msd import MSD_SAMPLE_TIME, msd_matrices, msd_model_vectors, msd_parameter_grid
@@ -282,20 +282,13 @@ class ObservabilityComparison:
 def _pair_observability(m3_pair, m3_seq, dt: float, samples: int) -> float:
     mats = [msd_matrices(m3=m, allow_outside=True) for m in m3_pair]
     (A1, B1), (A2, B2) = (first_order_discretize(A, B, dt) for A, B, _ in mats)
-    C = mats[0][2]
-
-    def step(z, u):  # z = [x; μ1], μ2 = 1 − μ1, constant weight (research note §5 [GAP])
-        x, m = z[:6], z[6]
-        return np.concatenate([m * (A1 @ x + B1 @ u) + (1 - m) * (A2 @ x + B2 @ u), z[6:]])
-
-    u, x, conds = np.ones(2), np.zeros(6), []
     inv_a, inv_b = 1.0 / m3_pair[0], 1.0 / m3_pair[1]
-    for k, m3 in enumerate(m3_seq):
-        z = np.concatenate([x, [(1.0 / m3 - inv_b) / (inv_a - inv_b)]])  # affine weight giving the true 1/m3
-        if k >= len(m3_seq) - samples:
-            conds.append(observability_condition(step, lambda z: C @ z[:6], z, np.ones((6, 2)))[0])
-        x = step(z, u)[:6]
-    return float(np.mean(conds))
+    mu = (1.0 / np.asarray(m3_seq) - inv_b) / (inv_a - inv_b)  # affine weight giving the true 1/m3
+    u, x, states = np.ones(2), np.zeros(6), []
+    for m in mu:
+        states.append(x)
+        x = m * (A1 @ x + B1 @ u) + (1 - m) * (A2 @ x + B2 @ u)
+    return pair_observability((A1, B1), (A2, B2), mats[0][2], states[-samples:], mu[-samples:], u)
 
 
 def msd_observability_comparison(realizations: int = 5, seed: int | None = 0, *, n_steps: int = 2000,
