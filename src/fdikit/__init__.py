@@ -1,7 +1,7 @@
 """fdikit: model-based fault detection, isolation and fault-tolerant control."""
 
-from fdikit.errors import DataError, DesignError, FdiError, ModelError
+from fdikit.errors import DataError, DesignError, FdiError, FdiWarning, ModelError, ParameterError
 from fdikit.model import FaultModel
 
-__all__ = ["FaultModel", "FdiError", "ModelError", "DesignError", "DataError"]
+__all__ = ["FaultModel", "FdiError", "ModelError", "DesignError", "DataError", "ParameterError", "FdiWarning"]
 __version__ = "0.1.0"

@@ -1,13 +1,26 @@
-"""Exceptions raised by fdikit.
+"""Exceptions and warnings raised by fdikit.
 
 Every message says what was wrong and how to fix it (scipy style).
 
 ``FdiError`` is the root; catch it to catch everything fdikit raises on purpose.
+
+========================  ==========================================================
+class                     raised for
+========================  ==========================================================
+``ModelError``            a malformed model: shapes, duplicate/unknown names, non-finite entries
+``DesignError``           a synthesis specification that cannot be met (with the numbers)
+``DataError``             unusable data: non-finite samples, gaps, signals that do not match,
+                          malformed or corrupted files
+``ParameterError``        a bad argument: wrong type, out of range, unknown method name
+========================  ==========================================================
+
+``FdiWarning`` is the category of every warning fdikit issues (for example a fault whose
+onset lies after the end of the run).
 """
 
 from __future__ import annotations
 
-__all__ = ["FdiError", "ModelError", "DesignError", "DataError"]
+__all__ = ["FdiError", "ModelError", "DesignError", "DataError", "ParameterError", "FdiWarning"]
 
 
 class FdiError(Exception):
@@ -23,4 +36,12 @@ class DesignError(FdiError):
 
 
 class DataError(FdiError, ValueError):
-    """Data are unusable: NaN/inf, gaps, missing or unexpected signals in a trace."""
+    """Data are unusable: NaN/inf, gaps, missing or unexpected signals, malformed or corrupted files."""
+
+
+class ParameterError(FdiError, ValueError):
+    """An argument is unusable: wrong type, out of range, unknown option or method name."""
+
+
+class FdiWarning(UserWarning):
+    """A result is computed but probably not what was meant (the message says why)."""
