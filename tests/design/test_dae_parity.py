@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import inspect
+
 import control
 import numpy as np
 import pytest
@@ -20,6 +22,7 @@ from fdikit.design.dae_parity import (
 )
 from fdikit.errors import DesignError, ModelError
 from fdikit.faults import Bias, FaultScenario, ScaleFactor
+from fdikit.lti import dlsim_blocked
 from fdikit.plants.single_track import single_track, single_track_lpv
 from fdikit.simulate import simulate, time_grid
 
@@ -170,11 +173,62 @@ def _lfilter_G(d, f):
     return scipy.signal.lfilter(b, d.denominator[::-1], f)
 
 
+def _rounding_bound(d, model, trace, f, mask):
+    """First-order bound on the round-off of the residual of ``trace`` on the samples ``mask``.
+
+    The residual is a small difference of large terms: over the open-loop run the lateral error drifts
+    to ~1.3e3 m while ``r`` stays ~1e-3.  Both the plant simulation and the generator run through the
+    lifted solver :func:`fdikit.lti.dlsim_blocked`, whose longest inner product has ``K = n + M m`` terms
+    (block ``M``), so every computed sample carries an error of at most ``γ_K = K ε / (1 − K ε)`` relative
+    to the sum of the absolute values of its terms (Higham, *Accuracy and Stability*, Lemma 3.1/3.5).
+    From ``N(q) H(q) = 0`` (2.8a) those errors reach ``r`` only through stable maps:
+
+    - an output error ``δy`` (and the plant states the outputs read) through the generator
+      ``d⁻¹ N L`` itself: gain ``Σ_j ‖h_j‖₁ max|v_j|`` over its inputs ``v = [u, y]``;
+    - a state error injected by a step of the plant recursion, of size ``γ_K (|A||x| + |B||v|)``,
+      through ``−d⁻¹ N_x(q)`` (the state rows of ``N``); an error carried on along a trajectory
+      of the plant is a free response, which the parity row annihilates.
+
+    ``ℓ₁`` impulse-response norms are the ``ℓ∞ → ℓ∞`` gains, so the bound is ``γ_K (κ_y + κ_x)`` with
+    ``κ`` these two gain-weighted magnitudes on ``mask`` — the condition of the residual computation,
+    growing with the horizon through the drifting states.  No kernel-specific number enters it.
+    """
+    g = d.generator
+    eps = np.finfo(float).eps
+    block = inspect.signature(dlsim_blocked).parameters["block"].default
+    K = max(g.n + block * g.B.shape[1], model.n + block * model.B.shape[1])
+    gamma = K * eps / (1 - K * eps)
+    t_len = trace.t.size
+    impulse = np.zeros(t_len)
+    impulse[0] = 1.0
+    v = g.inputs_from(trace)
+    kappa_y = 0.0
+    for j in range(v.shape[1]):
+        h = dlsim_blocked(g.A, g.B[:, [j]], g.C, g.D[:, [j]], impulse[:, None])[0]
+        kappa_y += np.abs(h).sum() * np.abs(v[mask, j]).max()
+    n = d.denominator.size - 1
+    terms = (np.abs(trace.x) @ np.abs(model.A).T + np.abs(trace.u) @ np.abs(model.Bu).T
+             + np.abs(trace.d) @ np.abs(model.Bd).T + np.abs(f)[:, None] @ np.abs(model.Bf).T)
+    kappa_x = 0.0
+    for i in range(model.n):
+        b = np.zeros(n + 1)
+        b[n - d.N.shape[0] + 1 :] = d.N[::-1, i]
+        h = scipy.signal.lfilter(b, d.denominator[::-1], impulse[:t_len])
+        kappa_x += np.abs(h).sum() * terms[mask, i].max()
+    return gamma * (kappa_y + kappa_x)
+
+
 def test_simulation_checklist_7():
     """S1 (Sec. 4-3-1, Fig. 4-3) at 70 km/h: κ = 1/350 m⁻¹ and a 2° bank at 15 s, f_a = 0.1° at 30 s, f_m = 0.9 at 50 s.
 
     The disturbances are rejected to round-off, r → f_a after the offset step (DC gain 1), and over
     the whole run r = G(q)[(f_m − 1) δ_set + f_a] (4.10), computed independently by lfilter.
+
+    "Round-off" is the bound of :func:`_rounding_bound`, derived from the conditioning of the
+    residual computation on the drifting open-loop states (no kernel-tuned constant): ≈1.3e-11 before
+    30 s, ≈6.7e-11 up to 50 s and ≈1.6e-10 over the whole run (lateral error up to 1.3e3 m), i.e.
+    r = G f holds to 1e-7 of f_a.  Measured errors are 1e-13 to 2e-12 depending on the OpenBLAS
+    kernel (Prescott, Haswell, SkylakeX), of the order of the note's "f_a to 1e-12" (§5.6).
     """
     d = parity_filter(M70)
     t = time_grid(70.0, H)
@@ -185,13 +239,15 @@ def test_simulation_checklist_7():
     trace = simulate(M70, scenario, t=t, u=u, d=dist)
     r = d.generator.run(trace).r[:, 0]
     assert np.abs(trace.y[:, 1]).max() > 100  # the open-loop lateral error drifts by > 100 m: rejection is no accident
-    assert np.abs(r[t < 30]).max() <= 1e-12
-    settled = (t >= 35) & (t < 50)
-    assert np.abs(r[settled] - fa).max() <= 1e-12  # note §5.6: "equals f_a = 0.1 deg to 1e-12"
     f = np.where(t >= 30, fa, 0.0) + np.where(t >= 50, -0.1 * u, 0.0)
-    np.testing.assert_allclose(r, _lfilter_G(d, f), rtol=0, atol=1e-9 * fa)
+    before, settled = t < 30, (t >= 35) & (t < 50)
+    assert np.abs(r[before]).max() <= _rounding_bound(d, M70, trace, f, before)
+    assert np.abs(r[settled] - fa).max() <= _rounding_bound(d, M70, trace, f, t < 50)
+    whole = _rounding_bound(d, M70, trace, f, np.ones(t.size, bool))
+    assert whole <= 1e-7 * fa  # the bound is tight enough for the check below to mean r = G f
+    np.testing.assert_allclose(r, _lfilter_G(d, f), rtol=0, atol=whole)
     online = d.generator.online().run(trace).r[:, 0]
-    np.testing.assert_allclose(online, r, rtol=0, atol=1e-12)  # round-off grows with the drifting states
+    np.testing.assert_allclose(online, r, rtol=0, atol=2 * whole)  # two evaluations, each within the bound
 
 
 def test_nonminimal_degree_takes_least_norm_row():
