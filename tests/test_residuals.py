@@ -1,7 +1,7 @@
 """ResidualGenerator: batch vs online, convergence, internal form, continuous filters, bad data.
 
 Oracles: the observer error dynamics written out by hand, ``scipy.signal.dlsim`` and
-``scipy.signal.cont2discrete``, and the sample-skipping semantics of the online stepper.
+``scipy.signal.cont2discrete``, and the model itself for the gap rule (open-loop propagation through invalid samples).
 """
 
 from __future__ import annotations
@@ -190,47 +190,71 @@ def _with_nans(tr: Trace) -> Trace:
                  fault=tr.fault, meta=tr.meta)
 
 
-def test_run_rejects_nan_naming_signal_and_sample():
-    model = _model()
-    gen = _designs(model)["kalman"].generator
-    bad = _with_nans(_trace(model))
-    with pytest.raises(DataError, match=r"signal 'b' is not finite at sample 50 \(t=2\.5\)"):
-        gen.run(bad)
-
-
-def test_online_survives_bad_samples_and_holds_state():
+def test_run_handles_gaps_exactly_like_online():
+    """Batch and online give the same residuals and flags on a trace with bad samples (gap rule)."""
     model = _model()
     gen = _designs(model)["kalman"].generator
     clean = _trace(model)
     bad = _with_nans(clean)
+    batch = gen.run(bad)
     stepper = gen.online()
-    res = stepper.run(bad)
+    online = stepper.run(bad)
     bad_k = [50, 70, 71]
-    assert np.isnan(res.r[bad_k]).all()
-    expect_valid = np.ones(len(bad), bool)
-    expect_valid[bad_k] = False
-    np.testing.assert_array_equal(res.valid, expect_valid)
+    assert np.isnan(batch.r[bad_k]).all() and np.isnan(online.r[bad_k]).all()
     assert stepper.invalid == 3
-    assert np.isfinite(res.r[expect_valid]).all()
-    # before the first gap: the same as the clean run
-    _relclose(res.r[:50], gen.run(clean).r[:50])
-    # holding the state = skipping the sample: equal to a run on the trace without the bad samples
-    keep = expect_valid
-    skipped = Trace(t=clean.t[keep], u=clean.u[keep], y=clean.y[keep], controls=clean.controls, outputs=clean.outputs)
-    _relclose(res.r[keep], gen.run(skipped).r)
-    ref = gen.online()
-    _relclose(res.r[keep], np.array([ref.step(skipped.u[k], skipped.y[k]) for k in range(len(skipped))]))
-    # one bad step, then a good one: last_valid follows the sample
+    np.testing.assert_array_equal(batch.valid, online.valid)
+    np.testing.assert_array_equal(batch.recovering, online.recovering)
+    finite = np.isfinite(batch.r).all(axis=1)
+    np.testing.assert_array_equal(finite, ~np.isin(np.arange(len(bad)), bad_k))
+    _relclose(batch.r[finite], online.r[finite], rel=1e-10)
+    # before the first gap: the clean run; recovering samples are finite but not valid
+    _relclose(batch.r[:50], gen.run(clean).r[:50])
+    assert batch.valid[:50].all() and not batch.valid[bad_k].any()
+    assert np.isfinite(batch.r[batch.recovering]).all() and not batch.valid[batch.recovering].any()
+    assert not batch.recovering[bad_k].any()
+
+
+def test_gap_propagates_the_model_open_loop():
+    """For an observer r = y − C x̂ − D u the gap rule feeds ŷ: the state follows x̂+ = A x̂ + B u (the model)."""
+    model = _model()
+    gen = _designs(model)["kalman"].generator
+    assert np.allclose(gen.C, -model.C)  # the generator's state is x̂
+    clean = _trace(model)
     st = gen.online()
-    assert np.isnan(st.step([np.nan, 0.5], [0.0, 0.0, 0.0])).all() and not st.last_valid
-    assert np.isfinite(st.step([0.1, 0.5], [0.0, 0.0, 0.0])).all() and st.last_valid
-    np.testing.assert_array_equal(st.x, gen.B @ np.array([0.1, 0.5, 0.0, 0.0, 0.0]))  # state held through the gap
-    # a NaN in a signal the generator does not read is no bad sample
+    for k in range(30):
+        st.step(clean.u[k], clean.y[k])
+    x = st.x.copy()
+    u = clean.u[30]
+    assert np.isnan(st.step(u, [np.nan] * 3)).all() and not st.last_valid
+    np.testing.assert_allclose(st.x, model.A @ x + model.Bu @ u, rtol=1e-12, atol=1e-12)
+    # only output 'b' missing: it is replaced by its prediction, 'a' and 'c' are used
+    x = st.x.copy()
+    u, y = clean.u[31], clean.y[31].copy()
+    y_hat = model.C @ x + model.Du @ u
+    y_fed = y.copy()
+    y_fed[1] = y_hat[1]
+    ref = gen.online(x0=x)
+    ref.step(u, y_fed)
+    y[1] = np.nan
+    st.step(u, y)
+    np.testing.assert_allclose(st.x, ref.x, rtol=1e-12, atol=1e-12)
+    # a missing control is held at its last valid value
+    x = st.x.copy()
+    ref = gen.online(x0=x)
+    ref.step(clean.u[31], clean.y[32])
+    st.step([np.nan, np.nan], clean.y[32])
+    np.testing.assert_allclose(st.x, ref.x, rtol=1e-12, atol=1e-12)
+
+
+def test_nan_in_unread_signal_is_no_bad_sample():
+    model = _model()
+    gen = _designs(model)["kalman"].generator
+    clean = _trace(model)
     spare = np.full((len(clean), 1), np.nan)
     extra = Trace(t=clean.t, u=np.hstack([clean.u, spare]), y=clean.y, controls=clean.controls + ("spare",),
                   outputs=clean.outputs)
     _relclose(gen.run(extra).r, gen.run(clean).r)
-    assert gen.online().run(extra).valid.all()
+    assert gen.online().run(extra).valid.all() and gen.run(extra).valid.all()
 
 
 def test_step_with_wrong_vector_length():
@@ -265,8 +289,10 @@ def test_missing_signal_in_trace():
     gen = _designs(_model())["observer"].generator
     tr = _trace(_model())
     slim = Trace(t=tr.t, u=tr.u, y=tr.y[:, :2], controls=tr.controls, outputs=["a", "b"])
-    with pytest.raises(DataError, match=r"no y-signal named 'c'"):
+    with pytest.raises(DataError, match=r"missing outputs \['c'\]"):
         gen.run(slim)
+    with pytest.raises(DataError, match=r"missing outputs \['c'\]"):
+        gen.online().run(slim)
 
 
 # ---------------------------------------------------------------------------------------------- containers
@@ -303,6 +329,6 @@ def test_residuals_container():
     np.testing.assert_array_equal(part.t, [1.0, 1.5, 2.0, 2.5])
     np.testing.assert_array_equal(part.r, res.r[2:6])
     df = res.to_pandas()
-    assert list(df.columns) == ["r1", "r2", "valid"] and df["valid"].all()
+    assert list(df.columns) == ["r1", "r2", "valid", "recovering"] and df["valid"].all() and not df["recovering"].any()
     with pytest.raises(DataError, match=r"residuals have shape \(10, 2\), need \(10, 3\)"):
         Residuals(t, res.r, ["a", "b", "c"], ())

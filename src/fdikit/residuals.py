@@ -7,22 +7,25 @@ controls ``u`` and the measurements ``y`` named in its ``controls`` and ``output
     r  = C z + D [u; y]
 
 ``run(trace)`` processes a whole :class:`~fdikit.trace.Trace` at once (a blocked,
-vectorised recursion); ``online()`` returns a :class:`ResidualStepper` whose
-``step(u, y)`` gives the same residuals one sample at a time and survives bad
-samples.  ``internal_form(model)`` is Varga's internal form ``R``: the
+vectorised recursion between gaps); ``online()`` returns a :class:`ResidualStepper` whose
+``step(u, y)`` gives the same residuals one sample at a time.  Both follow one gap rule
+for invalid (NaN/inf) samples: the filter is propagated with the model and the inputs
+through the gap and the samples after it are marked *recovering* (not valid for
+decisions) until the gap transient has decayed below the noise (:class:`ResidualStepper`
+gives the rule and its derivation).  ``internal_form(model)`` is Varga's internal form ``R``: the
 interconnection of the plant model and the filter, from ``(u, d, f, w)`` to ``r``,
 so decoupling is a number, not a plot.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg
 
-from fdikit.errors import DataError, ModelError
+from fdikit.errors import DataError, ModelError, ParameterError
 from fdikit.lti import dlsim_blocked
 from fdikit.model import GROUPS, FaultModel
 from fdikit.trace import Trace
@@ -38,7 +41,10 @@ class Residuals:
     ----------
     t : (N,) times; r : (N, q) residuals (NaN on invalid samples); names : residual names;
     isolates : per residual, the fault it is tied to (None = detection only);
-    valid : (N,) bool, False where the input sample was bad and the filter held its state.
+    valid : (N,) bool, True where the residuals may be used for decisions: False on an invalid
+        input sample (``r`` NaN) and on the *recovering* samples after a gap;
+    recovering : (N,) bool, True on the finite samples after a gap whose gap transient has not yet
+        decayed below the noise (see :class:`ResidualStepper`); these are also not ``valid``.
     """
 
     t: np.ndarray
@@ -47,6 +53,7 @@ class Residuals:
     isolates: tuple[str | None, ...]
     valid: np.ndarray | None = None
     meta: dict = field(default_factory=dict)
+    recovering: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         r = np.atleast_2d(np.asarray(self.r, dtype=float))
@@ -60,8 +67,13 @@ class Residuals:
         if len(isolates) != len(self.names):
             raise DataError(f"{len(isolates)} 'isolates' entries for {len(self.names)} residuals")
         object.__setattr__(self, "isolates", isolates)
-        valid = np.ones(t.size, bool) if self.valid is None else np.asarray(self.valid, bool)
+        valid = np.ones(t.size, bool) if self.valid is None else np.asarray(self.valid, bool).ravel()
+        rec = np.zeros(t.size, bool) if self.recovering is None else np.asarray(self.recovering, bool).ravel()
+        if valid.shape != t.shape or rec.shape != t.shape:
+            raise DataError(f"residuals 'valid'/'recovering' flags have {valid.size}/{rec.size} entries for "
+                            f"{t.size} samples")
         object.__setattr__(self, "valid", valid)
+        object.__setattr__(self, "recovering", rec)
 
     def __len__(self) -> int:
         return self.t.size
@@ -73,13 +85,15 @@ class Residuals:
             mask &= self.t >= start
         if stop is not None:
             mask &= self.t < stop
-        return Residuals(self.t[mask], self.r[mask], self.names, self.isolates, self.valid[mask], dict(self.meta))
+        return Residuals(self.t[mask], self.r[mask], self.names, self.isolates, self.valid[mask], dict(self.meta),
+                         self.recovering[mask])
 
     def to_pandas(self):
         import pandas as pd
 
         df = pd.DataFrame(self.r, columns=list(self.names), index=pd.Index(self.t, name="t"))
         df["valid"] = self.valid
+        df["recovering"] = self.recovering
         return df
 
 
@@ -165,30 +179,116 @@ class ResidualGenerator:
         self._check_dt(dt)
         return self
 
+    def check_trace(self, trace: Trace) -> None:
+        """Raise :class:`DataError` unless ``trace`` holds every signal this generator reads, in its group.
+
+        The message names the missing signals (and, for a signal found in the other group, where it is),
+        and the signals of the trace that could have been meant.  Signals of the trace that the generator
+        does not read are allowed (a generator of a bank reads a subset).
+        """
+        if not isinstance(trace, Trace):
+            raise DataError(f"trace must be a fdikit.trace.Trace, got {type(trace).__name__}")
+        _check_signals(trace, self.controls, self.outputs)
+
     def inputs_from(self, trace: Trace) -> np.ndarray:
         """The (N, m + p) block ``[u, y]`` this generator reads, taken from a trace by name."""
+        self.check_trace(trace)
         return np.hstack([trace.columns("u", self.controls), trace.columns("y", self.outputs)])
 
-    def run(self, trace: Trace, x0: np.ndarray | None = None) -> Residuals:
-        """Residuals of a whole trace (vectorised).  NaN/inf in the used signals raise :class:`DataError`."""
-        v = self.inputs_from(trace)
-        bad = np.argwhere(~np.isfinite(v))
-        if bad.size:
-            k, j = bad[0]
-            name = (self.controls + self.outputs)[j]
-            raise DataError(
-                f"signal {name!r} is not finite at sample {k} (t={trace.t[k]:g}); run() needs clean data — "
-                "clean the trace, or use online().step(), which skips bad samples"
-            )
-        g = self._for_dt(trace.dt)
-        r, _, _ = dlsim_blocked(g.A, g.B, g.C, g.D, v, x0)
-        return Residuals(trace.t, r, self.residuals, self.isolates, meta={"trace": dict(trace.meta)})
+    def run(
+        self, trace: Trace, x0: np.ndarray | None = None, *, residual_cov=None, recovery_tol: float = 0.1
+    ) -> Residuals:
+        """Residuals of a whole trace, vectorised between gaps; identical to ``online().run(trace)``.
 
-    def online(self, x0: np.ndarray | None = None, dt: float | None = None) -> ResidualStepper:
-        """A stepper for sample-by-sample use; a continuous generator needs ``dt``."""
+        A sample with a NaN/inf in a signal the generator reads is *invalid*: its residuals are NaN
+        and the filter is propagated through it by the gap rule of :class:`ResidualStepper` (model
+        prediction of the missing measurements, last value of a missing control).  The samples after
+        a gap are *recovering* (finite residuals, ``valid`` False, ``recovering`` True) until the gap
+        transient has decayed below ``recovery_tol`` noise standard deviations.  Stretches of valid
+        samples are processed by the blocked recursion of :func:`fdikit.lti.dlsim_blocked`; only the
+        invalid samples and the recovery bookkeeping are stepped one by one.
+
+        Parameters
+        ----------
+        trace : Trace
+            Must hold the generator's controls and outputs (see :meth:`check_trace`) at the
+            generator's ``dt``.
+        x0 : array_like, optional
+            Initial filter state (default zeros).
+        residual_cov : array_like, optional
+            Covariance (or only its shape: any positive multiple gives the same result) of the
+            fault-free residuals, used to decide when a gap transient is "below the noise";
+            default the identity (equal, uncorrelated residual noise).
+        recovery_tol : float
+            A recovering sample becomes valid when the standard deviation of the gap transient in
+            every residual is at most ``recovery_tol`` times that residual's noise standard deviation.
+
+        Raises
+        ------
+        DataError
+            On missing signals or a sample time different from the generator's.
+        ParameterError
+            On a bad ``x0``, ``residual_cov`` or ``recovery_tol``.
+        """
+        v = self.inputs_from(trace)
+        if len(trace) > 1:
+            g = self._for_dt(trace.dt)
+        elif self.dt is None:
+            raise DataError("a continuous generator needs a trace of at least 2 samples (its sample time)")
+        else:
+            g = self
+        x0 = _state0(g, x0)
+        ok_ch = np.isfinite(v)
+        ok = ok_ch.all(axis=1)
+        meta = {"trace": dict(trace.meta)}
+        if ok.all():
+            r, _, _ = dlsim_blocked(g.A, g.B, g.C, g.D, v, x0)
+            _GapRule(g, residual_cov, recovery_tol)  # validates the options alike on clean data
+            return Residuals(trace.t, r, self.residuals, self.isolates, meta=meta)
+        rule = _GapRule(g, residual_cov, recovery_tol)
+        N, q = v.shape[0], len(self.residuals)
+        r = np.full((N, q), np.nan)
+        valid = np.zeros(N, bool)
+        recovering = np.zeros(N, bool)
+        bad_idx = np.flatnonzero(~ok)
+        last = np.zeros(v.shape[1])
+        x = x0
+        rec = _Recovery(rule)
+        k = 0
+        while k < N:
+            if ok[k]:
+                nxt = bad_idx[np.searchsorted(bad_idx, k)] if bad_idx[-1] > k else N
+                r[k:nxt], _, x = dlsim_blocked(g.A, g.B, g.C, g.D, v[k:nxt], x)
+                i = k
+                while i < nxt and rec.active:
+                    valid[i] = rec.valid_sample()
+                    recovering[i] = not valid[i]
+                    i += 1
+                valid[i:nxt] = True
+                last = v[nxt - 1].copy()
+                k = nxt
+            else:
+                x = rule.propagate(x, v[k], ok_ch[k], last)
+                last[ok_ch[k]] = v[k, ok_ch[k]]
+                rec.invalid_sample(ok_ch[k])
+                k += 1
+        return Residuals(trace.t, r, self.residuals, self.isolates, valid, meta=meta, recovering=recovering)
+
+    def online(
+        self, x0: np.ndarray | None = None, dt: float | None = None, *, residual_cov=None, recovery_tol: float = 0.1
+    ) -> ResidualStepper:
+        """A stepper for sample-by-sample use (same gap rule and options as :meth:`run`).
+
+        A continuous generator needs ``dt`` (it is then ZOH-discretised); a discrete one accepts
+        only its own ``dt``.
+        """
         if self.dt is None and dt is None:
             raise ModelError("a continuous residual generator needs dt= to run online")
-        return ResidualStepper(self if dt is None else self._for_dt(dt), x0)
+        number = isinstance(dt, (int, float, np.floating, np.integer)) and not isinstance(dt, bool)
+        if dt is not None and not (number and np.isfinite(dt) and dt > 0):
+            raise ParameterError(f"dt must be a positive number of seconds, got {dt!r}")
+        g = self if dt is None else self._for_dt(float(dt))
+        return ResidualStepper(g, x0, residual_cov=residual_cov, recovery_tol=recovery_tol)
 
     def internal_form(self, model: FaultModel) -> FaultModel:
         """The plant model and this filter in series: a FaultModel from ``(u, d, f, w)`` to ``r``.
@@ -237,56 +337,332 @@ class ResidualGenerator:
                           inputs=list(self.controls) + list(self.outputs), outputs=list(self.residuals))
 
 
-class ResidualStepper:
-    """Online residual generation, one sample at a time.
+def _check_signals(trace: Trace, controls: Sequence[str], outputs: Sequence[str]) -> None:
+    """:class:`DataError` naming the controls/outputs a trace lacks (and where a misplaced one is)."""
+    problems = []
+    for kind, want, have, other, other_kind in (
+        ("control", controls, trace.controls, trace.outputs, "output"),
+        ("output", outputs, trace.outputs, trace.controls, "control"),
+    ):
+        missing = [nm for nm in want if nm not in have]
+        if missing:
+            moved = [nm for nm in missing if nm in other]
+            text = f"missing {kind}s {missing}"
+            if moved:
+                text += f" ({moved} found as {other_kind}s)"
+            extra = [nm for nm in have if nm not in want]
+            if extra:
+                text += f"; the trace's {kind}s not read: {extra}"
+            problems.append(text)
+    if problems:
+        raise DataError(
+            "the trace does not match the generator's signals: " + "; ".join(problems)
+            + f". The generator reads controls {list(controls)} and outputs {list(outputs)}; rename the "
+            "trace's columns or use the generator designed for this plant"
+        )
 
-    ``step(u, y)`` returns the residual vector of the current sample.  A sample with a
-    NaN/inf in the used signals gives NaN residuals, is counted in ``invalid`` and leaves
-    the filter state unchanged (the filter holds its state through the gap).
+
+def _state0(g: ResidualGenerator, x0) -> np.ndarray:
+    if x0 is None:
+        return np.zeros(g.n)
+    try:
+        x = np.asarray(x0, dtype=float).ravel()
+    except (TypeError, ValueError) as exc:
+        raise ParameterError(f"x0 must be {g.n} numbers (the filter state), got {x0!r}") from exc
+    if x.size != g.n:
+        raise ParameterError(f"x0 has {x.size} entries, the filter has {g.n} states")
+    if not np.all(np.isfinite(x)):
+        raise ParameterError("x0 has non-finite entries; the initial filter state must be finite")
+    return x.copy()
+
+
+class _GapRule:
+    """The gap rule of one discrete generator (shared by ``run`` and the stepper, so both agree).
+
+    The filter ``z+ = A z + B_u u + B_y y``, ``r = C z + D_u u + D_y y`` is split into its
+    independent parts (connected components of the states and residuals through ``A`` and ``C``;
+    a stacked bank gives one per filter).  On a sample where the outputs ``b`` are invalid, each
+    part ``c`` is fed ``y_b = −(D_{y,cb})⁺ (C_c z_c + D_{u,c} u + D_{y,c,good} y_good) + Π_c y_b,last``:
+    the least-squares choice that makes the part's residuals closest to zero (exactly zero when
+    ``D_{y,cb}`` has full column rank, as for an observer ``r = y − ŷ``, where it is the predicted
+    output: open-loop model propagation), and in the directions the part's feedthrough does not
+    see (``Π_c = I − D⁺D``) the last valid value.  An invalid control is held at its last valid
+    value (0 before any).  The deviation ``δ`` of the filter state from the one the true samples
+    would have given obeys, with ``e`` the fault-free residual,
+
+        δ+ = (A − B_b D⁺ C) δ − B_b D⁺ e     (invalid sample),      δ+ = A δ     (valid sample),
+
+    and the residual transient is ``C δ``.  :class:`_Recovery` propagates ``P = Cov δ`` with
+    ``Cov e = residual_cov`` and keeps the samples after a gap "recovering" while
+    ``diag(C P Cᵀ) > tol² diag(residual_cov)``.  Parts fed a held value (not predicted) add an
+    error the filter matrices cannot bound; for them the recovery lasts at least
+    ``ceil(log tol / log ρ(A))`` samples (the filter forgetting its state by the factor ``tol``).
     """
 
-    def __init__(self, generator: ResidualGenerator, x0: np.ndarray | None = None) -> None:
+    def __init__(self, g: ResidualGenerator, residual_cov, tol) -> None:
+        if isinstance(tol, bool) or not isinstance(tol, (int, float, np.integer, np.floating)):
+            raise ParameterError(f"recovery_tol must be a number in (0, 1], got {tol!r}")
+        if not (np.isfinite(tol) and 0 < tol <= 1):
+            raise ParameterError(f"recovery_tol must be in (0, 1] (a fraction of the noise std), got {tol!r}")
+        q = len(g.residuals)
+        if residual_cov is None:
+            S = np.eye(q)
+        else:
+            try:
+                S = np.atleast_2d(np.asarray(residual_cov, dtype=float))
+            except (TypeError, ValueError) as exc:
+                raise ParameterError(f"residual_cov must be a {q}x{q} covariance matrix, got {residual_cov!r}") from exc
+            if S.shape == (1, q) and q > 1:
+                S = np.diag(S[0])
+            if S.shape != (q, q) or not np.all(np.isfinite(S)) or not np.allclose(S, S.T, rtol=1e-10, atol=0):
+                raise ParameterError(f"residual_cov must be a finite symmetric {q}x{q} matrix (residuals "
+                                     f"{list(g.residuals)}), got shape {S.shape}")
+            if q and not np.all(np.diag(S) > 0):
+                raise ParameterError("residual_cov must have a positive diagonal (every residual has noise)")
+        self.g, self.S, self.tol = g, S, float(tol)
+        self.limit = self.tol**2 * np.diag(S)
+        self.mu = len(g.controls)
+        n = g.n
+        rho = float(np.max(np.abs(np.linalg.eigvals(g.A)))) if n else 0.0
+        self.rho = rho
+        self.settle = 0 if n == 0 else (1 if rho == 0 else (
+            int(np.ceil(np.log(self.tol) / np.log(rho))) if rho < 1 else -1))
+        self.parts = _components(g.A, g.C)
+        self._AT = g.A.T.copy()
+        self._cache: dict[bytes, tuple] = {}
+
+    def pattern(self, ok_ch: np.ndarray) -> tuple:
+        """Per pattern of valid channels: per part (states, rows, M⁺, Π), the δ-matrices (T, Q) and "held"."""
+        key = ok_ch.tobytes()
+        hit = self._cache.get(key)
+        if hit is not None:
+            return hit
+        g, mu = self.g, self.mu
+        bad_y = np.flatnonzero(~ok_ch[mu:])
+        bad_u = np.flatnonzero(~ok_ch[:mu])
+        good_y = np.flatnonzero(ok_ch[mu:])
+        n, q = g.n, len(g.residuals)
+        T = g.A.copy()
+        G = np.zeros((n, q))
+        held = bool(bad_u.size and np.any(g.B[:, bad_u] != 0))
+        parts = []
+        for states, rows in self.parts:
+            Bb = g.B[np.ix_(states, mu + bad_y)]
+            M = g.D[np.ix_(rows, mu + bad_y)]
+            Mp = np.linalg.pinv(M, rcond=1e-10) if M.size else np.zeros((bad_y.size, rows.size))
+            Pi = np.eye(bad_y.size) - Mp @ M
+            if states.size and np.any(np.abs(Bb @ Pi) > 1e-12 * max(1.0, np.abs(Bb).max(initial=0))):
+                held = True
+            K = Bb @ Mp
+            if states.size and rows.size:
+                T[np.ix_(states, states)] -= K @ g.C[np.ix_(rows, states)]
+                G[np.ix_(states, rows)] = -K
+            parts.append((states, rows, Mp, Pi))
+        hit = (bad_y, bad_u, good_y, parts, T, G @ self.S @ G.T, held)
+        self._cache[key] = hit
+        return hit
+
+    def propagate(self, z: np.ndarray, v: np.ndarray, ok_ch: np.ndarray, last: np.ndarray) -> np.ndarray:
+        """The filter state after an invalid sample ``v`` (entries with ``ok_ch`` False are unusable)."""
+        g, mu = self.g, self.mu
+        bad_y, bad_u, good_y, parts, _, _, _ = self.pattern(ok_ch)
+        w = np.where(ok_ch, v, last)  # controls: last valid value; outputs: replaced per part below
+        znew = np.empty_like(z)
+        for states, rows, Mp, Pi in parts:
+            wc = w.copy()
+            if bad_y.size:
+                known = g.C[np.ix_(rows, states)] @ z[states] + g.D[rows, :mu] @ w[:mu] \
+                    + g.D[np.ix_(rows, mu + good_y)] @ w[mu + good_y]
+                wc[mu + bad_y] = -(Mp @ known) + Pi @ last[mu + bad_y]
+            znew[states] = g.A[np.ix_(states, states)] @ z[states] + g.B[states] @ wc
+        return znew
+
+
+def _components(A: np.ndarray, C: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Independent parts of a filter: (states, residual rows) connected through A and C."""
+    n, q = A.shape[0], C.shape[0]
+    parent = list(range(n + q))
+
+    def find(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    def join(i: int, j: int) -> None:
+        parent[find(i)] = find(j)
+
+    for i, j in zip(*np.nonzero(A)):
+        join(int(i), int(j))
+    for k, j in zip(*np.nonzero(C)):
+        join(n + int(k), int(j))
+    groups: dict[int, list[int]] = {}
+    for i in range(n + q):
+        groups.setdefault(find(i), []).append(i)
+    out = []
+    for members in groups.values():
+        states = np.array([i for i in members if i < n], dtype=int)
+        rows = np.array([i - n for i in members if i >= n], dtype=int)
+        out.append((states, rows))
+    return out
+
+
+class _Recovery:
+    """Which samples after a gap are still recovering (the bookkeeping of :class:`_GapRule`)."""
+
+    def __init__(self, rule: _GapRule) -> None:
+        self.rule = rule
+        self.P: np.ndarray | None = None
+        self.hold = 0
+
+    @property
+    def active(self) -> bool:
+        return self.P is not None or self.hold != 0
+
+    def invalid_sample(self, ok_ch: np.ndarray) -> None:
+        rule = self.rule
+        _, _, _, _, T, Q, held = rule.pattern(ok_ch)
+        P = np.zeros_like(T) if self.P is None else self.P
+        self.P = T @ P @ T.T + Q
+        if held:
+            self.hold = rule.settle
+
+    def valid_sample(self) -> bool:
+        """Advance over a valid sample; True when it may be used for decisions."""
+        rule = self.rule
+        recovering = False
+        if self.P is not None:
+            d = np.einsum("ij,jk,ik->i", rule.g.C, self.P, rule.g.C)
+            if np.any(d > rule.limit):
+                recovering = True
+                self.P = rule.g.A @ self.P @ rule._AT
+            else:
+                self.P = None
+        if self.hold != 0:
+            recovering = True
+            self.hold -= 1 if self.hold > 0 else 0
+        return not recovering
+
+
+class ResidualStepper:
+    """Online residual generation, one sample at a time, through gaps of invalid samples.
+
+    ``step(u, y)`` returns the residual vector of the current sample.  The gap rule (the same
+    in :meth:`ResidualGenerator.run`, which gives the same residuals and flags):
+
+    * **invalid sample** (a NaN/inf in a signal the generator reads): the residuals are NaN,
+      ``last_valid`` is False, ``invalid`` counts it, and the filter is propagated with the model
+      and the inputs: each independent part of the filter (one per filter of a stacked bank) is
+      fed, for the missing outputs, the values that make its residuals zero (least squares) — for
+      an observer ``r = y − ŷ`` this is its own prediction ``ŷ``, i.e. open-loop propagation of
+      the model, channel by channel when only some outputs are missing.  Directions of a missing
+      output that the residual does not read directly (a strictly proper filter, a zero
+      feedthrough) are fed the last valid value, and so is a missing control.
+    * **recovering sample** (finite, after a gap): the residuals are computed as usual but
+      ``last_valid`` is False and ``last_recovering`` True, until the transient the gap left in
+      the filter has decayed below the noise: the covariance ``P`` of the state deviation is
+      propagated through the gap from ``residual_cov`` (``P+ = T P Tᵀ + G Σ Gᵀ`` per invalid
+      sample, ``P+ = A P Aᵀ`` per valid one) and the sample becomes valid when every residual's
+      transient standard deviation ``sqrt((C P Cᵀ)_ii)`` is at most ``recovery_tol · sqrt(Σ_ii)``.
+      The length therefore grows with the gap (slowly: as ``log`` of the open-loop error growth)
+      and shrinks with the filter's spectral radius ``ρ(A)``; parts fed held values recover for
+      at least ``ceil(log(recovery_tol) / log ρ(A))`` samples.  A filter with ``ρ(A) ≥ 1`` and
+      held values never recovers (every later sample stays recovering).
+    * **valid sample**: ``last_valid`` True; evaluators use it (pass ``valid=stepper.last_valid``
+      to their ``step``).
+
+    ``step`` accepts the values as sequences in the generator's ``controls``/``outputs`` order,
+    or as mappings ``{name: value}`` which are checked against those names.
+    """
+
+    def __init__(self, generator: ResidualGenerator, x0: np.ndarray | None = None, *,
+                 residual_cov=None, recovery_tol: float = 0.1) -> None:
         g = generator
         self.generator = g
-        self.x = np.zeros(g.n) if x0 is None else np.asarray(x0, dtype=float).copy()
-        self.invalid = 0
-        self.last_valid = True
+        self._rule = _GapRule(g, residual_cov, recovery_tol)
+        self._x0 = _state0(g, x0)
         self._AB = np.hstack([g.A, g.B])
         self._CD = np.hstack([g.C, g.D])
+        self.reset()
 
-    def step(self, u: Sequence[float], y: Sequence[float]) -> np.ndarray:
-        """Residuals for one sample; ``u`` and ``y`` in the generator's ``controls``/``outputs`` order."""
+    def reset(self, x0: np.ndarray | None = None) -> None:
+        """Start again: the initial state (``x0``, else the one given at creation), no gap history."""
+        self.x = self._x0.copy() if x0 is None else _state0(self.generator, x0)
+        self.invalid = 0
+        self.last_valid = True
+        self.last_recovering = False
+        self._last = np.zeros(self._AB.shape[1] - self.generator.n)
+        self._rec = _Recovery(self._rule)
+
+    def _vector(self, values, names: tuple[str, ...], what: str) -> np.ndarray:
+        if isinstance(values, Mapping):
+            keys = list(values)
+            missing = [nm for nm in names if nm not in values]
+            extra = [k for k in keys if k not in names]
+            if missing or extra:
+                raise DataError(f"step() {what} do not match the generator's {list(names)}: missing {missing}, "
+                                f"extra {extra}")
+            values = [values[nm] for nm in names]
+        try:
+            arr = np.asarray(values, dtype=float).ravel()
+        except (TypeError, ValueError) as exc:
+            raise DataError(f"step() {what} must be numbers (NaN marks a missing value), got {values!r}") from exc
+        return arr
+
+    def step(self, u, y) -> np.ndarray:
+        """Residuals for one sample.
+
+        Parameters
+        ----------
+        u, y : sequence of float or mapping of name to float
+            The controls and outputs, in the generator's ``controls``/``outputs`` order, or by name.
+
+        Returns
+        -------
+        (q,) array: NaN on an invalid sample; see the class docstring for ``last_valid``.
+        """
         g = self.generator
-        v = np.concatenate([np.asarray(u, dtype=float).ravel(), np.asarray(y, dtype=float).ravel()])
+        v = np.concatenate([self._vector(u, g.controls, "controls"), self._vector(y, g.outputs, "outputs")])
         if v.size != g.B.shape[1]:
             raise DataError(
                 f"step() got {v.size} values; need {len(g.controls)} controls {list(g.controls)} "
                 f"and {len(g.outputs)} outputs {list(g.outputs)}"
             )
-        if not np.all(np.isfinite(v)):
+        ok_ch = np.isfinite(v)
+        if not ok_ch.all():
             self.invalid += 1
             self.last_valid = False
+            self.last_recovering = False
+            self.x = self._rule.propagate(self.x, v, ok_ch, self._last)
+            self._last[ok_ch] = v[ok_ch]
+            self._rec.invalid_sample(ok_ch)
             return np.full(len(g.residuals), np.nan)
-        self.last_valid = True
         xv = np.concatenate([self.x, v])
         r = self._CD @ xv
         self.x = self._AB @ xv
+        self._last = v.copy()
+        self.last_valid = self._rec.valid_sample() if self._rec.active else True
+        self.last_recovering = not self.last_valid
         return r
 
     def run(self, trace: Trace) -> Residuals:
-        """Step through a whole trace (the loop ``run()`` vectorises); bad samples become invalid."""
+        """Step through a whole trace (the loop ``run()`` vectorises); flags as in :meth:`step`."""
+        g = self.generator
+        if not isinstance(trace, Trace):
+            raise DataError(f"trace must be a fdikit.trace.Trace, got {type(trace).__name__}")
         if len(trace) > 1:
-            self.generator._check_dt(trace.dt)
-        v = self.generator.inputs_from(trace)
-        mu = len(self.generator.controls)
-        r = np.empty((len(trace), len(self.generator.residuals)))
+            g._check_dt(trace.dt)
+        v = g.inputs_from(trace)
+        mu = len(g.controls)
+        r = np.empty((len(trace), len(g.residuals)))
         valid = np.empty(len(trace), bool)
+        recovering = np.empty(len(trace), bool)
         for k in range(len(trace)):
             r[k] = self.step(v[k, :mu], v[k, mu:])
             valid[k] = self.last_valid
-        g = self.generator
-        return Residuals(trace.t, r, g.residuals, g.isolates, valid, meta={"trace": dict(trace.meta)})
-
+            recovering[k] = self.last_recovering
+        return Residuals(trace.t, r, g.residuals, g.isolates, valid, meta={"trace": dict(trace.meta)},
+                         recovering=recovering)
 
 def stack_generators(generators: Iterable[ResidualGenerator]) -> ResidualGenerator:
     """One generator from several: block-diagonal filter states, concatenated residuals.
