@@ -23,7 +23,7 @@ from fdikit.analysis import (
     structure_matrix,
 )
 from fdikit.design import observer_generator
-from fdikit.errors import DesignError
+from fdikit.errors import DesignError, ParameterError
 from fdikit.plants.path_vehicle import path_vehicle_12, path_vehicle_14
 
 a = np.array([-1.0, -2.0, -3.0])
@@ -83,7 +83,7 @@ def test_gain_discrete_matches_closed_form():
         np.testing.assert_allclose(t.gains[:, 3 + i, i], np.abs((z - phi) / (z - phi + L_D[i])), rtol=1e-10)
     S = structure_matrix(g, md)
     np.testing.assert_array_equal(S.to_numpy(), np.vstack([np.eye(3, dtype=bool)] * 2))
-    with pytest.raises(ModelError, match="Nyquist"):
+    with pytest.raises(ParameterError, match="Nyquist"):
         fault_to_residual_gain(g, md, [np.pi / DT * 1.5])
 
 
@@ -138,7 +138,7 @@ def test_residual_groups_follow_isolates_and_multi_column_faults():
     np.testing.assert_allclose(t2.gains[:, 0, 0], full.gains[:, 1, 1], rtol=1e-12)
     with pytest.raises(ModelError):
         fault_to_residual_gain(g, m, W, faults=["nope"])
-    with pytest.raises(ModelError):
+    with pytest.raises(ParameterError, match="non-negative"):
         fault_to_residual_gain(g, m, [-1.0])
 
 
@@ -288,7 +288,7 @@ def test_resolve_fault_names():
         resolve_fault(m, "nope")
     with pytest.raises(ModelError, match="sensor faults only"):
         resolve_fault(m, "throttle:magnitude")
-    with pytest.raises(ModelError, match="suffix"):
+    with pytest.raises(ParameterError, match="suffix"):
         resolve_fault(m, "air_mass:bias")
     with pytest.raises(DesignError):  # 12-state steering has a feedthrough
         resolve_fault(path_vehicle_12("midpoint"), "steering")

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from fdikit import FaultModel, ModelError
+from fdikit import FaultModel, ModelError, ParameterError
 from fdikit.model import GROUPS
 
 N_STATES, N_OUT = 4, 3
@@ -165,7 +165,7 @@ def test_discretize_rejects_discrete_model_and_bad_dt():
     with pytest.raises(ModelError, match="already discrete"):
         _random_model(dt=0.1).discretize(0.1)
     for bad in (0.0, -0.1, np.inf, np.nan):
-        with pytest.raises(ModelError, match="dt must be positive"):
+        with pytest.raises(ParameterError, match=r"dt .*must be a positive"):
             _random_model().discretize(bad)
 
 
@@ -235,7 +235,7 @@ def test_freqresp_matches_python_control(dt):
     np.testing.assert_allclose(H[1:], np.moveaxis(ref, -1, 0), rtol=1e-10, atol=1e-12 * np.abs(ref).max())
     # one group = its columns of the full response
     np.testing.assert_array_equal(m.freqresp(omega, group="w"), H[:, :, m._slice("w")])
-    with pytest.raises(ModelError, match="unknown input group"):
+    with pytest.raises(ParameterError, match="unknown input group"):
         m.freqresp(omega, group="z")
 
 
@@ -359,5 +359,5 @@ def test_error_messages_say_what_the_model_has():
     m = _random_model()
     with pytest.raises(ModelError, match=re.escape("['px', 'py', 'vx', 'vy']")):
         m.index("states", ["pz"])
-    with pytest.raises(ModelError, match="unknown name kind"):
+    with pytest.raises(ParameterError, match="unknown name kind"):
         m.index("inputs", ["steer"])

@@ -26,7 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fdikit.errors import ModelError
+from fdikit import validate
+from fdikit.errors import ModelError, ParameterError
 from fdikit.fdi_report import FaultGeometry, FdiReport, fdi_report
 from fdikit.linalg import resolve_fault
 from fdikit.model import FaultModel
@@ -172,13 +173,13 @@ def _fault_columns(model: FaultModel, faults) -> tuple[tuple[str, ...], list[lis
 
 
 def _check_omega(omega, dt: float | None) -> np.ndarray:
-    omega = np.atleast_1d(np.asarray(omega, dtype=float))
+    omega = np.atleast_1d(validate.as_array("freqs", omega, finite=False))
     if omega.ndim != 1 or omega.size == 0:
-        raise ModelError(f"freqs must be a non-empty 1-D array of frequencies in rad/s, got shape {omega.shape}")
+        raise ParameterError(f"freqs must be a non-empty 1-D array of frequencies in rad/s, got shape {omega.shape}")
     if not np.all(np.isfinite(omega)) or np.any(omega < 0):
-        raise ModelError("freqs must be finite and non-negative (rad/s)")
+        raise ParameterError("freqs must be finite and non-negative (rad/s)")
     if dt is not None and omega.max() > np.pi / dt * (1 + 1e-12):
-        raise ModelError(
+        raise ParameterError(
             f"freqs go up to {omega.max():g} rad/s, above the Nyquist frequency π/dt = {np.pi / dt:g} rad/s of the "
             "discrete internal form; keep freqs <= π/dt"
         )
@@ -187,6 +188,9 @@ def _check_omega(omega, dt: float | None) -> np.ndarray:
 
 def default_freqs(dt: float | None, num: int = 200) -> np.ndarray:
     """Default grid: ``logspace(-2, 3)`` rad/s, capped at ``0.999 π/dt`` in discrete time."""
+    num = validate.integer("num", num, minimum=1)
+    if dt is not None:
+        dt = validate.positive("dt", dt)
     hi = 1e3 if dt is None else min(1e3, 0.999 * np.pi / dt)
     return np.logspace(-2, np.log10(hi), num)
 
@@ -214,6 +218,8 @@ def fault_to_residual_gain(
     Residual groups: the residuals tied to the same fault by ``generator.isolates`` form one group
     named after that fault; a residual with ``isolates`` None is a group of its own, named after it.
     """
+    validate.instance("generator", generator, ResidualGenerator, "pass a design's .generator")
+    validate.instance("model", model, FaultModel)
     R = generator.internal_form(model)
     omega = _check_omega(freqs, R.dt)
     names, cols = _fault_columns(model, faults)
@@ -249,6 +255,11 @@ def structure_matrix(
     """
     import pandas as pd
 
+    validate.instance("generator", generator, ResidualGenerator, "pass a design's .generator")
+    validate.instance("model", model, FaultModel)
+    rtol = validate.non_negative("rtol", rtol)
+    if atol is not None:
+        atol = validate.non_negative("atol", atol)
     dt = generator.dt if generator.dt is not None else model.dt
     table = fault_to_residual_gain(generator, model, default_freqs(dt) if freqs is None else freqs, faults)
     G = table.peak()

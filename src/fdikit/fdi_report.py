@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fdikit import linalg
+from fdikit import linalg, validate
 from fdikit.errors import ModelError
 from fdikit.linalg import resolve_fault
 from fdikit.model import FaultModel
@@ -206,13 +206,17 @@ def fdi_report(
     (:func:`linalg.output_separable`), mutual detectability (:func:`linalg.mutually_detectable`)
     and ``Σν`` against ``n`` (Douglas et al. 1996, §4.1; App. A).
     """
+    validate.instance("model", model, FaultModel)
+    if rtol is not None:
+        rtol = validate.non_negative("rtol", rtol)
+    ztol = validate.non_negative("ztol", ztol)
     if isinstance(faults, str):
         faults = [faults]
     A, C, n = model.A, model.C, model.n
     entries: list[tuple[str, np.ndarray, str]] = []
     if isinstance(faults, Mapping):
         for name, F in faults.items():
-            F = np.asarray(F, dtype=float)
+            F = validate.as_array(f"fault map {name!r}", F, error=ModelError, finite=False)
             F = F.reshape(-1, 1) if F.ndim == 1 else F
             if F.ndim != 2 or F.shape[0] != n or not np.all(np.isfinite(F)):
                 raise ModelError(f"fault map {name!r} must be a finite {n} x k matrix, got shape {F.shape}")

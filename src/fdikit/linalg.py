@@ -20,7 +20,8 @@ from collections.abc import Callable, Sequence
 import numpy as np
 import scipy.linalg
 
-from fdikit.errors import DesignError, ModelError
+from fdikit import validate
+from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.model import FaultModel
 
 __all__ = [
@@ -44,6 +45,39 @@ __all__ = [
 _EPS = np.finfo(float).eps
 
 
+def _mat(name: str, M) -> np.ndarray:
+    """``M`` as a finite real or complex 2-D array (a vector is one row); ParameterError otherwise."""
+    if isinstance(M, str | bytes):
+        raise ParameterError(f"{name} must be a matrix of numbers, got the string {M!r}")
+    try:
+        M = np.asarray(M)
+    except (ValueError, TypeError) as exc:
+        raise ParameterError(f"{name} must be a rectangular matrix of numbers ({exc})") from None
+    if M.dtype.kind not in "biufc":
+        raise ParameterError(f"{name} must be a matrix of numbers, got entries of type {M.dtype}")
+    M = np.atleast_2d(M)
+    if M.ndim != 2:
+        raise ParameterError(f"{name} must be a 2-D matrix, got an array with {M.ndim} dimensions (shape {M.shape})")
+    if not np.isfinite(M).all():
+        raise ParameterError(f"{name} has a non-finite entry (NaN or inf); every entry must be a finite number")
+    return M
+
+
+def _rtol(rtol):
+    if rtol is None:
+        return None
+    return validate.non_negative("rtol", rtol)
+
+
+def _system(A, C, F) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``A`` (n x n), ``C`` (p x n), ``F`` (n x k) as finite float matrices, shapes checked."""
+    A = validate.as_square("A", A)
+    n = A.shape[0]
+    C = validate.as_matrix("C", np.atleast_2d(C) if np.ndim(C) == 1 else C, (None, n))
+    F = validate.as_matrix("F", np.reshape(F, (-1, 1)) if np.ndim(F) == 1 else F, (n, None))
+    return A, C, F
+
+
 def _tol(M: np.ndarray, s: np.ndarray, rtol: float | None) -> float:
     smax = s[0] if s.size else 0.0
     return (rtol if rtol is not None else max(M.shape) * _EPS * 1e3) * max(smax, 0.0)
@@ -51,7 +85,7 @@ def _tol(M: np.ndarray, s: np.ndarray, rtol: float | None) -> float:
 
 def rank(M: np.ndarray, rtol: float | None = None) -> int:
     """Numerical rank: singular values above ``rtol · σ_max`` (default ``1e3 · max(shape) · eps``)."""
-    M = np.atleast_2d(M)
+    M, rtol = _mat("M", M), _rtol(rtol)
     if M.size == 0:
         return 0
     s = np.linalg.svd(M, compute_uv=False)
@@ -60,7 +94,7 @@ def rank(M: np.ndarray, rtol: float | None = None) -> int:
 
 def orth(M: np.ndarray, rtol: float | None = None) -> np.ndarray:
     """Orthonormal basis of the range of ``M`` (n x r)."""
-    M = np.atleast_2d(np.asarray(M))
+    M, rtol = _mat("M", M), _rtol(rtol)
     if M.size == 0:
         return np.zeros((M.shape[0], 0), dtype=M.dtype)
     U, s, _ = np.linalg.svd(M, full_matrices=False)
@@ -70,7 +104,7 @@ def orth(M: np.ndarray, rtol: float | None = None) -> np.ndarray:
 
 def null(M: np.ndarray, rtol: float | None = None) -> np.ndarray:
     """Orthonormal basis of the null space of ``M`` (columns)."""
-    M = np.atleast_2d(np.asarray(M))
+    M, rtol = _mat("M", M), _rtol(rtol)
     if M.shape[0] == 0:
         return np.eye(M.shape[1], dtype=M.dtype)
     _, s, Vh = np.linalg.svd(M, full_matrices=True)
@@ -80,9 +114,13 @@ def null(M: np.ndarray, rtol: float | None = None) -> np.ndarray:
 
 def span_sum(*bases: np.ndarray, rtol: float | None = None) -> np.ndarray:
     """Orthonormal basis of ``Im U₁ + Im U₂ + …``."""
-    bases = [np.atleast_2d(b) for b in bases if np.size(b)]
+    bases = [_mat(f"basis {i}", b) for i, b in enumerate(bases) if np.size(b)]
     if not bases:
-        raise ModelError("span_sum needs at least one non-empty basis")
+        raise ParameterError("span_sum needs at least one non-empty basis")
+    rows = {b.shape[0] for b in bases}
+    if len(rows) > 1:
+        raise ParameterError(f"span_sum: the bases have different numbers of rows {sorted(rows)}; "
+                             "every basis must live in the same space")
     return orth(np.hstack(bases), rtol)
 
 
@@ -99,7 +137,9 @@ def contains(U: np.ndarray, x: np.ndarray, rtol: float = 1e-8) -> bool:
     """Whether every column of ``x`` lies in ``Im U`` (relative residual below ``rtol``)."""
     Q = orth(U)
     x = np.asarray(x)
-    x = x.reshape(-1, 1) if x.ndim == 1 else x
+    x = _mat("x", x.reshape(-1, 1) if x.ndim == 1 else x)
+    if x.shape[0] != Q.shape[0]:
+        raise ParameterError(f"x has {x.shape[0]} rows but U has {Q.shape[0]}; pass vectors of length {Q.shape[0]}")
     res = x - Q @ (Q.conj().T @ x)
     return bool(np.linalg.norm(res) <= rtol * max(np.linalg.norm(x), _EPS))
 
@@ -115,6 +155,8 @@ def sensor_fault_map(model: FaultModel, output: str, direction: str = "both", rt
     solution; it must solve ``C F¹ = e_i`` exactly (to ``rtol``), otherwise the output is
     not reachable from the states and :class:`DesignError` is raised.
     """
+    validate.instance("model", model, FaultModel)
+    validate.choice("direction", direction, ("both", "magnitude", "rate"))
     i = model.index("outputs", output)[0]
     e = np.zeros(model.p)
     e[i] = 1.0
@@ -175,6 +217,7 @@ def actuator_fault_map(model: FaultModel, control: str) -> np.ndarray:
     command-side fault; a nonzero ``D`` column means the fault also reaches the outputs
     directly, which the geometric filters here do not model (:class:`DesignError`).
     """
+    validate.instance("model", model, FaultModel)
     j = model.index("u", control)[0]
     if np.any(model.Du[:, j] != 0):
         raise DesignError(
@@ -194,9 +237,14 @@ def resolve_fault(model: FaultModel, name: str) -> tuple[np.ndarray, str]:
     * a fault input of the model (group ``f``) → its ``Bf`` column when ``Df`` is zero, the sensor
       map of output ``i`` when it is a pure sensor fault (``Df = e_i``, ``Bf = 0``).
     """
+    validate.instance("model", model, FaultModel)
+    if not isinstance(name, str):
+        raise ParameterError(f"fault name must be a string, got {name!r} ({type(name).__name__})")
     base, _, suffix = name.partition(":")
     if suffix and suffix not in ("magnitude", "rate"):
-        raise ModelError(f"unknown fault suffix {suffix!r} in {name!r}; use ':magnitude' or ':rate' (sensor faults)")
+        raise ParameterError(
+            f"unknown fault suffix {suffix!r} in {name!r}; use ':magnitude' or ':rate' (sensor faults)"
+        )
     where = [k for k, pool in (("output", model.outputs), ("control", model.controls), ("fault", model.faults))
              if base in pool]
     if not where:
@@ -234,7 +282,8 @@ def caisa(A: np.ndarray, C: np.ndarray, F: np.ndarray, rtol: float | None = None
     ``W⁰ = 0``, ``W^{k+1} = Im F + A (W^k ∩ Ker C)``; the sequence is nondecreasing and
     stops within ``n`` steps.  Returns an orthonormal basis.
     """
-    A, C, F = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (A, C, F))
+    A, C, F = _system(A, C, F)
+    rtol = _rtol(rtol)
     kerC = null(C, rtol)
     W = orth(F, rtol)
     for _ in range(A.shape[0] + 1):
@@ -269,7 +318,8 @@ def invariant_zeros(
     """
     from slycot import ab08nd
 
-    A, C, F = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (A, C, F))
+    A, C, F = _system(A, C, F)
+    rtol = _rtol(rtol)
     n, k, p = A.shape[0], F.shape[1], C.shape[0]
     if n == 0:
         return np.zeros(0, dtype=complex), []
@@ -351,6 +401,7 @@ def detection_space(A: np.ndarray, C: np.ndarray, F: np.ndarray, rtol: float | N
     ``W*`` from :func:`caisa`, ``V`` the span of the invariant-zero directions of
     ``(C, A, F)``.  Orthonormal basis (n x ν).
     """
+    A, C, F = _system(A, C, F)
     W = caisa(A, C, F, rtol)
     _, dirs = invariant_zeros(A, C, F)
     return span_sum(W, _real_span(dirs, np.shape(A)[0]), rtol=rtol) if dirs else W
@@ -384,6 +435,12 @@ def mutually_detectable(
     Returns the verdict, the zeros of ``(C, A, [F₁ … F_q])`` and the union of the zeros of
     each ``(C, A, F_i)``.  The two multisets are matched with a tolerance relative to ‖A‖.
     """
+    A = validate.as_square("A", A)
+    C = validate.as_matrix("C", C, (None, A.shape[0]))
+    faults = [validate.as_matrix(f"fault map {i}", F, (A.shape[0], None)) for i, F in enumerate(faults)]
+    if not faults:
+        raise ParameterError("mutually_detectable needs at least one fault map")
+    rtol = validate.non_negative("rtol", rtol)
     joint, _ = invariant_zeros(A, C, np.hstack(faults))
     union = np.concatenate([invariant_zeros(A, C, F)[0] for F in faults]) if faults else np.zeros(0)
     scale = max(np.linalg.norm(A, 2), 1.0)

@@ -15,11 +15,16 @@ from __future__ import annotations
 
 import numpy as np
 
+from fdikit import validate
+
 __all__ = ["dlsim_blocked", "lifted_matrices"]
 
 
 def lifted_matrices(A: np.ndarray, B: np.ndarray, M: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """``Φ`` (M n x n), ``T`` (M n x M m), ``A^M`` and ``Γ_M`` (n x M m) of the lifted recursion."""
+    M = validate.integer("M (the block length)", M, minimum=1)
+    A = validate.as_square("A", A)
+    B = validate.as_matrix("B", B, (A.shape[0], None))
     n, m = B.shape
     powers = [np.eye(n)]
     for _ in range(M):
@@ -49,11 +54,16 @@ def dlsim_blocked(
     -------
     y : (N, p) outputs, x : (N, n) states (``x[0] = x0``), x_end : (n,) the state after the last sample.
     """
-    A, B, C, D = (np.asarray(M_, dtype=float) for M_ in (A, B, C, D))
-    v = np.asarray(v, dtype=float)
+    block = validate.integer("block", block, minimum=1)
+    A = validate.as_square("A", A)
+    n = A.shape[0]
+    B = validate.as_matrix("B", B, (n, None))
+    m = B.shape[1]
+    C = validate.as_matrix("C", C, (None, n))
+    D = validate.as_matrix("D", D, (C.shape[0], m))
+    v = validate.as_matrix("v (the input sequence)", v, (None, m), finite=False)
     N = v.shape[0]
-    n, m = B.shape
-    x0 = np.zeros(n) if x0 is None else np.asarray(x0, dtype=float)
+    x0 = np.zeros(n) if x0 is None else validate.as_vector("x0", x0, n, finite=False)
     if n == 0 or N == 0:
         return v @ D.T, np.zeros((N, n)), x0.copy()
     M = max(1, min(block, N))

@@ -30,7 +30,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg
 
-from fdikit.errors import ModelError
+from fdikit import validate
+from fdikit.errors import ModelError, ParameterError
 
 __all__ = [
     "FaultModel",
@@ -41,6 +42,7 @@ __all__ = [
 
 #: Input groups in the order their columns appear in ``B`` and ``D``.
 GROUPS: tuple[str, ...] = ("u", "d", "f", "w")
+_DISCRETIZE_METHODS = ("zoh", "foh", "bilinear", "euler", "backward_diff", "impulse")
 _GROUP_WORD = {"u": "controls", "d": "disturbances", "f": "faults", "w": "noise"}
 
 
@@ -61,7 +63,7 @@ def _matrix(name: str, value, rows: int | None, cols: int | None) -> np.ndarray:
             raise ModelError(f"{name} is required")
         out = np.zeros((rows, cols))
     else:
-        out = np.array(value, dtype=float, copy=True)
+        out = validate.as_array(name, value, error=ModelError, finite=False)
         if out.ndim == 0:
             out = out.reshape(1, 1)
         if out.ndim == 1 and cols == 1:
@@ -90,6 +92,15 @@ def _names(kind: str, names: Sequence[str] | None, count: int, prefix: str) -> t
         return tuple(f"{prefix}{i}" for i in range(count))
     if isinstance(names, str):
         raise ModelError(f"{kind} names must be a sequence of strings, got the single string {names!r}")
+    try:
+        names = tuple(names)
+    except TypeError:
+        raise ModelError(f"{kind} names must be a sequence of strings, got {type(names).__name__}") from None
+    for n in names:
+        if not isinstance(n, str):
+            raise ModelError(f"{kind} names must be strings, got {n!r} ({type(n).__name__}); name every {kind}")
+        if not n.strip():
+            raise ModelError(f"{kind} names must not be empty or blank, got {n!r}; give every {kind} a name")
     names = tuple(str(n) for n in names)
     if len(names) != count:
         raise ModelError(f"{len(names)} {kind} names given for {count} {kind}")
@@ -180,7 +191,7 @@ class FaultModel:
             dup = next(x for x in all_inputs if all_inputs.count(x) > 1)
             raise ModelError(f"input name {dup!r} is used in two groups; input names must be unique")
         if dt is not None:
-            dt = float(dt)
+            dt = validate.number("dt (the sample time)", dt, error=ModelError, finite=False)
             if not np.isfinite(dt) or dt <= 0:
                 raise ModelError(f"dt must be a positive sample time or None (continuous), got {dt}")
         B = np.hstack(blocks_b) if n else np.zeros((0, len(all_inputs)))
@@ -229,7 +240,7 @@ class FaultModel:
 
     def _slice(self, group: str) -> slice:
         if group not in GROUPS:
-            raise ModelError(f"unknown input group {group!r}; use one of {GROUPS}")
+            raise ParameterError(f"unknown input group {group!r}; use one of {GROUPS}")
         start = sum(len(self.inputs[g]) for g in GROUPS[: GROUPS.index(group)])
         return slice(start, start + len(self.inputs[group]))
 
@@ -269,9 +280,11 @@ class FaultModel:
         """Positions of named ``'states'``, ``'outputs'`` or inputs of a group (``'u'``, ``'d'``, ``'f'``, ``'w'``)."""
         if isinstance(names, str):
             names = [names]
+        if not isinstance(kind, str):
+            raise ParameterError(f"name kind must be a string ('states', 'outputs' or one of {GROUPS}), got {kind!r}")
         pool = {"states": self.states, "outputs": self.outputs}.get(kind) or self.inputs.get(kind)
         if pool is None and kind not in ("states", "outputs") and kind not in GROUPS:
-            raise ModelError(f"unknown name kind {kind!r}; use 'states', 'outputs' or one of {GROUPS}")
+            raise ParameterError(f"unknown name kind {kind!r}; use 'states', 'outputs' or one of {GROUPS}")
         pool = pool or ()
         out = []
         for name in names:
@@ -284,6 +297,11 @@ class FaultModel:
     # ------------------------------------------------------------------ fault channels
     def add_faults(self, names: Sequence[str], Bf, Df=None) -> FaultModel:
         """Append fault inputs with given directions (``Bf`` n x k, ``Df`` p x k)."""
+        if isinstance(names, str):
+            raise ModelError(
+                f"fault names must be a sequence of strings, got the single string {names!r}; use [{names!r}]"
+            )
+        names = tuple(names)
         k = len(names)
         Bf_new = _matrix("Bf (new faults)", Bf, self.n, k)
         Df_new = _matrix("Df (new faults)", Df, self.p, k)
@@ -297,6 +315,8 @@ class FaultModel:
         ``y = C x + ... + E_i μ_i`` with ``E_i`` the unit vector of output ``i``
         (Douglas et al. 1996, eq. (3.3)).  Fault names are ``"<output>_sensor"``.
         """
+        if not isinstance(outputs, str) and len(outputs) == 0:
+            raise ParameterError("outputs is empty; name at least one output whose sensor can fail")
         idx = self.index("outputs", outputs)
         Df = np.zeros((self.p, len(idx)))
         Df[idx, range(len(idx))] = 1.0
@@ -309,6 +329,8 @@ class FaultModel:
         1996, §3.2: "the direction of an engine throttle control fault is the first
         column of the B matrix").  Fault names are ``"<control>_actuator"``.
         """
+        if not isinstance(controls, str) and len(controls) == 0:
+            raise ParameterError("controls is empty; name at least one control whose actuator can fail")
         idx = self.index("u", controls)
         return self.add_faults([actuator_fault_name(self.controls[i]) for i in idx], self.Bu[:, idx], self.Du[:, idx])
 
@@ -344,8 +366,8 @@ class FaultModel:
 
         if self.is_discrete:
             raise ModelError(f"model is already discrete (dt={self.dt}); discretize a continuous model")
-        if not (np.isfinite(dt) and dt > 0):
-            raise ModelError(f"dt must be positive, got {dt}")
+        dt = validate.positive("dt (the sample time)", dt)
+        validate.choice("discretization method", method, _DISCRETIZE_METHODS)
         Ad, Bd, Cd, Dd, _ = scipy.signal.cont2discrete((self.A, self.B, self.C, self.D), dt, method=method)
         return self._with_matrices(Ad, Bd, Cd, Dd, dt)
 
@@ -366,7 +388,7 @@ class FaultModel:
         ``z = jω`` in continuous time and ``e^{jω dt}`` in discrete time; ``group``
         restricts the inputs to one group (``'u'``, ``'d'``, ``'f'``, ``'w'``).
         """
-        omega = np.atleast_1d(np.asarray(omega, dtype=float))
+        omega = validate.as_vector("omega (rad/s)", omega)
         B, D = (self.B, self.D) if group is None else (self.b(group), self.d(group))
         z = np.exp(1j * omega * self.dt) if self.is_discrete else 1j * omega
         eye = np.eye(self.n)

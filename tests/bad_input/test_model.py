@@ -107,7 +107,8 @@ CASES = [
     case("dlsim-x0-size", lambda: dlsim_blocked(np.eye(2), np.ones((2, 1)), np.eye(2), np.zeros((2, 1)),
                                                 np.ones((10, 1)), x0=[1.0, 2.0, 3.0]), ParameterError, "x0", "2"),
     case("dlsim-A-not-square", lambda: dlsim_blocked(np.ones((2, 3)), np.ones((2, 1)), np.eye(2),
-                                                     np.zeros((2, 1)), np.ones((10, 1))), ParameterError, "A", "square"),
+                                                     np.zeros((2, 1)), np.ones((10, 1))),
+         ParameterError, "A", "square"),
     case("lifted-M-negative", lambda: lifted_matrices(np.eye(2), np.ones((2, 1)), -3), ParameterError, "M", "integer"),
     case("lifted-M-string", lambda: lifted_matrices(np.eye(2), np.ones((2, 1)), "4"), ParameterError, "M", "integer"),
     # ------------------------------------------------------------------ linalg
@@ -135,7 +136,7 @@ CASES = [
          ParameterError, "fault", "rows"),
     # ------------------------------------------------------------------ analysis and fdi_report
     case("gain-freqs-negative", lambda: fault_to_residual_gain(_gen(), _mf().discretize(0.1), [-1.0]),
-         ModelError, "freqs", "non-negative"),
+         ParameterError, "freqs", "non-negative"),
     case("gain-unknown-fault", lambda: fault_to_residual_gain(_gen(), _mf().discretize(0.1), [1.0], faults=["zz"]),
          ModelError, "zz"),
     case("gain-not-generator", lambda: fault_to_residual_gain("gen", _mf().discretize(0.1), [1.0]),

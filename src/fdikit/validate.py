@@ -1,0 +1,235 @@
+"""Argument validation shared by the public entry points.
+
+Each helper checks one argument, returns it in canonical form (a float, an int, a read-only
+float array ...) and otherwise raises an :mod:`fdikit.errors` class whose message names the
+argument, says what is wrong and how to fix it.  The class defaults to
+:class:`~fdikit.errors.ParameterError` (a bad argument); model constructors pass
+``error=ModelError`` (a malformed model) and data readers ``error=DataError``.
+
+Examples
+--------
+>>> from fdikit.validate import as_matrix, positive
+>>> as_matrix("L", [[1.0, 2.0]], (1, 2)).shape
+(1, 2)
+>>> positive("dt", 0.0)
+Traceback (most recent call last):
+...
+fdikit.errors.ParameterError: dt must be a positive number, got 0.0
+"""
+
+from __future__ import annotations
+
+import numbers
+from collections.abc import Sequence
+
+import numpy as np
+
+from fdikit.errors import ParameterError
+
+__all__ = [
+    "as_array",
+    "as_matrix",
+    "as_square",
+    "as_vector",
+    "as_covariance",
+    "number",
+    "positive",
+    "non_negative",
+    "integer",
+    "in_range",
+    "choice",
+    "instance",
+]
+
+
+def _show(value) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def as_array(name: str, value, *, error: type[Exception] = ParameterError, finite: bool = True) -> np.ndarray:
+    """``value`` as a float array (any number of dimensions); strings, complex and ragged input are refused."""
+    if value is None:
+        raise error(f"{name} is required (got None); pass an array of numbers")
+    if isinstance(value, str | bytes):
+        raise error(f"{name} must be a number or an array of numbers, got the string {_show(value)}")
+    try:
+        raw = np.asarray(value)
+    except (ValueError, TypeError) as exc:
+        raise error(f"{name} must be a rectangular array of numbers (got {_show(value)}: {exc})") from None
+    if raw.dtype == object:
+        raise error(f"{name} must be a rectangular array of numbers, got {_show(value)} (ragged rows or objects)")
+    if np.iscomplexobj(raw):
+        raise error(f"{name} must be real; it has complex entries ({_show(value)})")
+    if raw.dtype.kind not in "biuf":
+        raise error(f"{name} must be an array of numbers, got entries of type {raw.dtype} ({_show(value)})")
+    out = raw.astype(float, copy=True)
+    if finite:
+        bad = np.argwhere(~np.isfinite(out))
+        if bad.size:
+            where = tuple(int(i) for i in bad[0])
+            at = f" at index {where}" if out.ndim else ""
+            raise error(f"{name} has a non-finite entry{at} ({out[where]!r}); every entry must be a finite number")
+    return out
+
+
+def as_matrix(
+    name: str,
+    value,
+    shape: tuple[int | None, int | None] | None = None,
+    *,
+    error: type[Exception] = ParameterError,
+    finite: bool = True,
+    scalar_ok: bool = False,
+) -> np.ndarray:
+    """``value`` as a 2-D float matrix of ``shape`` (``None`` entries are free).
+
+    A scalar becomes 1 x 1 (or, with ``scalar_ok`` and a square ``shape``, ``value · I``).
+    """
+    out = as_array(name, value, error=error, finite=finite)
+    rows, cols = shape if shape is not None else (None, None)
+    if out.ndim == 0:
+        if scalar_ok and rows is not None and rows == cols:
+            out = float(out) * np.eye(rows)
+        else:
+            out = out.reshape(1, 1)
+    if out.ndim != 2:
+        raise error(f"{name} must be a 2-D matrix, got an array with {out.ndim} dimensions (shape {out.shape})")
+    want = f"{'n' if rows is None else rows} x {'m' if cols is None else cols}"
+    if rows is not None and out.shape[0] != rows:
+        raise error(f"{name} has {out.shape[0]} rows but must have {rows}; pass a {want} matrix")
+    if cols is not None and out.shape[1] != cols:
+        raise error(f"{name} has {out.shape[1]} columns but must have {cols}; pass a {want} matrix")
+    return out
+
+
+def as_square(name: str, value, n: int | None = None, *, error: type[Exception] = ParameterError) -> np.ndarray:
+    """A finite square matrix (``n x n`` when ``n`` is given)."""
+    out = as_matrix(name, value, error=error)
+    if out.shape[0] != out.shape[1]:
+        raise error(f"{name} must be square, got shape {out.shape}")
+    if n is not None and out.shape[0] != n:
+        raise error(f"{name} must be {n} x {n}, got shape {out.shape}")
+    return out
+
+
+def as_vector(name: str, value, size: int | None = None, *, error: type[Exception] = ParameterError,
+              finite: bool = True) -> np.ndarray:
+    """A 1-D float vector (a column or row matrix is flattened) of ``size`` entries."""
+    out = as_array(name, value, error=error, finite=finite)
+    if out.ndim > 1 and sum(d > 1 for d in out.shape) <= 1:
+        out = out.reshape(-1)
+    if out.ndim == 0:
+        out = out.reshape(1)
+    if out.ndim != 1:
+        raise error(f"{name} must be a 1-D vector, got shape {out.shape}")
+    if size is not None and out.size != size:
+        raise error(f"{name} has {out.size} entries but must have {size}; pass a vector of length {size}")
+    return out
+
+
+def as_covariance(
+    name: str,
+    value,
+    n: int,
+    *,
+    error: type[Exception] = ParameterError,
+    definite: bool = False,
+    scalar_ok: bool = True,
+) -> np.ndarray:
+    """A symmetric positive semidefinite (``definite``: positive definite) ``n x n`` matrix.
+
+    A scalar means ``value · I``.  Symmetry and the eigenvalue test use a tolerance relative
+    to the largest entry (1e-12).  Returns the symmetric part.
+    """
+    out = as_matrix(name, value, (n, n), error=error, scalar_ok=scalar_ok)
+    scale = max(1.0, float(np.abs(out).max(initial=0.0)))
+    if not np.allclose(out, out.T, rtol=0.0, atol=1e-12 * scale):
+        raise error(f"{name} must be symmetric; pass (M + M.T) / 2 or a diagonal matrix")
+    out = (out + out.T) / 2
+    if n:
+        low = float(np.linalg.eigvalsh(out)[0])
+        if definite and low <= 0:
+            raise error(
+                f"{name} must be positive definite (smallest eigenvalue {low:.3g}); add a small positive diagonal"
+            )
+        if low < -1e-12 * scale:
+            raise error(f"{name} must be positive semidefinite (smallest eigenvalue {low:.3g}); "
+                        "a covariance has non-negative eigenvalues")
+    return out
+
+
+def number(name: str, value, *, error: type[Exception] = ParameterError, finite: bool = True) -> float:
+    """A real number (not a bool, string or array) as float; NaN/inf refused when ``finite``."""
+    if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):
+        if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
+            value = value.item()
+        else:
+            raise error(f"{name} must be a number, got {_show(value)} ({type(value).__name__})")
+    out = float(value)
+    if finite and not np.isfinite(out):
+        raise error(f"{name} must be a finite number, got {out}")
+    return out
+
+
+def positive(name: str, value, *, error: type[Exception] = ParameterError) -> float:
+    """A finite number > 0."""
+    if not isinstance(value, bool | np.bool_) and isinstance(value, numbers.Real) and not np.isfinite(float(value)):
+        raise error(f"{name} must be a positive finite number, got {float(value)}")
+    out = number(name, value, error=error)
+    if not out > 0:
+        raise error(f"{name} must be a positive number, got {out}")
+    return out
+
+
+def non_negative(name: str, value, *, error: type[Exception] = ParameterError) -> float:
+    """A finite number >= 0."""
+    out = number(name, value, error=error)
+    if out < 0:
+        raise error(f"{name} must be a non-negative number (>= 0), got {out}")
+    return out
+
+
+def integer(name: str, value, *, minimum: int | None = None, error: type[Exception] = ParameterError) -> int:
+    """An integer (``int`` or integral numpy integer; not a bool or float) ``>= minimum``."""
+    if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Integral):
+        raise error(f"{name} must be an integer, got {_show(value)} ({type(value).__name__})")
+    out = int(value)
+    if minimum is not None and out < minimum:
+        word = {0: "a non-negative integer", 1: "a positive integer"}.get(minimum, f"an integer >= {minimum}")
+        raise error(f"{name} must be {word}, got {out}")
+    return out
+
+
+def in_range(name: str, value, low: float, high: float, *, closed: str = "both",
+             error: type[Exception] = ParameterError) -> float:
+    """A finite number in ``[low, high]`` (``closed`` = 'both', 'left', 'right' or 'neither')."""
+    out = number(name, value, error=error)
+    lo_ok = out >= low if closed in ("both", "left") else out > low
+    hi_ok = out <= high if closed in ("both", "right") else out < high
+    if not (lo_ok and hi_ok):
+        left = "[" if closed in ("both", "left") else "("
+        right = "]" if closed in ("both", "right") else ")"
+        raise error(f"{name} must lie in {left}{low:g}, {high:g}{right}, got {out}")
+    return out
+
+
+def choice(name: str, value, options: Sequence, *, error: type[Exception] = ParameterError):
+    """``value`` if it is one of ``options``; otherwise an error listing them."""
+    try:
+        ok = value in options
+    except TypeError:
+        ok = False
+    if not ok or isinstance(value, bool) and not any(o is value for o in options):
+        listed = ", ".join(repr(o) for o in options)
+        raise error(f"unknown {name} {_show(value)}; use one of {listed}")
+    return value
+
+
+def instance(name: str, value, cls: type | tuple[type, ...], hint: str = "", *,
+             error: type[Exception] = ParameterError):
+    """``value`` if it is an instance of ``cls``; otherwise an error naming the expected type."""
+    if not isinstance(value, cls):
+        want = cls.__name__ if isinstance(cls, type) else " or ".join(c.__name__ for c in cls)
+        raise error(f"{name} must be a {want}, got {type(value).__name__}" + (f"; {hint}" if hint else ""))
+    return value
