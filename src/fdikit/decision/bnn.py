@@ -67,6 +67,7 @@ import numpy as np
 from scipy.special import expit
 
 from fdikit.decision.bnn_network import BnnNetwork
+from fdikit.decision.common import checked_residuals, step_vector
 from fdikit.decision.labelled_runs import _as_runs, _decisions, _Inputs, _targets
 from fdikit.decision.quasi_newton import QuasiNewtonResult, quasi_newton, robbins_monro_steps
 from fdikit.diagnosis import Diagnosis, StepDecision
@@ -215,6 +216,7 @@ class BnnEvaluator:
         self.w: np.ndarray | None = None
         self.report: TrainingReport | None = None
         self._inputs: _Inputs | None = None
+        self.names: tuple[str, ...] | None = None
         self.reset()
 
     # ------------------------------------------------------------------ training
@@ -231,6 +233,7 @@ class BnnEvaluator:
         runs = _as_runs(data, labels)
         res0 = runs[0][0]
         spec = _Inputs.build(res0.names, res0.isolates, self.inputs, self.columns)
+        self.names = res0.names
         feats = []
         for res, _ in runs:
             x = spec.raw(res.r)
@@ -341,6 +344,7 @@ class BnnEvaluator:
 
     def run(self, residuals: Residuals) -> Diagnosis:
         """Decisions for a whole residual series from the reset state; identical to stepping through it."""
+        residuals = checked_residuals(residuals, self.names, "the BNN")
         net, spec = self._ready()
         X = spec(residuals.r)
         ok = residuals.valid & np.all(np.isfinite(X), axis=1)
@@ -357,13 +361,18 @@ class BnnEvaluator:
         """Zero the feedback state ``y_{k−1}`` (start of a new run)."""
         self._y = None
 
-    def step(self, r) -> StepDecision:
-        """Decision for one residual sample; a NaN/inf sample holds the feedback state and the output."""
+    def step(self, r, *, valid: bool = True, names=None) -> StepDecision:
+        """Decision for one residual sample; a NaN/inf sample holds the feedback state and the output.
+
+        ``valid=False`` (e.g. ``valid=stepper.last_valid`` for a recovering sample after a gap) is
+        treated like a NaN sample: the decision (and any feedback state) holds.  ``names`` (optional)
+        are checked against the residual names of the fit (:class:`DataError` on a difference).
+        """
         net, spec = self._ready()
-        x = spec(np.asarray(r, dtype=float).ravel())
+        x = spec(step_vector(r, self.names, names, "the BNN"))
         if self._y is None:
             self._y = np.zeros((1, net.widths[-1]))
-        valid = bool(np.all(np.isfinite(x)))
+        valid = bool(valid) and bool(np.all(np.isfinite(x)))
         if valid:
             self._y = net._layers(*net.unpack(self.w), x[None, :], self._y)[-1]
         p = self._y[0].copy()

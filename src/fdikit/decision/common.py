@@ -7,8 +7,10 @@ import numpy as np
 
 from fdikit.diagnosis import isolate
 from fdikit.errors import DataError
+from fdikit.residuals import Residuals
 
-__all__ = ["k_of_n", "held", "isolate_cached", "checked_names"]
+__all__ = ["k_of_n", "held", "isolate_cached", "checked_names", "check_fitted_names", "checked_residuals",
+           "step_vector"]
 
 
 def k_of_n(exceed: np.ndarray, k: int, n: int) -> np.ndarray:
@@ -50,3 +52,60 @@ def checked_names(q: int, residuals, fitted) -> tuple[str, ...]:
     if len(names) != q:
         raise DataError(f"got {q} residuals, the evaluator was fitted on {len(names)} ({list(names)})")
     return names
+
+
+def check_fitted_names(names, fitted, evaluator: str = "the evaluator") -> None:
+    """Raise :class:`DataError` unless the residual ``names`` are exactly the ``fitted`` ones, in order.
+
+    The message names the difference: the missing and the extra residuals, or, for the same set in
+    another order, the positions that differ.  ``fitted`` None (an evaluator set up by hand, not fitted)
+    accepts any names.
+    """
+    if fitted is None or names is None:
+        return
+    names, fitted = tuple(names), tuple(fitted)
+    if names == fitted:
+        return
+    missing = [n for n in fitted if n not in names]
+    extra = [n for n in names if n not in fitted]
+    if missing or extra or len(names) != len(fitted):
+        raise DataError(
+            f"residual names {list(names)} differ from the {list(fitted)} {evaluator} was fitted on: "
+            f"missing {missing}, extra {extra}; run the generator it was fitted with, or fit it again"
+        )
+    moved = [f"{n!r} at {i} (fitted at {fitted.index(n)})" for i, n in enumerate(names) if fitted[i] != n]
+    raise DataError(
+        f"residuals are reordered: got {list(names)}, {evaluator} was fitted on {list(fitted)} "
+        f"({', '.join(moved)}); its thresholds would apply to the wrong residuals — reorder the columns by name"
+    )
+
+
+def checked_residuals(residuals, fitted, evaluator: str = "the evaluator") -> Residuals:
+    """``residuals`` after checking that it is a :class:`Residuals` whose names match the fitted ones."""
+    if not isinstance(residuals, Residuals):
+        raise DataError(f"residuals must be a fdikit.residuals.Residuals (from a generator's run), got "
+                        f"{type(residuals).__name__}")
+    check_fitted_names(residuals.names, fitted, evaluator)
+    return residuals
+
+
+def step_vector(r, fitted=None, names=None, evaluator: str = "the evaluator") -> np.ndarray:
+    """One residual sample for ``step`` as a float vector; ``names`` (optional) are checked against ``fitted``.
+
+    A mapping ``{name: value}`` is accepted too: its keys are the names, in order.
+    """
+    from collections.abc import Mapping
+
+    if isinstance(r, Mapping):
+        names = tuple(r) if names is None else names
+        r = list(r.values())
+    try:
+        arr = np.asarray(r, dtype=float).ravel()
+    except (TypeError, ValueError) as exc:
+        raise DataError(f"step() needs the residual sample as numbers (NaN for a missing one), got {r!r}") from exc
+    if names is not None:
+        names = (names,) if isinstance(names, str) else tuple(names)
+        if len(names) != arr.size:
+            raise DataError(f"step() got {arr.size} residual values but {len(names)} names {list(names)}")
+        check_fitted_names(names, fitted, evaluator)
+    return arr

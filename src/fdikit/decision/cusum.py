@@ -50,7 +50,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import brentq
 
-from fdikit.decision.common import held, isolate_cached, k_of_n
+from fdikit.decision.common import checked_residuals, held, isolate_cached, k_of_n, step_vector
 from fdikit.diagnosis import Diagnosis, StepDecision, isolate
 from fdikit.errors import DataError, ModelError
 from fdikit.residuals import Residuals
@@ -425,6 +425,7 @@ class CusumEvaluator:
         ``meta`` holds the parameters and the statistics ``g_plus``, ``g_minus`` (N, q)
         (the value at each sample before any restart; held on invalid samples).
         """
+        residuals = checked_residuals(residuals, self.names, "the CUSUM")
         q = len(residuals.names)
         nu, h, mu, sd, iso = self._ready(q, residuals)
         r = residuals.r
@@ -451,13 +452,18 @@ class CusumEvaluator:
         self.g_plus: np.ndarray | None = None
         self.g_minus: np.ndarray | None = None
 
-    def step(self, r) -> StepDecision:
+    def step(self, r, *, valid: bool = True, names=None) -> StepDecision:
         """Decision for one residual sample; a NaN/inf sample holds the statistics and the decision.
+
+        ``valid=False`` (e.g. ``valid=stepper.last_valid`` for a recovering sample after a gap) is
+        treated like a NaN sample: the statistics and the decision hold.  ``names`` (optional) are
+        checked against the residual names of the fit (:class:`DataError` on a difference).
+
 
         After the call, ``g_plus`` and ``g_minus`` hold the current statistics.  The
         parameters are read at the first step after :meth:`reset` (or :meth:`fit`).
         """
-        r = np.asarray(r, dtype=float).ravel()
+        r = step_vector(r, self.names, names, "the CUSUM")
         st = self._state
         if st is not None and st["q"] != r.size:
             raise DataError(f"step() got {r.size} residuals after steps with {st['q']}; call reset() first")
@@ -469,7 +475,7 @@ class CusumEvaluator:
                                 "sp": z, "mp": z, "sm": z, "mm": z, "count": np.zeros(q, int),
                                 "left": np.zeros(q, int), "fired": np.zeros(q, bool)}
             self.g_plus, self.g_minus = z, z
-        if not np.all(np.isfinite(r)):
+        if not (valid and np.all(np.isfinite(r))):
             fired = st["fired"]
             return StepDecision(bool(fired.any()), self._isolate(fired), fired.copy(), False)
         nu, h = st["nu"], st["h"]

@@ -18,6 +18,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 from scipy.special import logsumexp
 
+from fdikit.decision.common import checked_residuals, step_vector
 from fdikit.decision.labelled_runs import _as_runs, _Inputs
 from fdikit.diagnosis import Diagnosis, StepDecision
 from fdikit.errors import DataError, ModelError
@@ -50,6 +51,7 @@ class GaussianMlEvaluator:
         self.covariance: np.ndarray | None = None
         self.prior: np.ndarray | None = None
         self._inputs: _Inputs | None = None
+        self.names: tuple[str, ...] | None = None
         self.reset()
 
     @classmethod
@@ -67,6 +69,7 @@ class GaussianMlEvaluator:
         runs = _as_runs(data, labels)
         res0 = runs[0][0]
         spec = _Inputs.build(res0.names, res0.isolates, self.inputs, self.columns)
+        self.names = res0.names
         X = np.concatenate([spec(res.r) for res, _ in runs])
         lab = np.concatenate([lb for _, lb in runs]).astype(str)
         ok = np.concatenate([res.valid for res, _ in runs]) & np.all(np.isfinite(X), axis=1)
@@ -147,6 +150,7 @@ class GaussianMlEvaluator:
 
     def run(self, residuals: Residuals) -> Diagnosis:
         """Per-sample decisions; invalid samples hold the previous decision (identical to :meth:`step`)."""
+        residuals = checked_residuals(residuals, self.names, "the Gaussian ML classifier")
         X = self._ready()(residuals.r)
         ok = residuals.valid & np.all(np.isfinite(X), axis=1)
         H = len(self.classes)
@@ -171,10 +175,15 @@ class GaussianMlEvaluator:
         """Forget the held decision."""
         self._last = None
 
-    def step(self, r) -> StepDecision:
-        """Decision for one residual sample; a NaN/inf sample holds the previous decision."""
-        x = self._ready()(np.asarray(r, dtype=float).ravel())
-        valid = bool(np.all(np.isfinite(x)))
+    def step(self, r, *, valid: bool = True, names=None) -> StepDecision:
+        """Decision for one residual sample; a NaN/inf sample holds the previous decision.
+
+        ``valid=False`` (e.g. ``valid=stepper.last_valid`` for a recovering sample after a gap) is
+        treated like a NaN sample: the decision (and any feedback state) holds.  ``names`` (optional)
+        are checked against the residual names of the fit (:class:`DataError` on a difference).
+        """
+        x = self._ready()(step_vector(r, self.names, names, "the Gaussian ML classifier"))
+        valid = bool(valid) and bool(np.all(np.isfinite(x)))
         if valid:
             c, P = self._classify(x[None, :])
             self._last = (np.array([c[0]]), P)

@@ -40,7 +40,7 @@ import numpy as np
 import scipy.linalg
 from scipy.stats import chi2
 
-from fdikit.decision.common import checked_names, held, isolate_cached
+from fdikit.decision.common import checked_names, checked_residuals, held, isolate_cached, step_vector
 from fdikit.diagnosis import Diagnosis, StepDecision, isolate
 from fdikit.errors import DataError, ModelError
 from fdikit.residuals import Residuals
@@ -346,6 +346,7 @@ class GlrEvaluator:
     # ------------------------------------------------------------------ batch
     def run(self, residuals: Residuals) -> Diagnosis:
         """Decisions for a whole residual series; identical to stepping through it."""
+        residuals = checked_residuals(residuals, self.names, "the GLR")
         q = len(residuals.names)
         mean, layout, h = self._ready(q, residuals)
         r = residuals.r
@@ -395,12 +396,17 @@ class GlrEvaluator:
         S, n = self._last
         return layout.split(_lin(layout.chol, S) / n[:, None])
 
-    def step(self, r) -> StepDecision:
+    def step(self, r, *, valid: bool = True, names=None) -> StepDecision:
         """Decision for one residual sample; a NaN/inf sample leaves the window and the decision unchanged.
+
+        ``valid=False`` (e.g. ``valid=stepper.last_valid`` for a recovering sample after a gap) is
+        treated like a NaN sample: the statistics and the decision hold.  ``names`` (optional) are
+        checked against the residual names of the fit (:class:`DataError` on a difference).
+
 
         The parameters are read at the first step after :meth:`reset` (or :meth:`fit`).
         """
-        r = np.asarray(r, dtype=float).ravel()
+        r = step_vector(r, self.names, names, "the GLR")
         st = self._state
         if st is not None and st["q"] != r.size:
             raise DataError(f"step() got {r.size} residuals after steps with {st['q']}; call reset() first")
@@ -415,7 +421,7 @@ class GlrEvaluator:
             }
             self.statistic, self.change_index, self._last = np.zeros(G), np.full(G, -1), None
         st["k"] += 1
-        if not np.all(np.isfinite(r)):
+        if not (valid and np.all(np.isfinite(r))):
             fired = st["fired"]
             return StepDecision(bool(fired.any()), self._isolate(fired), fired.copy(), False)
         layout, M = st["layout"], self.window

@@ -30,6 +30,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
+from fdikit.decision.common import checked_residuals, step_vector
 from fdikit.decision.densities import (
     GaussianDensity,
     UniformMeanDensity,
@@ -319,9 +320,8 @@ class MhsprtEvaluator:
     # ------------------------------------------------------------------ batch
     def run(self, residuals: Residuals) -> Diagnosis:
         """Posteriors and decisions for a whole series; identical to :meth:`reset` then :meth:`step` per sample."""
+        residuals = checked_residuals(residuals, self.names, "the MHSPRT")
         self._need()
-        if self.names is not None and residuals.names != self.names:
-            raise DataError(f"residuals {residuals.names} differ from the fitted {self.names}")
         r = residuals.r
         ok = residuals.valid & np.all(np.isfinite(r), axis=1)
         x = self._features(r)
@@ -352,11 +352,16 @@ class MhsprtEvaluator:
         self._setup()
         self._state = self._init.copy()
 
-    def step(self, r) -> StepDecision:
-        """Update with one residual sample; a NaN/inf sample holds the posterior and is reported invalid."""
+    def step(self, r, *, valid: bool = True, names=None) -> StepDecision:
+        """Update with one residual sample; a NaN/inf sample holds the posterior and is reported invalid.
+
+        ``valid=False`` (e.g. ``valid=stepper.last_valid`` for a recovering sample after a gap) is
+        treated like a NaN sample: the statistics and the decision hold.  ``names`` (optional) are
+        checked against the residual names of the fit (:class:`DataError` on a difference).
+        """
         self._need()
-        r = np.asarray(r, dtype=float).ravel()
-        valid = bool(np.all(np.isfinite(r)))
+        r = step_vector(r, self.names, names, "the MHSPRT")
+        valid = bool(valid) and bool(np.all(np.isfinite(r)))
         if valid:
             x = self._features(r[None, :])
             if x.shape[1] != self.densities[NO_FAULT].dim:

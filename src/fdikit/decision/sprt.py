@@ -42,7 +42,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from fdikit.decision.common import checked_names, held, isolate_cached, k_of_n
+from fdikit.decision.common import checked_names, checked_residuals, held, isolate_cached, k_of_n, step_vector
 from fdikit.decision.glr import BlockLayout, as_covariance, fit_moments
 from fdikit.diagnosis import Diagnosis, StepDecision, isolate
 from fdikit.errors import DataError, ModelError
@@ -243,6 +243,7 @@ class SprtEvaluator:
     # ------------------------------------------------------------------ batch
     def run(self, residuals: Residuals) -> Diagnosis:
         """Decisions for a whole residual series; identical to stepping through it."""
+        residuals = checked_residuals(residuals, self.names, "the SPRT")
         q = len(residuals.names)
         mean, layout, w, c = self._ready(q, residuals)
         r = residuals.r
@@ -271,13 +272,18 @@ class SprtEvaluator:
         self.llr: np.ndarray | None = None
         self.decision: np.ndarray | None = None
 
-    def step(self, r) -> StepDecision:
+    def step(self, r, *, valid: bool = True, names=None) -> StepDecision:
         """Decision for one residual sample; a NaN/inf sample holds the statistic and the decision.
+
+        ``valid=False`` (e.g. ``valid=stepper.last_valid`` for a recovering sample after a gap) is
+        treated like a NaN sample: the statistics and the decision hold.  ``names`` (optional) are
+        checked against the residual names of the fit (:class:`DataError` on a difference).
+
 
         After the call ``llr`` holds ``Λ_k`` and ``decision`` the decision as in ``meta``.
         The parameters are read at the first step after :meth:`reset` (or :meth:`fit`).
         """
-        r = np.asarray(r, dtype=float).ravel()
+        r = step_vector(r, self.names, names, "the SPRT")
         st = self._state
         if st is not None and st["q"] != r.size:
             raise DataError(f"step() got {r.size} residuals after steps with {st['q']}; call reset() first")
@@ -290,7 +296,7 @@ class SprtEvaluator:
                 "fired": np.zeros(G, bool), "cache": {},
             }
             self.llr, self.decision = np.zeros(G), np.zeros(G, np.int8)
-        if not np.all(np.isfinite(r)):
+        if not (valid and np.all(np.isfinite(r))):
             fired = st["fired"]
             return StepDecision(bool(fired.any()), self._isolate(fired), fired.copy(), False)
         lam = self._llr(r - st["mean"], st["layout"], st["w"], st["c"])

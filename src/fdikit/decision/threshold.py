@@ -26,7 +26,7 @@ from collections import deque
 import numpy as np
 from scipy.stats import norm
 
-from fdikit.decision.common import held, isolate_cached, k_of_n
+from fdikit.decision.common import checked_residuals, held, isolate_cached, k_of_n, step_vector
 from fdikit.diagnosis import Diagnosis, StepDecision, isolate
 from fdikit.errors import DataError, ModelError
 from fdikit.residuals import Residuals
@@ -149,6 +149,7 @@ class ThresholdEvaluator:
     # ------------------------------------------------------------------ batch
     def run(self, residuals: Residuals) -> Diagnosis:
         """Decisions for a whole residual series; identical to stepping through it."""
+        residuals = checked_residuals(residuals, self.names, "the threshold evaluator")
         q = len(residuals.names)
         tau, c, iso = self._ready(q, residuals)
         r = residuals.r
@@ -168,11 +169,16 @@ class ThresholdEvaluator:
         self._last = None
         self._labels: dict[bytes, str] = {}
 
-    def step(self, r) -> StepDecision:
-        """Decision for one residual sample; a NaN/inf sample holds the previous decision."""
-        r = np.asarray(r, dtype=float).ravel()
+    def step(self, r, *, valid: bool = True, names=None) -> StepDecision:
+        """Decision for one residual sample; a NaN/inf sample holds the previous decision.
+
+        ``valid=False`` (e.g. ``valid=stepper.last_valid`` for a recovering sample after a gap) is
+        treated like a NaN sample: the statistics and the decision hold.  ``names`` (optional) are
+        checked against the residual names of the fit (:class:`DataError` on a difference).
+        """
+        r = step_vector(r, self.names, names, "the threshold evaluator")
         tau, c, iso = self._ready(r.size)
-        if not np.all(np.isfinite(r)):
+        if not (valid and np.all(np.isfinite(r))):
             fired = np.zeros(r.size, bool) if self._last is None else self._last
             valid = False
         else:
