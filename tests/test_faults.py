@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 import scipy.stats
 
-from fdikit import FaultModel, ModelError
+from fdikit import FaultModel, ParameterError
 from fdikit.faults import (
     NO_FAULT,
     Bias,
@@ -97,9 +97,10 @@ def test_loss_of_effectiveness(loss):
     np.testing.assert_array_equal(out[during], (1.0 - loss) * v[during])
 
 
-@pytest.mark.parametrize("loss", [-0.01, 1.01, np.nan])
-def test_loss_of_effectiveness_outside_unit_interval(loss):
-    with pytest.raises(ModelError, match=r"must be in \[0, 1\]"):
+@pytest.mark.parametrize(("loss", "pattern"), [(-0.01, r"must be in \[0, 1\]"), (1.01, r"must be in \[0, 1\]"),
+                                               (np.nan, "loss must be a finite number")])
+def test_loss_of_effectiveness_outside_unit_interval(loss, pattern):
+    with pytest.raises(ParameterError, match=pattern):
         LossOfEffectiveness("a", loss=loss)
 
 
@@ -132,9 +133,9 @@ def test_noise_std_within_chi_square_tolerance_and_zero_mean():
 
 
 def test_noise_needs_rng_and_nonnegative_std():
-    with pytest.raises(ModelError, match="numpy.random.Generator"):
+    with pytest.raises(ParameterError, match="numpy.random.Generator"):
         Noise("a", std=0.1).apply(T, _clean())
-    with pytest.raises(ModelError, match="std must be >= 0"):
+    with pytest.raises(ParameterError, match="std must be >= 0"):
         Noise("a", std=-0.1)
 
 
@@ -165,24 +166,24 @@ def test_intermittent_active_samples_per_period_equal_duty(onset, period, duty, 
 
 
 def test_intermittent_validation():
-    with pytest.raises(ModelError, match="period > 0"):
+    with pytest.raises(ParameterError, match="period > 0"):
         Intermittent("a", period=0.0)
-    with pytest.raises(ModelError, match="0 < duty <= 1"):
+    with pytest.raises(ParameterError, match="0 < duty <= 1"):
         Intermittent("a", duty=0.0)
-    with pytest.raises(ModelError, match="0 < duty <= 1"):
+    with pytest.raises(ParameterError, match="0 < duty <= 1"):
         Intermittent("a", duty=1.5)
 
 
 def test_fault_construction_validation():
-    with pytest.raises(ModelError, match="must be after its onset"):
+    with pytest.raises(ParameterError, match="must be after its onset"):
         Bias("a", 1.0, onset=5.0, end=5.0)
-    with pytest.raises(ModelError, match="finite time"):
+    with pytest.raises(ParameterError, match="onset must be a finite number"):
         Bias("a", 1.0, onset=np.inf)
-    with pytest.raises(ModelError, match="'sensor' or 'actuator'"):
+    with pytest.raises(ParameterError, match="'sensor' or 'actuator'"):
         Bias("a", 1.0, location="engine")
-    with pytest.raises(ModelError, match="name of the signal"):
+    with pytest.raises(ParameterError, match="name of the signal"):
         Bias("", 1.0)
-    with pytest.raises(ModelError, match="no location yet"):
+    with pytest.raises(ParameterError, match="no location yet"):
         _ = Bias("a", 1.0).name
 
 
@@ -203,17 +204,17 @@ def test_resolve_fixes_location_from_names():
 
 
 def test_resolve_errors_name_the_plant_signals():
-    with pytest.raises(ModelError, match=r"both an output and a control"):
+    with pytest.raises(ParameterError, match=r"both an output and a control"):
         FaultScenario([Bias("steer", 0.1)]).resolve(OUTPUTS, CONTROLS)
-    with pytest.raises(ModelError, match=r"no sensor named 'throttle'.*\['yaw_rate', 'speed', 'steer'\]"):
+    with pytest.raises(ParameterError, match=r"no sensor named 'throttle'.*\['yaw_rate', 'speed', 'steer'\]"):
         FaultScenario([Bias("throttle", 0.1, location="sensor")]).resolve(OUTPUTS, CONTROLS)
-    with pytest.raises(ModelError, match=r"no actuator named 'speed'.*\['steer', 'throttle'\]"):
+    with pytest.raises(ParameterError, match=r"no actuator named 'speed'.*\['steer', 'throttle'\]"):
         FaultScenario([Bias("speed", 0.1, location="actuator")]).resolve(OUTPUTS, CONTROLS)
     with pytest.raises(
-        ModelError, match=r"no signal named 'brake'.*\['yaw_rate', 'speed', 'steer'\].*\['steer', 'throttle'\]"
+        ParameterError, match=r"no signal named 'brake'.*\['yaw_rate', 'speed', 'steer'\].*\['steer', 'throttle'\]"
     ):
         FaultScenario([Bias("brake", 0.1)]).resolve(OUTPUTS, CONTROLS)
-    with pytest.raises(ModelError, match="holds Fault objects"):
+    with pytest.raises(ParameterError, match="holds Fault objects"):
         FaultScenario(["bias:speed:1"])
 
 
@@ -279,7 +280,7 @@ def test_parse_fault_onset_in_exponent_notation():
     ],
 )
 def test_parse_fault_bad_specs(spec, pattern):
-    with pytest.raises(ModelError, match=pattern):
+    with pytest.raises(ParameterError, match=pattern):
         parse_fault(spec)
 
 

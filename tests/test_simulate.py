@@ -13,7 +13,7 @@ import scipy.linalg
 import scipy.signal
 import scipy.stats
 
-from fdikit import DataError, FaultModel, ModelError
+from fdikit import DataError, FaultModel, ModelError, ParameterError
 from fdikit.faults import Bias, FaultScenario
 from fdikit.simulate import NonlinearPlant, simulate, time_grid
 from reference import state_space_loop
@@ -88,7 +88,7 @@ def test_discrete_plant_runs_at_its_own_dt():
     np.testing.assert_allclose(tr.y, y_ref, rtol=0, atol=1e-12 * np.abs(y_ref).max())
     same = simulate(m, duration=3.0, dt=0.05, u=u, x0=X0)  # a matching dt is accepted
     np.testing.assert_array_equal(same.y, tr.y)
-    with pytest.raises(DataError, match="differs from the discrete plant"):
+    with pytest.raises(ParameterError, match="differs from the discrete plant"):
         simulate(m, duration=3.0, dt=0.1)
 
 
@@ -260,16 +260,16 @@ def test_nonlinear_plant_with_sensor_fault():
         ({"duration": 1.0, "dt": 0.1, "u": np.zeros((10, 2))}, DataError, r"u has shape"),
         ({"duration": 1.0, "dt": 0.1, "u": np.full((11, 2), np.nan)}, DataError, "non-finite"),
         ({"duration": 1.0, "dt": 0.1, "d": np.zeros((11, 2))}, DataError, r"d has shape"),
-        ({"dt": 0.1}, DataError, "give either t, or both duration and dt"),
-        ({"duration": 1.0}, DataError, "give either t, or both duration and dt"),
-        ({"duration": -1.0, "dt": 0.1}, DataError, "duration must be >= 0"),
-        ({"duration": 1.0, "dt": 0.0}, DataError, "dt must be positive"),
+        ({"dt": 0.1}, ParameterError, "give either t, or both duration and dt"),
+        ({"duration": 1.0}, ParameterError, "give either t, or both duration and dt"),
+        ({"duration": -1.0, "dt": 0.1}, ParameterError, "duration must be >= 0"),
+        ({"duration": 1.0, "dt": 0.0}, ParameterError, r"dt \(the sample time\) must be > 0"),
         ({"t": np.array([0.0, 0.1, 0.25, 0.3])}, DataError, "uniformly spaced"),
-        ({"duration": 1.0, "dt": 0.1, "measurement_noise": [0.1, 0.2, 0.3]}, DataError, "standard deviations"),
-        ({"duration": 1.0, "dt": 0.1, "measurement_noise": [[1.0, 2.0], [2.0, 1.0]]}, DataError, "semidefinite"),
-        ({"duration": 1.0, "dt": 0.1, "scenario": FaultScenario([Bias("brake", 1.0)])}, ModelError,
+        ({"duration": 1.0, "dt": 0.1, "measurement_noise": [0.1, 0.2, 0.3]}, ParameterError, "standard deviations"),
+        ({"duration": 1.0, "dt": 0.1, "measurement_noise": [[1.0, 2.0], [2.0, 1.0]]}, ParameterError, "semidefinite"),
+        ({"duration": 1.0, "dt": 0.1, "scenario": FaultScenario([Bias("brake", 1.0)])}, ParameterError,
          r"no signal named 'brake'"),
-        ({"duration": 1.0, "dt": 0.1, "scenario": FaultScenario([Bias("u1", 1.0, location="sensor")])}, ModelError,
+        ({"duration": 1.0, "dt": 0.1, "scenario": FaultScenario([Bias("u1", 1.0, location="sensor")])}, ParameterError,
          r"no sensor named 'u1'"),
     ],
 )
@@ -280,24 +280,24 @@ def test_bad_inputs_linear(kwargs, error, pattern):
         simulate(_continuous(), scenario, **kwargs)
 
 
-def test_wrong_initial_state_shape_is_a_data_error():
-    with pytest.raises((DataError, ModelError)):
+def test_wrong_initial_state_shape_is_a_parameter_error():
+    with pytest.raises(ParameterError, match="x0 has shape"):
         simulate(_continuous(), duration=1.0, dt=0.1, x0=[1.0, 2.0])
 
 
-def test_noise_cov_for_a_model_without_noise_inputs_is_a_data_error():
+def test_noise_cov_for_a_model_without_noise_inputs_is_a_parameter_error():
     """_continuous() has no noise group; simulate should say so rather than fail inside numpy."""
-    with pytest.raises(DataError):
+    with pytest.raises(ParameterError, match="no noise inputs"):
         simulate(_continuous(), duration=1.0, dt=0.1, noise_cov=0.1)
 
 
 def test_bad_inputs_nonlinear_and_unknown_plant():
     plant = _linear_as_nonlinear()
-    with pytest.raises(ModelError, match="unknown integration method"):
+    with pytest.raises(ParameterError, match="unknown integration method"):
         simulate(plant, duration=1.0, dt=0.1, method="euler")
-    with pytest.raises(DataError, match="no separate disturbance"):
+    with pytest.raises(ParameterError, match="no separate disturbance"):
         simulate(plant, duration=1.0, dt=0.1, d=np.zeros((11, 1)))
-    with pytest.raises(ModelError, match="cannot simulate a StateSpace"):
+    with pytest.raises(ParameterError, match="cannot simulate a StateSpace"):
         simulate(control.ss(-1, 1, 1, 0), duration=1.0, dt=0.1)
     with pytest.raises(ModelError, match="x0 has shape"):
         NonlinearPlant(f=plant.f, h=plant.h, states=["a"], outputs=["b"], controls=[], x0=[1.0, 2.0])

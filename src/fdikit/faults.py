@@ -21,15 +21,17 @@ Examples
 
 from __future__ import annotations
 
+import math
+import numbers
 import re
 from abc import ABC, abstractmethod
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Literal
+from typing import ClassVar, Literal
 
 import numpy as np
 
-from fdikit.errors import ModelError
+from fdikit.errors import DataError, ParameterError
 from fdikit.model import actuator_fault_name, sensor_fault_name
 
 __all__ = [
@@ -44,11 +46,25 @@ __all__ = [
     "FaultScenario",
     "NO_FAULT",
     "parse_fault",
+    "format_fault",
 ]
 
 Location = Literal["sensor", "actuator"]
 #: Truth label of a sample with no active fault.
 NO_FAULT = "none"
+
+
+def _real(owner: str, name: str, value, *, finite: bool = True, hint: str = "") -> float:
+    """``value`` as a float: a real number (not a bool, str or array), finite unless ``finite=False``."""
+    ok = isinstance(value, numbers.Real) and not isinstance(value, bool | np.bool_)
+    if not ok and isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
+        ok = True
+    if not ok:
+        raise ParameterError(f"{owner}: {name} must be a number, got {value!r} ({type(value).__name__})")
+    v = float(value)
+    if finite and not math.isfinite(v):
+        raise ParameterError(f"{owner}: {name} must be a finite number, got {v}{hint}")
+    return v
 
 
 @dataclass(frozen=True)
@@ -57,7 +73,14 @@ class Fault(ABC):
 
     ``location`` is ``'sensor'`` or ``'actuator'``; ``None`` lets the scenario
     resolve it from the plant's names (an error when the name is both an output and
-    a control).
+    a control).  Every number (onset, end and the kind's size) must be finite; they are
+    stored as floats.
+
+    Raises
+    ------
+    ParameterError
+        For an empty or non-string target, an unknown location, a non-number or non-finite
+        onset, end or size, an end not after the onset, or a size out of the kind's range.
     """
 
     target: str
@@ -65,22 +88,54 @@ class Fault(ABC):
     end: float | None = field(default=None, kw_only=True)
     location: Location | None = field(default=None, kw_only=True)
 
+    #: names of the kind's numeric parameters (validated finite and stored as float)
+    _values: ClassVar[tuple[str, ...]] = ()
+
     def __post_init__(self) -> None:
+        kind = type(self).__name__
         if not isinstance(self.target, str) or not self.target:
-            raise ModelError(f"a fault needs the name of the signal it acts on, got {self.target!r}")
+            raise ParameterError(
+                f"{kind}: target must be the name of the signal the fault acts on (a non-empty str), "
+                f"got {self.target!r}"
+            )
+        owner = f"{kind} on {self.target!r}"
         if self.location not in (None, "sensor", "actuator"):
-            raise ModelError(f"fault location must be 'sensor' or 'actuator', got {self.location!r}")
-        if not np.isfinite(self.onset):
-            raise ModelError(f"fault onset must be a finite time, got {self.onset}")
-        if self.end is not None and not self.end > self.onset:
-            raise ModelError(f"fault end ({self.end}) must be after its onset ({self.onset})")
+            raise ParameterError(f"{owner}: location must be 'sensor' or 'actuator' (or None to resolve it from "
+                                 f"the plant's names), got {self.location!r}")
+        object.__setattr__(self, "onset", _real(owner, "onset", self.onset))
+        if self.end is not None:
+            end = _real(owner, "end", self.end, finite=False)
+            if not math.isfinite(end):
+                raise ParameterError(f"{owner}: end must be a finite time, got {end}; "
+                                     "use end=None for a fault that never ends")
+            if not end > self.onset:
+                raise ParameterError(f"{owner}: end ({end}) must be after its onset ({self.onset})")
+            object.__setattr__(self, "end", end)
+        for name in self._values:
+            value = getattr(self, name)
+            if value is not None or not self._optional(name):
+                object.__setattr__(self, name, _real(owner, name, value))
+        self._check(owner)
+
+    def _optional(self, name: str) -> bool:
+        """Whether the parameter ``name`` may be None."""
+        return False
+
+    def _check(self, owner: str) -> None:  # noqa: B027 - a hook; most kinds take any finite value
+        """Range checks of the kind's parameters (after they are known finite floats)."""
 
     @property
     def name(self) -> str:
         """Truth label: ``'<target>_sensor'`` or ``'<target>_actuator'`` (the FaultModel fault name)."""
         if self.location is None:
-            raise ModelError(f"fault on {self.target!r} has no location yet; resolve the scenario against a plant")
+            raise ParameterError(f"fault on {self.target!r} has no location yet; resolve the scenario against a "
+                                 "plant (FaultScenario.resolve) or give location='sensor' or 'actuator'")
         return sensor_fault_name(self.target) if self.location == "sensor" else actuator_fault_name(self.target)
+
+    @property
+    def spec(self) -> str:
+        """The fault as a spec string (:func:`format_fault`); ``parse_fault(f.spec) == f``."""
+        return format_fault(self)
 
     def active(self, t: np.ndarray) -> np.ndarray:
         """Boolean mask of the samples where the fault acts."""
@@ -91,9 +146,27 @@ class Fault(ABC):
         return mask
 
     def apply(self, t: np.ndarray, v: np.ndarray, rng: np.random.Generator | None = None) -> np.ndarray:
-        """The faulty signal: ``v`` (samples,) changed where the fault is active."""
-        t = np.asarray(t, dtype=float)
-        v = np.asarray(v, dtype=float)
+        """The faulty signal: ``v`` (samples,) changed where the fault is active.
+
+        Samples before the onset (and from the end on) are returned unchanged, bit for bit.
+
+        Raises
+        ------
+        DataError
+            When ``t`` or ``v`` is not numeric or their shapes differ.
+        ParameterError
+            For a :class:`Noise` fault without a generator ``rng``.
+        """
+        arrs = []
+        for label, a in (("t", t), ("v", v)):
+            try:
+                arrs.append(np.asarray(a, dtype=float))
+            except (TypeError, ValueError):
+                raise DataError(f"{type(self).__name__}.apply: {label} must hold numbers, got {a!r:.80}") from None
+        t, v = arrs
+        if t.ndim != 1 or t.shape != v.shape:
+            raise DataError(f"{type(self).__name__}.apply: t has shape {t.shape} and v {v.shape}; "
+                            "need two 1-D arrays of the same length (one value per sample)")
         out = v.copy()
         mask = self.active(t)
         if mask.any():
@@ -110,6 +183,7 @@ class Bias(Fault):
     """Additive step: ``v + size`` (sensor bias, Douglas et al. 1996 eq. (3.3); actuator offset)."""
 
     size: float = 0.0
+    _values: ClassVar[tuple[str, ...]] = ("size",)
 
     def _faulty(self, t, v, mask, rng):
         return v[mask] + self.size
@@ -120,6 +194,7 @@ class Drift(Fault):
     """Ramp: ``v + rate * (t - onset)``."""
 
     rate: float = 0.0
+    _values: ClassVar[tuple[str, ...]] = ("rate",)
 
     def _faulty(self, t, v, mask, rng):
         return v[mask] + self.rate * (t[mask] - self.onset)
@@ -134,6 +209,10 @@ class Stuck(Fault):
     """
 
     value: float | None = None
+    _values: ClassVar[tuple[str, ...]] = ("value",)
+
+    def _optional(self, name: str) -> bool:
+        return True
 
     def _faulty(self, t, v, mask, rng):
         if self.value is not None:
@@ -147,11 +226,12 @@ class LossOfEffectiveness(Fault):
     """Multiplicative loss: ``(1 - loss) * v`` with ``loss`` in [0, 1] (Hallouzi 2008, §4.1)."""
 
     loss: float = 0.0
+    _values: ClassVar[tuple[str, ...]] = ("loss",)
 
-    def __post_init__(self) -> None:
-        super().__post_init__()
+    def _check(self, owner: str) -> None:
         if not 0.0 <= self.loss <= 1.0:
-            raise ModelError(f"loss of effectiveness must be in [0, 1] (0 = healthy, 1 = dead), got {self.loss}")
+            raise ParameterError(f"{owner}: loss of effectiveness must be in [0, 1] (0 = healthy, 1 = dead), "
+                                 f"got loss={self.loss}")
 
     def _faulty(self, t, v, mask, rng):
         return (1.0 - self.loss) * v[mask]
@@ -162,6 +242,7 @@ class ScaleFactor(Fault):
     """Gain error: ``factor * v`` (a sensor scale-factor fault; van der Ploeg's ``f_m``)."""
 
     factor: float = 1.0
+    _values: ClassVar[tuple[str, ...]] = ("factor",)
 
     def _faulty(self, t, v, mask, rng):
         return self.factor * v[mask]
@@ -172,15 +253,16 @@ class Noise(Fault):
     """Extra zero-mean Gaussian noise of standard deviation ``std``."""
 
     std: float = 0.0
+    _values: ClassVar[tuple[str, ...]] = ("std",)
 
-    def __post_init__(self) -> None:
-        super().__post_init__()
+    def _check(self, owner: str) -> None:
         if not self.std >= 0:
-            raise ModelError(f"noise std must be >= 0, got {self.std}")
+            raise ParameterError(f"{owner}: noise std must be >= 0, got std={self.std}")
 
     def _faulty(self, t, v, mask, rng):
-        if rng is None:
-            raise ModelError("a Noise fault needs a numpy.random.Generator (pass rng= or seed= to simulate)")
+        if not isinstance(rng, np.random.Generator):
+            raise ParameterError(f"a Noise fault on {self.target!r} needs rng, a numpy.random.Generator "
+                                 f"(got {type(rng).__name__}; pass rng= or seed= to simulate)")
         return v[mask] + self.std * rng.standard_normal(mask.sum())
 
 
@@ -191,11 +273,14 @@ class Intermittent(Fault):
     size: float = 0.0
     period: float = 1.0
     duty: float = 0.5
+    _values: ClassVar[tuple[str, ...]] = ("size", "period", "duty")
 
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        if not self.period > 0 or not 0 < self.duty <= 1:
-            raise ModelError(f"intermittent fault needs period > 0 and 0 < duty <= 1, got {self.period}, {self.duty}")
+    def _check(self, owner: str) -> None:
+        if not self.period > 0:
+            raise ParameterError(f"{owner}: intermittent fault needs period > 0, got period={self.period}")
+        if not 0 < self.duty <= 1:
+            raise ParameterError(f"{owner}: intermittent fault needs a duty in (0, 1] (0 < duty <= 1), "
+                                 f"got duty={self.duty}")
 
     def active(self, t: np.ndarray) -> np.ndarray:
         t = np.asarray(t, dtype=float)
@@ -214,15 +299,35 @@ class FaultScenario:
     Parameters
     ----------
     faults : iterable of Fault
+        Applied in this order to each signal (so ``[ScaleFactor, Bias]`` on one actuator gives
+        ``factor * u + size``).
     label : str, optional
         Defaults to the names of the faults joined by ``'+'``, or ``'none'``.
+
+    Raises
+    ------
+    ParameterError
+        When ``faults`` is not an iterable of :class:`Fault` or ``label`` is not a non-empty str.
     """
 
     def __init__(self, faults: Iterable[Fault] = (), label: str | None = None) -> None:
-        self.faults: tuple[Fault, ...] = tuple(faults)
+        if isinstance(faults, Fault):
+            raise ParameterError("FaultScenario: faults must be an iterable of Fault objects; "
+                                 f"wrap the single fault in a list: FaultScenario([{faults!r}])")
+        if isinstance(faults, str):
+            raise ParameterError(f"FaultScenario: faults must be Fault objects, got the str {faults!r}; "
+                                 "read spec strings with parse_fault")
+        try:
+            self.faults: tuple[Fault, ...] = tuple(faults)
+        except TypeError:
+            raise ParameterError(f"FaultScenario: faults must be an iterable of Fault objects, "
+                                 f"got {type(faults).__name__}") from None
         for f in self.faults:
             if not isinstance(f, Fault):
-                raise ModelError(f"a FaultScenario holds Fault objects, got {type(f).__name__}")
+                hint = "; read spec strings with parse_fault" if isinstance(f, str) else ""
+                raise ParameterError(f"a FaultScenario holds Fault objects, got {type(f).__name__} {f!r:.60}{hint}")
+        if label is not None and (not isinstance(label, str) or not label):
+            raise ParameterError(f"FaultScenario: label must be a non-empty str (or None), got {label!r}")
         self._label = label
 
     @property
@@ -238,25 +343,26 @@ class FaultScenario:
 
         Raises
         ------
-        ModelError
+        ParameterError
             For a target the plant does not have, a location that does not match, or an
             ambiguous name (both an output and a control) without an explicit location.
         """
+        outputs, controls = list(outputs), list(controls)
         resolved = []
         for f in self.faults:
             is_out, is_ctl = f.target in outputs, f.target in controls
             loc = f.location
             if loc is None:
                 if is_out and is_ctl:
-                    raise ModelError(
+                    raise ParameterError(
                         f"{f.target!r} is both an output and a control of the plant; "
                         "give the fault location='sensor' or location='actuator'"
                     )
                 loc = "sensor" if is_out else "actuator" if is_ctl else None
             if (loc == "sensor" and not is_out) or (loc == "actuator" and not is_ctl) or loc is None:
-                raise ModelError(
+                raise ParameterError(
                     f"the plant has no {'sensor' if loc == 'sensor' else 'actuator' if loc else 'signal'} "
-                    f"named {f.target!r}; its outputs are {list(outputs)} and its controls {list(controls)}"
+                    f"named {f.target!r}; its outputs are {outputs} and its controls {controls}"
                 )
             resolved.append(replace(f, location=loc))
         return FaultScenario(resolved, self._label)
@@ -290,36 +396,143 @@ _KINDS = {
     "noise": (Noise, "std"),
     "intermittent": (Intermittent, "size"),
 }
+#: the kind word :func:`format_fault` writes for each class (``ramp`` is read as a drift)
+_KIND_OF = {Bias: "bias", Drift: "drift", Stuck: "stuck", LossOfEffectiveness: "loe", ScaleFactor: "scale",
+            Noise: "noise", Intermittent: "intermittent"}
 _NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
-_SPEC = re.compile(
-    rf"^(?P<kind>\w+):(?P<target>[\w.]+)(?::(?P<value>[^@]*))?(?:@(?P<onset>{_NUM})(?:-(?P<end>{_NUM}))?)?$"
-)
+# also matched (then refused as not finite) so that '@inf' says what is wrong
+_NUM_OR_WORD = rf"(?:{_NUM}|[-+]?(?:nan|inf|infinity))"
+_TIMING = re.compile(rf"^(?P<onset>{_NUM_OR_WORD})(?:-(?P<end>{_NUM_OR_WORD}))?$", re.IGNORECASE)
+_TARGET = re.compile(r"^[\w.]+$")
+_GRAMMAR = "kind:target[:value][@onset[-end]][#sensor|#actuator]"
+
+
+def _spec_number(spec: str, what: str, text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise ParameterError(f"fault spec {spec!r}: the {what} {text!r} cannot be read as a number") from None
+    if not math.isfinite(value):
+        raise ParameterError(f"fault spec {spec!r}: the {what} must be a finite number, got {text!r}")
+    return value
 
 
 def parse_fault(spec: str) -> Fault:
-    """Parse ``"kind:target[:value][@onset[-end]]"``, e.g. ``"bias:yaw_rate:0.02@10"``.
+    """Parse ``"kind:target[:value][@onset[-end]][#location]"``, e.g. ``"bias:yaw_rate:0.02@10"``.
 
-    Kinds: bias, drift (or ramp), stuck (value optional: hold at onset), loe, scale,
-    noise, intermittent (bias with 1 s period, 50 % duty).
+    Kinds: bias, drift (or ramp), stuck (value optional: hold at onset), loe, scale, noise,
+    intermittent (value ``size[/period[/duty]]``, by default a 1 s period and 50 % duty).
+    ``#sensor`` or ``#actuator`` fixes the location of a name that is both an output and a
+    control.  Every number must be finite; :func:`format_fault` writes the same grammar, and
+    ``parse_fault(format_fault(f)) == f`` for every fault.
+
+    Raises
+    ------
+    ParameterError
+        For a spec that is not a str, does not follow the grammar, names an unknown kind or
+        holds a number that cannot be read, is not finite or is out of the kind's range.
+
+    Examples
+    --------
+    >>> parse_fault("intermittent:speed:0.2/2/0.25@4-10")
+    Intermittent(target='speed', onset=4.0, end=10.0, location=None, size=0.2, period=2.0, duty=0.25)
     """
-    m = _SPEC.match(spec.strip())
-    if not m or m["kind"] not in _KINDS:
-        raise ModelError(
-            f"cannot read fault spec {spec!r}; write kind:target[:value][@onset[-end]] "
-            f"with kind one of {sorted(_KINDS)}, e.g. 'bias:yaw_rate:0.02@10'"
-        )
-    cls, field_name = _KINDS[m["kind"]]
-    kw: dict = {"target": m["target"]}
-    try:
-        if m["value"]:
-            kw[field_name] = float(m["value"])
-        elif cls is not Stuck:
-            example = f"{m['kind']}:{m['target']}:0.1"
-            raise ModelError(f"fault spec {spec!r} needs a value after the target, e.g. {example!r}")
-        if m["onset"]:
-            kw["onset"] = float(m["onset"])
+    if not isinstance(spec, str):
+        raise ParameterError(f"a fault spec must be a string like 'bias:yaw_rate:0.02@10', "
+                             f"got {type(spec).__name__} {spec!r:.60}")
+    text = spec.strip()
+    if not text:
+        raise ParameterError(f"the fault spec is empty; write {_GRAMMAR}, e.g. 'bias:yaw_rate:0.02@10'")
+    kw: dict = {}
+    text, hash_, loc = text.partition("#")
+    if hash_:
+        if loc not in ("sensor", "actuator"):
+            raise ParameterError(f"fault spec {spec!r}: the location after '#' must be 'sensor' or 'actuator', "
+                                 f"got {loc!r}")
+        kw["location"] = loc
+    text, at, timing = text.partition("@")
+    head = text.split(":", 2)
+    if len(head) < 2 or (at and not timing):
+        raise ParameterError(f"cannot read fault spec {spec!r}; write {_GRAMMAR} "
+                             f"with kind one of {sorted(_KINDS)}, e.g. 'bias:yaw_rate:0.02@10'")
+    kind, target = head[0], head[1]
+    if kind not in _KINDS:
+        raise ParameterError(f"cannot read fault spec {spec!r}: unknown fault kind {kind!r}; "
+                             f"the kinds are {sorted(_KINDS)}")
+    if not _TARGET.match(target):
+        raise ParameterError(f"cannot read fault spec {spec!r}: the target must be a signal name (letters, digits, "
+                             f"'_' and '.'), got {target!r}")
+    kw["target"] = target
+    cls, field_name = _KINDS[kind]
+    value = head[2] if len(head) == 3 else ""
+    if value:
+        parts = value.split("/")
+        names = (field_name, "period", "duty") if cls is Intermittent else (field_name,)
+        if len(parts) > len(names):
+            raise ParameterError(f"fault spec {spec!r}: a {kind} fault takes one value ({field_name})"
+                                 if len(names) == 1 else
+                                 f"fault spec {spec!r}: an intermittent fault takes at most size/period/duty")
+        for name, part in zip(names, parts):
+            kw[name] = _spec_number(spec, name, part)
+    elif cls is not Stuck:
+        raise ParameterError(f"fault spec {spec!r} needs a value after the target, e.g. {f'{kind}:{target}:0.1'!r}")
+    if at:
+        m = _TIMING.match(timing)
+        if not m:
+            raise ParameterError(f"cannot read fault spec {spec!r}: after '@' write onset or onset-end in seconds, "
+                                 f"got {timing!r}")
+        kw["onset"] = _spec_number(spec, "onset", m["onset"])
         if m["end"]:
-            kw["end"] = float(m["end"])
-    except ValueError as exc:
-        raise ModelError(f"fault spec {spec!r} has a number that cannot be read: {exc}") from None
-    return cls(**kw)
+            kw["end"] = _spec_number(spec, "end", m["end"])
+    try:
+        return cls(**kw)
+    except ParameterError as exc:
+        raise ParameterError(f"fault spec {spec!r}: {exc}") from None
+
+
+def format_fault(fault: Fault) -> str:
+    """The spec string of ``fault``, the grammar of :func:`parse_fault`; ``parse_fault(format_fault(f)) == f``.
+
+    Numbers are written with ``repr`` (the shortest string that reads back to the same float);
+    the onset is left out when it is 0 and the fault never ends, the value of a :class:`Stuck`
+    fault that holds its onset value is left out, as are an :class:`Intermittent` fault's
+    default period (1 s) and duty (0.5) at the end of its value.  The location is written as
+    ``#sensor`` / ``#actuator`` when it is set.
+
+    Raises
+    ------
+    ParameterError
+        For an object that is not one of the fault kinds, or a target that the grammar cannot
+        hold (anything but letters, digits, ``_`` and ``.``).
+
+    Examples
+    --------
+    >>> format_fault(Bias("yaw_rate", 0.02, onset=10))
+    'bias:yaw_rate:0.02@10.0'
+    >>> format_fault(parse_fault("ramp:speed:2e-3@1-5"))
+    'drift:speed:0.002@1.0-5.0'
+    """
+    kind = _KIND_OF.get(type(fault))
+    if kind is None:
+        raise ParameterError(f"format_fault needs a Fault of one of the kinds {sorted(_KINDS)}, "
+                             f"got {type(fault).__name__} {fault!r:.60}")
+    if not _TARGET.match(fault.target):
+        raise ParameterError(f"format_fault: the target {fault.target!r} cannot be written in a fault spec "
+                             "(only letters, digits, '_' and '.' are allowed in a spec's signal name)")
+    text = f"{kind}:{fault.target}"
+    if isinstance(fault, Intermittent):
+        values = [fault.size, fault.period, fault.duty]
+        while len(values) > 1 and values[-1] == (1.0, 0.5)[len(values) - 2]:
+            values.pop()
+        text += ":" + "/".join(repr(v) for v in values)
+    else:
+        value = getattr(fault, _KINDS[kind][1])
+        if value is not None:
+            text += f":{value!r}"
+    if fault.onset != 0.0 or fault.end is not None:
+        text += f"@{fault.onset!r}"
+        if fault.end is not None:
+            text += f"-{fault.end!r}"
+    if fault.location is not None:
+        text += f"#{fault.location}"
+    return text
