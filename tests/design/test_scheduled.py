@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import cvxpy as cp
 import numpy as np
 import pytest
@@ -168,25 +170,50 @@ def test_scheduled_filter_tracks_offset_while_speed_varies():
     assert np.abs(r_lti[before]).max() > 1e-3  # ... but not the LTI one (≈ 3e-3 rad before the fault)
 
 
-def test_online_equals_batch_and_skips_bad_samples():
+def test_online_equals_batch_and_follows_the_gap_rule():
     t = time_grid(3.0, 0.01)
     speed = (70 + 50 * t / 3.0) * KMH  # fast ramp so every window differs
     trace = simulate_scheduled(FAMILY, speed, FaultScenario([Bias("steering", FA, onset=1.0)]), u=_steering(t),
                                d=np.column_stack([np.full(t.size, 1 / 350), np.zeros(t.size)]))
     gen = scheduled_parity_filter(FAMILY, V70, gamma=1e7)
-    batch = gen.run(trace, schedule="speed").r[:, 0]
+    clean = gen.run(trace, schedule="speed")
+    batch = clean.r[:, 0]
     stepper = gen.online()
     online = np.array([stepper.step(trace.u[k], trace.y[k, :3], speed[k]) for k in range(len(trace))])
     np.testing.assert_allclose(online, batch, rtol=0, atol=1e-14)
-    # a NaN sample is skipped: the rest equals the batch run of the trace without that sample
-    stepper = gen.online()
-    y = trace.y[:, :3].copy()
+    assert clean.valid.all() and not clean.recovering.any()
+    # a NaN sample: NaN residual; the windows holding it give w = 0; recovering for recovery_length() after
+    y = trace.y.copy()
     y[100, 1] = np.nan
-    out = np.array([stepper.step(trace.u[k], y[k], speed[k]) for k in range(len(trace))])
-    assert np.isnan(out[100]) and stepper.invalid == 1
+    bad = Trace(t=t, u=trace.u, y=y, controls=trace.controls, outputs=trace.outputs)
+    res = gen.run(bad)
+    stepper = gen.online()
+    out = stepper.run(bad)
+    assert np.isnan(res.r[100, 0]) and np.isnan(out.r[100, 0]) and stepper.invalid == 1
+    np.testing.assert_array_equal(res.valid, out.valid)
+    np.testing.assert_array_equal(res.recovering, out.recovering)
     keep = np.arange(len(trace)) != 100
-    short = Trace(t=t[keep], u=trace.u[keep], y=trace.y[keep], controls=trace.controls, outputs=trace.outputs)
-    np.testing.assert_allclose(out[keep], gen.run(short).r[:, 0], rtol=0, atol=1e-14)
+    np.testing.assert_allclose(out.r[keep, 0], res.r[keep, 0], rtol=0, atol=1e-14)
+    np.testing.assert_allclose(res.r[:100, 0], batch[:100], rtol=0, atol=0)  # before the gap: untouched
+    # the last zero-filled w is at the last window holding sample 100: k = 100 + window
+    n_dec = gen.recovery_length()
+    last_fill = 100 + gen.window
+    expect = np.ones(len(trace), bool)
+    expect[100 : last_fill + n_dec] = False
+    np.testing.assert_array_equal(res.valid, expect)
+    assert res.recovering.sum() == last_fill + n_dec - 101
+    # after the recovery the transient is below recovery_tol (0.1) of the residual's own size
+    after = slice(last_fill + n_dec, len(trace))
+    dev = np.abs(res.r[after, 0] - batch[after])
+    assert dev.max() <= 0.1 * np.abs(batch[after]).max()
+
+
+def test_recovery_length_from_the_impulse_response():
+    """One pole p: Σ_{i≥d} p^{2i} / Σ p^{2i} = p^{2d} ≤ tol² ⇔ d ≥ log tol / log p."""
+    gen = scheduled_parity_filter(FAMILY, V70)
+    single = dataclasses.replace(gen, poles=np.array([0.9]))
+    assert single.recovery_length(0.1) == int(np.ceil(np.log(0.1) / np.log(0.9)))
+    assert gen.recovery_length(0.5) < gen.recovery_length(0.1) < gen.recovery_length(0.01)
 
 
 def test_generic_family_equals_fast_path():

@@ -46,10 +46,10 @@ import scipy.signal
 
 from fdikit.design.dae_parity import DAEModel, PolynomialParityDesign, RankTest, _real_poles, dae_form, parity_filter
 from fdikit.design.dae_parity import time_varying_bar as _bar
-from fdikit.errors import DataError, DesignError, ModelError
+from fdikit.errors import DataError, DesignError, ModelError, ParameterError
 from fdikit.linalg import rank
 from fdikit.model import FaultModel
-from fdikit.residuals import Residuals
+from fdikit.residuals import Residuals, _check_signals
 from fdikit.trace import Trace
 
 __all__ = [
@@ -220,23 +220,70 @@ class ScheduledResidualGenerator:
     def _z_lags(self) -> int:
         return self.degree + len(self.reference.dae.L)
 
-    def run(self, trace: Trace, schedule: np.ndarray | str | None = None) -> Residuals:
-        """Residuals of a whole trace; ``schedule`` is an array (N,), a column name, or None (``self.schedule``)."""
+    def recovery_length(self, tol: float = 0.1) -> int:
+        """Samples a residual stays *recovering* after the last sample whose ``w`` was zero-filled.
+
+        The residual is ``r = h * w`` with ``h`` the impulse response of ``1/d(q)``.  A value
+        ``w_j`` that could not be formed (its window held an invalid sample) is replaced by 0 (its
+        fault-free prediction), which leaves ``r_k`` short by ``h_{k−j} w_j``.  Taking ``w`` white,
+        the transient's variance relative to the residual's is at most ``Σ_{i≥k−j} h_i² / Σ_i h_i²``
+        (every earlier ``w`` missing); the sample is valid again when this is ``≤ tol²``.  Pure
+        function of the poles (one value per ``tol``).
+        """
+        if isinstance(tol, bool) or not isinstance(tol, (int, float, np.integer, np.floating)) or not (
+                np.isfinite(tol) and 0 < tol <= 1):
+            raise ParameterError(f"recovery_tol must be a number in (0, 1], got {tol!r}")
+        pmax = float(np.max(np.abs(self.poles))) if self.poles.size else 0.0
+        length = int(max(64, np.ceil(60.0 * max(1, self.poles.size) / max(1e-3, 1.0 - pmax))))
+        h = np.zeros(length)
+        h[0] = 1.0
+        for pole in self.poles:
+            h = scipy.signal.lfilter([1.0], [1.0, -pole], h)
+        tail = np.cumsum((h**2)[::-1])[::-1]  # tail[d] = Σ_{i≥d} h_i²
+        return int(np.argmax(tail <= tol**2 * tail[0]))
+
+    def run(self, trace: Trace, schedule: np.ndarray | str | None = None, *, recovery_tol: float = 0.1) -> Residuals:
+        """Residuals of a whole trace; ``schedule`` is an array (N,), a column name, or None (``self.schedule``).
+
+        Vectorised, and identical to :meth:`online` stepping (same residuals to rounding, same flags).
+
+        Gap rule (a sample is *invalid* when a used signal or the schedule is NaN/inf): its residual
+        is NaN.  The parity value ``w(k) = N̄_k L̄_k [z(τ_0) … z(τ_{d_N+d_L})]`` is formed only when
+        every sample of its window is valid; otherwise ``w(k) = 0``, its fault-free prediction (the
+        parity relation is zero without fault and noise), so the ``d(q)`` filter is propagated
+        through the gap.  The samples after a gap are *recovering* (finite residual, ``valid``
+        False) until :meth:`recovery_length` samples after the last zero-filled ``w``.  At the
+        start of a run that begins with a valid sample the window is padded with zeros as before
+        (the start-up transient is not flagged).
+        """
+        if not isinstance(trace, Trace):
+            raise DataError(f"trace must be a fdikit.trace.Trace, got {type(trace).__name__}")
         if len(trace) > 1 and not np.isclose(trace.dt, self.dt, rtol=1e-6):
             raise DataError(f"data sampled at dt={trace.dt:g} but the filter runs at dt={self.dt:g}; resample")
+        _check_signals(trace, self.controls, self.outputs)
         rho = self._schedule_of(trace, schedule)
+        n_dec = self.recovery_length(recovery_tol)
         z = np.hstack([trace.columns("y", self.outputs), trace.columns("u", self.controls)])
-        if not np.all(np.isfinite(z)):
-            k = int(np.argwhere(~np.isfinite(z))[0, 0])
-            raise DataError(f"a used signal is not finite at sample {k}; run() needs clean data — use online().step()")
+        N = len(trace)
+        ok = np.all(np.isfinite(z), axis=1) & np.isfinite(rho)
         n, m = self.window, self._z_lags()
-        zp = np.vstack([np.zeros((n, z.shape[1])), z])
-        zwin = np.hstack([zp[i : i + len(trace)] for i in range(m)])
-        w = np.einsum("kj,kj->k", self.rows(self._windows(rho)), zwin)
-        for p in self.poles:
-            w = scipy.signal.lfilter([1.0], [1.0, -p], w)
+        okp = np.concatenate([np.full(n, bool(ok[0]) if N else True), ok])
+        cs = np.concatenate([[0], np.cumsum(okp)])
+        win_ok = (cs[m : m + N] - cs[:N]) == m  # samples k−n … k−n+m−1 all valid
+        zp = np.vstack([np.zeros((n, z.shape[1])), np.where(ok[:, None], z, 0.0)])
+        w = np.zeros(N)
+        if win_ok.any():
+            zwin = np.hstack([zp[i : i + N] for i in range(m)])[win_ok]
+            w[win_ok] = np.einsum("kj,kj->k", self.rows(self._windows(rho)[win_ok]), zwin)
+        for pole in self.poles:
+            w = scipy.signal.lfilter([1.0], [1.0, -pole], w)
+        idx = np.arange(N)
+        last_fill = np.maximum.accumulate(np.where(~win_ok, idx, -(n_dec + 1)))
+        valid = ok & (idx - last_fill >= n_dec)
+        r = np.where(ok, w, np.nan)
         meta = {"trace": dict(trace.meta), "schedule": schedule if isinstance(schedule, str) else self.schedule}
-        return Residuals(trace.t, w[:, None], self.residuals, self.isolates, meta=meta)
+        return Residuals(trace.t, r[:, None], self.residuals, self.isolates, valid, meta=meta,
+                         recovering=ok & ~valid)
 
     def _schedule_of(self, trace: Trace, schedule) -> np.ndarray:
         if schedule is None or isinstance(schedule, str):
@@ -247,54 +294,103 @@ class ScheduledResidualGenerator:
                                 f"{len(trace)} values> or the name of one of {list(trace.outputs + trace.controls)}")
             rho = trace.signal(name, kind)
         else:
-            rho = np.asarray(schedule, dtype=float).ravel()
-        if rho.shape != (len(trace),) or not np.all(np.isfinite(rho)):
-            raise DataError(f"the schedule must be {len(trace)} finite values (one per sample), got shape {rho.shape}")
+            try:
+                rho = np.asarray(schedule, dtype=float).ravel()
+            except (TypeError, ValueError) as exc:
+                raise DataError(f"the schedule must be {len(trace)} numbers (one per sample), got "
+                                f"{type(schedule).__name__}") from exc
+        if rho.shape != (len(trace),):
+            raise DataError(f"the schedule must be {len(trace)} values (one per sample), got shape {rho.shape}")
         return rho
 
-    def online(self) -> ScheduledStepper:
-        """A stepper with zero initial history (like ``run``)."""
-        return ScheduledStepper(self)
+    def online(self, *, recovery_tol: float = 0.1) -> ScheduledStepper:
+        """A stepper with zero initial history (like ``run``) and the same gap rule."""
+        return ScheduledStepper(self, recovery_tol=recovery_tol)
 
 
 class ScheduledStepper:
     """Online scheduled residuals: ``step(u, y, rho)`` returns ``r(k)`` for the sample ``(u(k), y(k), ρ(k))``.
 
-    A sample with a NaN/inf gives a NaN residual, counts in ``invalid`` and is skipped (the
-    window and the filter state hold), as :class:`~fdikit.residuals.ResidualStepper` does.
+    Gap rule as :meth:`ScheduledResidualGenerator.run`: a sample with a NaN/inf (in ``u``, ``y``
+    or ``rho``) gives a NaN residual and counts in ``invalid``; it still enters the window (marked
+    invalid), and every ``w`` whose window holds an invalid sample is replaced by 0 so the
+    ``d(q)`` filter runs on.  ``last_valid`` is False on invalid and on recovering samples,
+    ``last_recovering`` True on the latter.
     """
 
-    def __init__(self, generator: ScheduledResidualGenerator) -> None:
+    def __init__(self, generator: ScheduledResidualGenerator, *, recovery_tol: float = 0.1) -> None:
         self.generator = generator
-        n = generator.window
-        self._z = np.zeros((n, len(generator.outputs) + len(generator.controls)))
+        self._n_dec = generator.recovery_length(recovery_tol)
+        self.reset()
+
+    def reset(self) -> None:
+        """Start again with zero history."""
+        g = self.generator
+        n = g.window
+        self._z = np.zeros((n, len(g.outputs) + len(g.controls)))
         self._rho: np.ndarray | None = None
+        self._ok = np.ones(n, bool)
         self._x = np.zeros(n)
+        self._k = 0
+        self._last_fill = -(self._n_dec + 1)
         self.invalid = 0
         self.last_valid = True
+        self.last_recovering = False
 
     def step(self, u: Sequence[float], y: Sequence[float], rho: float) -> float:
         """Residual of this sample (``u``, ``y`` in the generator's controls/outputs order, ``rho`` the schedule)."""
         g = self.generator
-        u, y = np.asarray(u, dtype=float).ravel(), np.asarray(y, dtype=float).ravel()
+        try:
+            u, y = np.asarray(u, dtype=float).ravel(), np.asarray(y, dtype=float).ravel()
+            rho = float(rho)
+        except (TypeError, ValueError) as exc:
+            raise DataError(f"step() needs numbers for u, y and rho (NaN marks a missing value): {exc}") from exc
         if u.size != len(g.controls) or y.size != len(g.outputs):
             raise DataError(f"step() needs {len(g.controls)} controls {list(g.controls)} and {len(g.outputs)} "
                             f"outputs {list(g.outputs)}, got {u.size} and {y.size}")
-        if not (np.all(np.isfinite(u)) and np.all(np.isfinite(y)) and np.isfinite(rho)):
-            self.invalid += 1
-            self.last_valid = False
-            return float("nan")
-        self.last_valid = True
+        ok = bool(np.all(np.isfinite(u)) and np.all(np.isfinite(y)) and np.isfinite(rho))
         if self._rho is None:
-            self._rho = np.full(g.window, float(rho))
-        row = g.rows(self._rho[: g.degree + 1])[0]
-        w = float(row @ self._z[: g._z_lags()].ravel())
+            self._rho = np.full(g.window, rho if ok else np.nan)
+            self._ok[:] = ok
+        m = g._z_lags()
+        if self._ok[:m].all():
+            row = g.rows(self._rho[: g.degree + 1])[0]
+            w = float(row @ self._z[:m].ravel())
+        else:
+            w = 0.0
+            self._last_fill = self._k
         for i, p in enumerate(g.poles):
             self._x[i] = p * self._x[i] + w
             w = self._x[i]
-        self._z = np.vstack([self._z[1:], np.concatenate([y, u])])
-        self._rho = np.append(self._rho[1:], float(rho))
+        self._z = np.vstack([self._z[1:], np.concatenate([y, u]) if ok else np.zeros(self._z.shape[1])])
+        self._rho = np.append(self._rho[1:], rho if ok else np.nan)
+        self._ok = np.append(self._ok[1:], ok)
+        self.last_valid = ok and self._k - self._last_fill >= self._n_dec
+        self.last_recovering = ok and not self.last_valid
+        self._k += 1
+        if not ok:
+            self.invalid += 1
+            return float("nan")
         return w
+
+    def run(self, trace: Trace, schedule: np.ndarray | str | None = None) -> Residuals:
+        """Step through a whole trace (what :meth:`ScheduledResidualGenerator.run` vectorises)."""
+        g = self.generator
+        if not isinstance(trace, Trace):
+            raise DataError(f"trace must be a fdikit.trace.Trace, got {type(trace).__name__}")
+        if len(trace) > 1 and not np.isclose(trace.dt, g.dt, rtol=1e-6):
+            raise DataError(f"data sampled at dt={trace.dt:g} but the filter runs at dt={g.dt:g}; resample")
+        _check_signals(trace, g.controls, g.outputs)
+        rho = g._schedule_of(trace, schedule)
+        U, Y = trace.columns("u", g.controls), trace.columns("y", g.outputs)
+        r = np.empty(len(trace))
+        valid = np.empty(len(trace), bool)
+        rec = np.empty(len(trace), bool)
+        for k in range(len(trace)):
+            r[k] = self.step(U[k], Y[k], rho[k])
+            valid[k], rec[k] = self.last_valid, self.last_recovering
+        meta = {"trace": dict(trace.meta), "schedule": schedule if isinstance(schedule, str) else g.schedule}
+        return Residuals(trace.t, r[:, None], g.residuals, g.isolates, valid, meta=meta, recovering=rec)
 
 
 def scheduled_parity_filter(
