@@ -6,11 +6,27 @@ from __future__ import annotations
 import numpy as np
 
 from fdikit.diagnosis import isolate
-from fdikit.errors import DataError
+from fdikit.errors import DataError, ModelError, ParameterError
 from fdikit.residuals import Residuals
 
-__all__ = ["k_of_n", "held", "isolate_cached", "checked_names", "check_fitted_names", "checked_residuals",
-           "step_vector"]
+__all__ = ["EvaluatorArgumentError", "is_count", "k_of_n", "held", "isolate_cached", "checked_names",
+           "check_fitted_names", "checked_residuals", "step_vector"]
+
+
+class EvaluatorArgumentError(ParameterError, ModelError):
+    """A bad evaluator argument or an evaluator used before it is set up.
+
+    A :class:`~fdikit.errors.ParameterError` (the class for bad arguments); also a
+    :class:`~fdikit.errors.ModelError`, which the evaluators raised for these before, so existing
+    ``except ModelError`` code keeps working.
+    """
+
+
+def is_count(value, minimum: int) -> bool:
+    """True for an integer (or an integral float) ``>= minimum``; False for anything else (no exception)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        return False
+    return bool(np.isfinite(value) and int(value) == value and value >= minimum)
 
 
 def k_of_n(exceed: np.ndarray, k: int, n: int) -> np.ndarray:

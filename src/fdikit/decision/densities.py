@@ -13,7 +13,8 @@ import numpy as np
 import scipy.linalg
 from scipy.special import log_ndtr, logsumexp, ndtr
 
-from fdikit.errors import DataError, ModelError
+from fdikit.decision.common import EvaluatorArgumentError
+from fdikit.errors import DataError
 
 __all__ = ["GaussianDensity", "UniformMeanDensity", "gaussian_mean_density"]
 
@@ -22,9 +23,9 @@ _LOG2PI = np.log(2.0 * np.pi)
 def _vec(value, name: str, n: int | None = None) -> np.ndarray:
     v = np.atleast_1d(np.asarray(value, dtype=float)).ravel()
     if n is not None and v.size != n:
-        raise ModelError(f"{name} has {v.size} entries, need {n}")
+        raise EvaluatorArgumentError(f"{name} has {v.size} entries, need {n}")
     if not np.all(np.isfinite(v)):
-        raise ModelError(f"{name} has non-finite entries: {v}")
+        raise EvaluatorArgumentError(f"{name} has non-finite entries: {v}")
     return v
 
 
@@ -33,24 +34,25 @@ def _cov(value, n: int, name: str = "covariance", regularization: float = 0.0, d
     c = np.asarray(value, dtype=float)
     c = c * np.eye(n) if c.ndim == 0 else np.diag(c) if c.ndim == 1 else c
     if c.shape != (n, n) or not np.all(np.isfinite(c)):
-        raise ModelError(f"{name} must be a finite ({n}, {n}) matrix, got shape {c.shape}")
+        raise EvaluatorArgumentError(f"{name} must be a finite ({n}, {n}) matrix, got shape {c.shape}")
     scale = np.abs(c).max(initial=0.0)
     if np.abs(c - c.T).max(initial=0.0) > 1e-8 * scale:
-        raise ModelError(f"{name} is not symmetric (max |Λ − Λᵀ| = {np.abs(c - c.T).max():.3g})")
+        raise EvaluatorArgumentError(f"{name} is not symmetric (max |Λ − Λᵀ| = {np.abs(c - c.T).max():.3g})")
     c = 0.5 * (c + c.T)
     if regularization:
         if not regularization > 0:
-            raise ModelError(f"regularization must be positive, got {regularization}")
+            raise EvaluatorArgumentError(f"regularization must be positive, got {regularization}")
         c = c + regularization * np.diag(np.diag(c))
     if not definite:
         return c
     d = np.diag(c)
     if not np.all(d > 0):
-        raise ModelError(f"{name} has zero or negative variance in component(s) {np.flatnonzero(~(d > 0)).tolist()}; "
+        raise EvaluatorArgumentError(
+            f"{name} has zero or negative variance in component(s) {np.flatnonzero(~(d > 0)).tolist()}; "
                          "drop constant residual components, or pass regularization=ε (adds ε·diag(Λ))")
     ev = np.linalg.eigvalsh(c / np.sqrt(np.outer(d, d)))  # of the correlation matrix: scale-free conditioning
     if not ev[0] > 1e3 * n * np.finfo(float).eps:
-        raise ModelError(
+        raise EvaluatorArgumentError(
             f"{name} is singular (smallest correlation eigenvalue {ev[0]:.3g}: components are linearly dependent); "
             "remove duplicated residual components, or pass regularization=ε (adds ε·diag(Λ))"
         )
@@ -132,7 +134,7 @@ def gaussian_mean_density(center, cov, mean_cov, regularization: float = 0.0) ->
     lam = _cov(cov, n, "cov", definite=False)
     s = _cov(mean_cov, n, "mean_cov", definite=False)
     if np.linalg.eigvalsh(s)[0] < -1e-12 * np.abs(s).max(initial=0.0):
-        raise ModelError("mean_cov must be positive semi-definite")
+        raise EvaluatorArgumentError("mean_cov must be positive semi-definite")
     return GaussianDensity(center, lam + s, regularization)
 
 
@@ -179,7 +181,7 @@ class UniformMeanDensity:
         low = _vec(self.low, "low")
         high = _vec(self.high, "high", low.size)
         if np.any(high < low):
-            raise ModelError(f"the box needs low <= high, got low={low}, high={high}")
+            raise EvaluatorArgumentError(f"the box needs low <= high, got low={low}, high={high}")
         cov = _cov(self.cov, low.size, regularization=self.regularization)
         set_ = object.__setattr__
         set_(self, "low", low)
@@ -188,7 +190,7 @@ class UniformMeanDensity:
         if self.method == "erf":
             off = cov - np.diag(np.diag(cov))
             if np.abs(off).max(initial=0.0) > 0:
-                raise ModelError(
+                raise EvaluatorArgumentError(
                     "the erf form of Prop. 7.5 needs a diagonal covariance (the box does not factor otherwise); "
                     "use method='mixture' with a seeded rng, or keep only the variances"
                 )
@@ -197,7 +199,9 @@ class UniformMeanDensity:
             set_(self, "_point", (high - low) <= 1e-8 * sig)
         elif self.method == "mixture":
             if self.rng is None:
-                raise ModelError("method='mixture' draws points in the box: pass rng= (a seed or a Generator)")
+                raise EvaluatorArgumentError(
+                    "method='mixture' draws points in the box: pass rng= (a seed or a Generator)"
+                )
             from scipy.stats import qmc
 
             k = int(np.ceil(np.log2(max(int(self.n_points), 2))))
@@ -206,7 +210,7 @@ class UniformMeanDensity:
             set_(self, "_g", g)
             set_(self, "_zm", _whiten(low + u * (high - low), g._W))
         else:
-            raise ModelError(f"unknown method {self.method!r}; use 'erf' or 'mixture'")
+            raise EvaluatorArgumentError(f"unknown method {self.method!r}; use 'erf' or 'mixture'")
 
     @property
     def dim(self) -> int:

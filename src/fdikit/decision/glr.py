@@ -40,9 +40,17 @@ import numpy as np
 import scipy.linalg
 from scipy.stats import chi2
 
-from fdikit.decision.common import checked_names, checked_residuals, held, isolate_cached, step_vector
+from fdikit.decision.common import (
+    EvaluatorArgumentError,
+    checked_names,
+    checked_residuals,
+    held,
+    is_count,
+    isolate_cached,
+    step_vector,
+)
 from fdikit.diagnosis import Diagnosis, StepDecision, isolate
-from fdikit.errors import DataError, ModelError
+from fdikit.errors import DataError
 from fdikit.residuals import Residuals
 
 __all__ = ["BlockLayout", "GlrEvaluator", "as_covariance", "fit_moments", "glr_threshold", "residual_blocks"]
@@ -60,11 +68,11 @@ def glr_threshold(false_alarm_prob: float, window: int, dof: int = 1) -> float:
     9.095
     """
     if not 0 < false_alarm_prob < 1:
-        raise ModelError(f"false-alarm probability must be in (0, 1), got {false_alarm_prob}")
-    if int(window) != window or window < 1:
-        raise ModelError(f"window must be a positive number of samples, got {window}")
-    if int(dof) != dof or dof < 1:
-        raise ModelError(f"dof (the block dimension) must be a positive integer, got {dof}")
+        raise EvaluatorArgumentError(f"false-alarm probability must be in (0, 1), got {false_alarm_prob}")
+    if not is_count(window, 1):
+        raise EvaluatorArgumentError(f"window must be a positive number of samples, got {window}")
+    if not is_count(dof, 1):
+        raise EvaluatorArgumentError(f"dof (the block dimension) must be a positive integer, got {dof}")
     return float(chi2.isf(false_alarm_prob / window, dof) / 2.0)
 
 
@@ -96,11 +104,13 @@ def residual_blocks(
         elif blocks == "all":
             labels = ["all"] * q
         else:
-            raise ModelError(f"blocks must be 'isolates', 'each', 'all' or one label per residual, got {blocks!r}")
+            raise EvaluatorArgumentError(
+                f"blocks must be 'isolates', 'each', 'all' or one label per residual, got {blocks!r}"
+            )
     else:
         labels = [str(b) for b in blocks]
         if len(labels) != q:
-            raise ModelError(f"{len(labels)} block labels for {q} residuals")
+            raise EvaluatorArgumentError(f"{len(labels)} block labels for {q} residuals")
     out: dict[str, list[int]] = {}
     for i, lab in enumerate(labels):
         out.setdefault(str(lab), []).append(i)
@@ -166,7 +176,8 @@ class BlockLayout:
             if groups is not None:
                 gs = {groups[i] for i in ix}
                 if len(gs) != 1:
-                    raise ModelError(f"block {name!r} mixes residuals of the filters {sorted(gs)}; a block must "
+                    raise EvaluatorArgumentError(
+                        f"block {name!r} mixes residuals of the filters {sorted(gs)}; a block must "
                                      "lie within one filter of the bank")
                 grp.append(gs.pop())
         self.isolates = tuple(iso)
@@ -207,16 +218,17 @@ def _check_cov(cov) -> np.ndarray | None:
         return None
     c = np.asarray(cov, dtype=float)
     if not np.all(np.isfinite(c)):
-        raise ModelError("the covariance has non-finite entries")
+        raise EvaluatorArgumentError("the covariance has non-finite entries")
     if c.ndim <= 1 and not np.all(c > 0):
-        raise ModelError(f"variances must be positive, got {c}")
+        raise EvaluatorArgumentError(f"variances must be positive, got {c}")
     if c.ndim == 2 and (c.shape[0] != c.shape[1] or not np.allclose(c, c.T, rtol=1e-10, atol=0)):
-        raise ModelError(f"the covariance must be a symmetric square matrix, got shape {c.shape}")
+        raise EvaluatorArgumentError(f"the covariance must be a symmetric square matrix, got shape {c.shape}")
     return c
 
 
 def fit_moments(residuals: Residuals, minimum: int = 10) -> tuple[np.ndarray, np.ndarray]:
     """Mean and covariance of the valid, finite rows of fault-free residuals."""
+    residuals = checked_residuals(residuals, None)
     r = residuals.r[residuals.valid]
     r = r[np.all(np.isfinite(r), axis=1)]
     if r.shape[0] < minimum:
@@ -269,16 +281,18 @@ class GlrEvaluator:
         self, window: int = 50, threshold=None, mean=None, cov=None, *, blocks="isolates", isolates=None,
         groups=None,
     ) -> None:
-        if int(window) != window or window < 1:
-            raise ModelError(f"window must be a positive number of samples, got {window}")
+        if not is_count(window, 1):
+            raise EvaluatorArgumentError(f"window must be a positive number of samples, got {window}")
         self.window = int(window)
         self.threshold = None if threshold is None else np.atleast_1d(np.asarray(threshold, dtype=float))
         if self.threshold is not None and not np.all(self.threshold > 0):
-            raise ModelError(f"GLR threshold must be positive, got {self.threshold}")
+            raise EvaluatorArgumentError(f"GLR threshold must be positive, got {self.threshold}")
         self.mean = None if mean is None else np.atleast_1d(np.asarray(mean, dtype=float))
         self.cov = _check_cov(cov)
         if not (isinstance(blocks, str) or isinstance(blocks, Sequence)):
-            raise ModelError(f"blocks must be 'isolates', 'each', 'all' or one label per residual, got {blocks!r}")
+            raise EvaluatorArgumentError(
+                f"blocks must be 'isolates', 'each', 'all' or one label per residual, got {blocks!r}"
+            )
         self.blocks = blocks if isinstance(blocks, str) else tuple(blocks)
         self.isolates = None if isolates is None else tuple(isolates)
         self.groups = None if groups is None else tuple(groups)
@@ -297,18 +311,20 @@ class GlrEvaluator:
         docstring).  Without a target the threshold given to the constructor is kept.
         """
         if false_alarm_prob is not None and false_alarms_per_hour is not None:
-            raise ModelError("give at most one of false_alarm_prob and false_alarms_per_hour")
+            raise EvaluatorArgumentError("give at most one of false_alarm_prob and false_alarms_per_hour")
         mean, cov = fit_moments(residuals)
         if false_alarms_per_hour is not None:
             dt = float(np.median(np.diff(residuals.t)))
             if not false_alarms_per_hour > 0 or not dt > 0:
-                raise ModelError(f"need a positive rate and sample time, got {false_alarms_per_hour}/h and dt={dt}")
+                raise EvaluatorArgumentError(
+                    f"need a positive rate and sample time, got {false_alarms_per_hour}/h and dt={dt}"
+                )
             false_alarm_prob = min(0.5, false_alarms_per_hour * dt / 3600.0)
         iso = self.isolates if self.isolates is not None else residuals.isolates
         layout = BlockLayout(self.blocks, residuals.names, iso, self.groups, cov)
         if false_alarm_prob is not None:
             if not 0 < false_alarm_prob < 1:
-                raise ModelError(f"false-alarm probability must be in (0, 1), got {false_alarm_prob}")
+                raise EvaluatorArgumentError(f"false-alarm probability must be in (0, 1), got {false_alarm_prob}")
             G = len(layout.blocks)
             self.threshold = np.array([glr_threshold(false_alarm_prob / G, self.window, int(p)) for p in layout.dims])
             self.alpha = float(false_alarm_prob)
@@ -321,7 +337,7 @@ class GlrEvaluator:
     def _ready(self, q: int, residuals: Residuals | None = None):
         names = checked_names(q, residuals, self.names)
         if self.threshold is None:
-            raise ModelError(
+            raise EvaluatorArgumentError(
                 "the GLR has no threshold; pass threshold= (see glr_threshold) or call "
                 "fit(fault_free, false_alarm_prob=...)"
             )

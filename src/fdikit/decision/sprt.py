@@ -42,10 +42,19 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from fdikit.decision.common import checked_names, checked_residuals, held, isolate_cached, k_of_n, step_vector
+from fdikit.decision.common import (
+    EvaluatorArgumentError,
+    checked_names,
+    checked_residuals,
+    held,
+    is_count,
+    isolate_cached,
+    k_of_n,
+    step_vector,
+)
 from fdikit.decision.glr import BlockLayout, as_covariance, fit_moments
 from fdikit.diagnosis import Diagnosis, StepDecision, isolate
-from fdikit.errors import DataError, ModelError
+from fdikit.errors import DataError
 from fdikit.residuals import Residuals
 
 __all__ = ["SprtEvaluator", "sprt_asn", "sprt_thresholds"]
@@ -60,7 +69,7 @@ def sprt_thresholds(alpha: float, beta: float) -> tuple[float, float]:
     [4.5951, -4.5951]
     """
     if not (0 < alpha < 1 and 0 < beta < 1 and alpha + beta < 1):
-        raise ModelError(f"need 0 < alpha, beta < 1 and alpha + beta < 1, got alpha={alpha}, beta={beta}")
+        raise EvaluatorArgumentError(f"need 0 < alpha, beta < 1 and alpha + beta < 1, got alpha={alpha}, beta={beta}")
     return float(np.log((1 - beta) / alpha)), float(np.log(beta / (1 - alpha)))
 
 
@@ -72,13 +81,13 @@ def sprt_asn(alpha: float, beta: float, divergence: float, hypothesis: int = 1) 
     somewhat larger (by about ``0.583·√(2D)/D`` samples for Gaussian data).
     """
     if not divergence > 0:
-        raise ModelError(f"the divergence must be positive, got {divergence}")
+        raise EvaluatorArgumentError(f"the divergence must be positive, got {divergence}")
     A, B = sprt_thresholds(alpha, beta)
     if hypothesis == 1:
         return ((1 - beta) * A + beta * B) / divergence
     if hypothesis == 0:
         return ((1 - alpha) * B + alpha * A) / (-divergence)
-    raise ModelError(f"hypothesis must be 0 or 1, got {hypothesis}")
+    raise EvaluatorArgumentError(f"hypothesis must be 0 or 1, got {hypothesis}")
 
 
 def _advance(L: np.ndarray, done: np.ndarray, lam: np.ndarray, A: np.ndarray, B: np.ndarray, restart: bool):
@@ -169,18 +178,20 @@ class SprtEvaluator:
     ) -> None:
         self.shift = np.atleast_1d(np.asarray(shift, dtype=float))
         if self.shift.ndim != 1 or not np.all(np.isfinite(self.shift)):
-            raise ModelError(f"shift must be finite, one value or one per residual; got {shift}")
+            raise EvaluatorArgumentError(f"shift must be finite, one value or one per residual; got {shift}")
         self.A, self.B = sprt_thresholds(alpha, beta)
         self.alpha, self.beta = float(alpha), float(beta)
         self.mean = None if mean is None else np.atleast_1d(np.asarray(mean, dtype=float))
         self.cov = None if cov is None else np.asarray(cov, dtype=float)
         if self.cov is not None and (not np.all(np.isfinite(self.cov)) or (self.cov.ndim < 2 and
                                                                             not np.all(self.cov > 0))):
-            raise ModelError(f"cov must be finite with positive variances, got {cov}")
-        if int(hold) != hold or hold < 0:
-            raise ModelError(f"hold must be a non-negative number of samples, got {hold}")
+            raise EvaluatorArgumentError(f"cov must be finite with positive variances, got {cov}")
+        if not is_count(hold, 0):
+            raise EvaluatorArgumentError(f"hold must be a non-negative number of samples, got {hold}")
         if not (isinstance(blocks, str) or isinstance(blocks, Sequence)):
-            raise ModelError(f"blocks must be 'isolates', 'each', 'all' or one label per residual, got {blocks!r}")
+            raise EvaluatorArgumentError(
+                f"blocks must be 'isolates', 'each', 'all' or one label per residual, got {blocks!r}"
+            )
         self.blocks = blocks if isinstance(blocks, str) else tuple(blocks)
         self.restart = bool(restart)
         self.hold = int(hold)
@@ -219,7 +230,9 @@ class SprtEvaluator:
         for g, (name, ix) in enumerate(layout.blocks):
             d = delta[list(ix)]
             if not np.any(d != 0):
-                raise ModelError(f"block {name!r} has a zero shift; the SPRT needs a non-zero change δ to test")
+                raise EvaluatorArgumentError(
+                    f"block {name!r} has a zero shift; the SPRT needs a non-zero change δ to test"
+                )
             W = layout.whiten[g, : len(ix), : len(ix)]
             w[g, : len(ix)] = W.T @ (W @ d)  # Σ⁻¹ δ with Σ⁻¹ = L⁻ᵀ L⁻¹
             c[g] = 0.5 * float(d @ w[g, : len(ix)])
