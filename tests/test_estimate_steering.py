@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 import scipy.signal
 
-from fdikit.errors import DataError, DesignError, ModelError
+from fdikit.errors import DataError, DesignError, ModelError, ParameterError
 from fdikit.estimate.steering import (
     SteeringFaultIsolator,
     fault_map_coefficients,
@@ -107,7 +107,7 @@ def test_guard_flags_windows_without_excitation_and_never_raises():
 
 
 def test_bad_input_raises_clear_errors():
-    with pytest.raises(DataError, match="window length n"):
+    with pytest.raises(ParameterError, match="window length n"):
         isolate_steering_faults(E, E, 1)
     with pytest.raises(DataError, match="equal length"):
         isolate_steering_faults(E[:10], E[:11], 5)

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from fdikit import DesignError, FaultModel, ModelError
+from fdikit import DesignError, FaultModel, ParameterError
 from fdikit.design import kalman, observer, observer_generator, unobservable_modes
 from fdikit.simulate import simulate
 
@@ -84,9 +84,9 @@ def test_unobservable_model_names_the_mode():
 
 def test_observer_bad_requests():
     m = _model(0.1)
-    with pytest.raises(DesignError, match="need 4 observer poles"):
+    with pytest.raises(ParameterError, match="need 4 observer poles"):
         observer(m, [0.1, 0.2])
-    with pytest.raises(ModelError, match="unknown placement method"):
+    with pytest.raises(ParameterError, match="unknown placement method"):
         observer(m, [0.1, 0.2, 0.3, 0.4], method="ackermann")
     with pytest.raises(DesignError, match="not stable"):
         observer(m, [0.1, 0.2, 0.3, 1.2])
@@ -228,12 +228,12 @@ def test_innovations_are_white_with_the_predicted_covariance(dw):
     ],
 )
 def test_kalman_bad_covariances(Qv, Rv, pattern):
-    with pytest.raises(ModelError, match=pattern):
+    with pytest.raises(ParameterError, match=pattern):
         kalman(_model(0.1), Qv, Rv)
 
 
 def test_kalman_without_noise_group_needs_n_by_n_Q():
-    with pytest.raises(ModelError, match=r"Q must be a 4x4"):
+    with pytest.raises(ParameterError, match=r"Q must be a 4x4"):
         kalman(_model(noise=False), np.eye(2), R)
 
 

@@ -31,6 +31,7 @@ __all__ = [
     "as_matrix",
     "as_square",
     "as_vector",
+    "as_complex_vector",
     "as_covariance",
     "number",
     "positive",
@@ -125,6 +126,24 @@ def as_vector(name: str, value, size: int | None = None, *, error: type[Exceptio
         raise error(f"{name} must be a 1-D vector, got shape {out.shape}")
     if size is not None and out.size != size:
         raise error(f"{name} has {out.size} entries but must have {size}; pass a vector of length {size}")
+    return out
+
+
+def as_complex_vector(name: str, value, size: int | None = None, *,
+                      error: type[Exception] = ParameterError) -> np.ndarray:
+    """Finite complex numbers (poles, eigenvalues) as a 1-D complex vector of ``size`` entries."""
+    if isinstance(value, str | bytes) or value is None:
+        raise error(f"{name} must be a sequence of numbers, got {_show(value)}")
+    try:
+        out = np.atleast_1d(np.asarray(value, dtype=complex))
+    except (TypeError, ValueError) as exc:
+        raise error(f"{name} must be a sequence of numbers ({exc})") from None
+    if out.ndim != 1:
+        raise error(f"{name} must be a 1-D sequence of numbers, got shape {out.shape}")
+    if size is not None and out.size != size:
+        raise error(f"{name} has {out.size} entries but must have {size}")
+    if not np.all(np.isfinite(out)):
+        raise error(f"{name} must be finite numbers, got {out.tolist()}")
     return out
 
 

@@ -12,6 +12,7 @@ from fdikit.design import (
     beard_jones,
     detection_gain_family,
     dgtfdf,
+    dgtmfdf,
     discrete_game_setup,
     game_filter,
     game_filter_bank,
@@ -35,12 +36,23 @@ from fdikit.design import (
 )
 from fdikit.errors import DataError, DesignError, ModelError, ParameterError
 from fdikit.estimate import SteeringFaultIsolator, isolate_steering_faults, lateral_fault_map
+from fdikit.plants import white_speyer
 
 
 def _m() -> FaultModel:
     """3 states, 3 outputs (C = I), one control, sensor faults on y0 and y1."""
     A = [[-1.0, 1.0, 0.0], [0.0, -2.0, 1.0], [0.0, 0.0, -3.0]]
     return FaultModel(A=A, C=np.eye(3), Bu=[[0.0], [0.0], [1.0]]).with_sensor_faults(["y0", "y1"])
+
+
+def _mh() -> FaultModel:
+    """_m() with a disturbance on every output (the H-infinity filter needs one)."""
+    return _m().replace(Dd=np.eye(3), Bd=np.zeros((3, 3)), disturbances=["w0", "w1", "w2"])
+
+
+def _dgs():
+    return discrete_game_setup(white_speyer().discretize(0.01), ["f1", "f2"], gamma=1e-2, Vbar=1.0, Q=1e-3, M=5.0,
+                               K=0.1, N=1.0, steps=50)
 
 
 def _md():
@@ -79,14 +91,20 @@ CASES = [
     case("resolve-faults-unknown", lambda: resolve_faults(_m(), ["zz"]), ModelError, "zz"),
     case("resolve-faults-map-shape", lambda: resolve_faults(_m(), {"a": np.ones((2, 1))}), ModelError, "'a'", "3"),
     case("beard-jones-unknown", lambda: beard_jones(_m(), ["zz"], {"zz": [-1]}), ModelError, "zz"),
-    case("beard-jones-eig-missing", lambda: beard_jones(_m(), ["y0_sensor"], {}), ParameterError, "eigenvalues",
+    case("beard-jones-eig-missing", lambda: beard_jones(_m(), ["y0_sensor"], {}), DesignError, "eigenvalues",
          "y0_sensor"),
     case("beard-jones-sweeps", lambda: beard_jones(_m(), ["y0_sensor"], {"y0_sensor": [-1]}, sweeps=-1),
          ParameterError, "sweeps", "non-negative"),
-    case("restricted-diagonal-poles-nan", lambda: restricted_diagonal(_m(), ["y0_sensor"], [np.nan, -2, -3]),
+    case("restricted-diagonal-poles-nan",
+         lambda: restricted_diagonal(_m(), ["y0_sensor", "y1_sensor"], [np.nan, -2, -3]),
          ParameterError, "poles", "finite"),
     case("uio-unknown-target", lambda: uio(_m(), "zz"), ModelError, "zz"),
-    case("uio-poles-count", lambda: uio(_m(), "y0_sensor", poles=[-1.0] * 7), ParameterError, "poles"),
+    case("uio-poles-count", lambda: uio(_m(), "y0_sensor", poles=[-1.0] * 7), DesignError, "poles", "7"),
+    case("uio-poles-nan", lambda: uio(_m(), "y0_sensor", poles=[np.nan, -1.0]), ParameterError, "poles", "finite"),
+    case("beard-jones-eig-string", lambda: beard_jones(_m(), ["y0_sensor"], {"y0_sensor": "fast"}), ParameterError,
+         "eigenvalues", "numbers"),
+    case("beard-jones-eig-list", lambda: beard_jones(_m(), ["y0_sensor"], [-1.0]), ParameterError, "eigenvalues",
+         "mapping"),
     case("uio-bank-unknown", lambda: uio_bank(_m(), ["zz"]), ModelError, "zz"),
     case("unknown-input-matrix-unknown", lambda: unknown_input_matrix(_m(), ["zz"]), ModelError, "zz"),
     # ------------------------------------------------------------------ parity
@@ -110,20 +128,25 @@ CASES = [
          "3 x 3"),
     case("game-Q-negative", lambda: game_filter(_m(), ["y0_sensor"], Q=-1.0), ParameterError, "Q",
          "positive semidefinite"),
-    case("game-bank-empty", lambda: game_filter_bank(_m(), []), ParameterError, "faults", "empty"),
+    case("game-bank-empty", lambda: game_filter_bank(_m(), []), ParameterError, "target", "at least one"),
+    case("game-filter-method", lambda: game_filter(white_speyer(), ["f1", "f2"], method="newton"),
+         ParameterError, "method", "newton"),
+    case("dgtmfdf-method", lambda: dgtmfdf(_dgs(), method="newton"), ParameterError, "method", "'auto'"),
+    case("dgtmfdf-radius", lambda: dgtmfdf(_dgs(), max_radius=1.5), ParameterError, "max_radius", "(0, 1)"),
+    case("dgtmfdf-L0-shape", lambda: dgtmfdf(_dgs(), L0=np.ones((2, 2))), ParameterError, "L0", "rows"),
     case("goh-unknown", lambda: goh_filter(_m(), ["zz"]), ModelError, "zz"),
-    case("hinf-gamma-zero", lambda: hinf_detection_filter(_m(), _F, gamma=0.0), ParameterError,
+    case("hinf-gamma-zero", lambda: hinf_detection_filter(_mh(), _F, gamma=0.0), ParameterError,
          "gamma", "positive"),
-    case("hinf-form", lambda: hinf_detection_filter(_m(), _F, gamma=1.0, form="book"), ParameterError,
+    case("hinf-form", lambda: hinf_detection_filter(_mh(), _F, gamma=1.0, form="book"), ParameterError,
          "form", "'corrected'"),
-    case("hinf-horizon-negative", lambda: hinf_detection_filter(_m(), _F, gamma=1.0, horizon=-5),
+    case("hinf-horizon-negative", lambda: hinf_detection_filter(_mh(), _F, gamma=1.0, horizon=-5),
          ParameterError, "horizon", "positive"),
     case("dgs-steps-zero", lambda: discrete_game_setup(_md(), ["y0_sensor"], gamma=1.0, Vbar=1.0, Q=1.0, M=1.0,
                                                        steps=0), ParameterError, "steps", "positive"),
     case("dgs-gamma-nan", lambda: discrete_game_setup(_md(), ["y0_sensor"], gamma=float("nan"), Vbar=1.0, Q=1.0,
                                                       M=1.0), ParameterError, "gamma", "finite"),
     case("dgs-continuous", lambda: discrete_game_setup(_m(), ["y0_sensor"], gamma=1.0, Vbar=1.0, Q=1.0, M=1.0),
-         ModelError, "discrete"),
+         DesignError, "discrete"),
     case("dgtfdf-not-setup", lambda: dgtfdf("setup"), ParameterError, "setup", "discrete_game_setup"),
     case("solve-game-are-shape", lambda: solve_game_are(np.eye(2), np.eye(3), np.eye(2)), ParameterError, "R",
          "2 x 2"),
@@ -133,8 +156,10 @@ CASES = [
     case("steering-n-float", lambda: isolate_steering_faults(_r, _r, 2.5), ParameterError, "n", "integer"),
     case("steering-length-mismatch", lambda: isolate_steering_faults(_r, _r[:-3], 10), DataError,
          "setpoint", "samples"),
-    case("steering-nan-setpoint", lambda: isolate_steering_faults(_r, np.full(N, np.nan), 10), DataError,
-         "setpoint", "finite"),
+    case("steering-t-length", lambda: isolate_steering_faults(_r, _r, 10, t=np.arange(5.0)), DataError, "t",
+         "one time per sample"),
+    case("steering-t-nan", lambda: isolate_steering_faults(_r, _r, 10, t=np.full(N, np.nan)), DataError, "t",
+         "non-finite"),
     case("steering-string", lambda: isolate_steering_faults("r", _r, 10), DataError, "residual", "number"),
     case("steering-2d", lambda: isolate_steering_faults(np.ones((N, 2)), _r, 10), DataError, "residual", "1-D"),
     case("steering-gain-nan", lambda: isolate_steering_faults(_r, _r, 10, nominal_gain=np.nan), ParameterError,

@@ -17,7 +17,7 @@ from fdikit.design.beard_jones import resolve_faults
 from fdikit.design.game import game_filter, game_filter_bank, single_fault_game_filter
 from fdikit.design.game_riccati import game_cost, game_riccati, solve_game_are
 from fdikit.design.game_setup import game_problem
-from fdikit.errors import DesignError
+from fdikit.errors import DesignError, ParameterError
 from fdikit.plants.f16xl import f16xl_longitudinal
 from fdikit.plants.white_speyer import white_speyer
 
@@ -405,11 +405,11 @@ def test_errors_name_the_problem(f16):
     m, faults = f16
     with pytest.raises(DesignError, match="discrete"):
         single_fault_game_filter(white_speyer().discretize(0.1), "f1", ["f2"])
-    with pytest.raises(DesignError, match="positive semidefinite"):
+    with pytest.raises(ParameterError, match="positive semidefinite"):
         single_fault_game_filter(white_speyer(), "f1", ["f2"], M=-1.0)
     with pytest.raises(DesignError, match="not achievable"):
         single_fault_game_filter(white_speyer(), "f1", ["f2"], Q=1.5, M=0.05)
-    with pytest.raises(DesignError, match="not a target"):
+    with pytest.raises(ParameterError, match="not a target"):
         game_filter(m, faults, K={"theta": 0.1, "rudder": 0.1})
     with pytest.raises(DesignError, match="initial gain violates"):
         game_filter(white_speyer(), ["f1", "f2"], L0=np.zeros((3, 2)))

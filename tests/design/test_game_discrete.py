@@ -19,7 +19,7 @@ from fdikit.design.game_discrete import (
     secondary_cost,
 )
 from fdikit.design.game_setup import game_problem
-from fdikit.errors import DesignError
+from fdikit.errors import DesignError, ParameterError
 from fdikit.plants.f16xl import f16xl_longitudinal
 from fdikit.plants.white_speyer import white_speyer
 
@@ -231,11 +231,11 @@ def test_bad_input_raises_design_errors():
         discrete_game_setup(model, ["f1"], ["f2"], gamma=1.0, Vbar=1.0, Q=0.1, M=1.0)
     with pytest.raises(DesignError, match="Φ = model.A is singular"):
         discrete_game_setup(md.replace(A=np.diag([1.0, 0.5, 0.0])), ["f1"], ["f2"], gamma=1.0, Vbar=1.0, Q=0.1, M=1.0)
-    with pytest.raises(DesignError, match="gamma"):
+    with pytest.raises(ParameterError, match="gamma"):
         discrete_game_setup(md, ["f1"], ["f2"], gamma=0.0, Vbar=1.0, Q=0.1, M=1.0)
-    with pytest.raises(DesignError, match=r"M\[f1\] must be positive definite"):
+    with pytest.raises(ParameterError, match=r"M\[f1\] must be positive definite"):
         discrete_game_setup(md, ["f1"], ["f2"], gamma=1.0, Vbar=1.0, Q=0.1, M=0.0)
-    with pytest.raises(DesignError, match=r"weight Q has no entry for target\(s\) \['f2'\]"):
+    with pytest.raises(ParameterError, match=r"weight Q has no entry for target\(s\) \['f2'\]"):
         discrete_game_setup(md, ["f1", "f2"], gamma=1.0, Vbar=1.0, Q={"f1": 0.1}, M=1.0)
     st = discrete_game_setup(md, ["f1", "f2"], gamma=1.0, Vbar=1.0, Q=0.1, M=1.0, steps=10)
     with pytest.raises(DesignError, match="I − LC is singular"):
@@ -244,7 +244,7 @@ def test_bad_input_raises_design_errors():
         dgtfdf(st)
     with pytest.raises(DesignError, match="K_i and N_i are all zero"):
         dgtmfdf(st)
-    with pytest.raises(DesignError, match="max_radius"):
+    with pytest.raises(ParameterError, match="max_radius"):
         dgtmfdf(st, max_radius=1.0)
     with pytest.raises(DesignError, match="one constant gain"):
         secondary_cost(st, np.zeros((10, 3, 2)))

@@ -25,7 +25,7 @@ from fdikit.design.game_ltv import ltv_detection_filter, ltv_feasibility, ltv_ga
 from fdikit.design.game_setup import game_problem
 from fdikit.design.ltv import LTVModel, invariant_generators, ltv_projector
 from fdikit.design.observer import observer_generator
-from fdikit.errors import DataError, DesignError, ModelError
+from fdikit.errors import DataError, DesignError, ModelError, ParameterError
 from fdikit.plants import single_track
 from fdikit.plants.white_speyer import white_speyer
 from fdikit.trace import Trace
@@ -395,15 +395,15 @@ def test_time_varying_game_filter_blocks_road_disturbances_better_than_lti_filte
 def test_bad_inputs_raise_clear_errors():
     ws = white_speyer()
     m = LTVModel.from_lti(ws, ["f1", "f2"])
-    with pytest.raises(DesignError, match="gamma must be a positive"):
+    with pytest.raises(ParameterError, match="gamma must be a positive"):
         ltv_game_filter(m, "f1", ["f2"], [0.0, 1.0], gamma=0.0)
     with pytest.raises(DesignError, match="both as target and as nuisance"):
         ltv_game_filter(m, "f1", ["f1"], [0.0, 1.0], gamma=1e-3)
     with pytest.raises(ModelError, match="no fault named 'f3'"):
         ltv_feasibility(m, ["f1", "f3"], [], lambda s: np.zeros((3, 2)), [0.0, 1.0], gamma=1.0)
-    with pytest.raises(DesignError, match="weight Q must be symmetric"):
+    with pytest.raises(ParameterError, match="weight Q must be symmetric"):
         ltv_game_filter(m, "f1", ["f2"], [0.0, 1.0], gamma=1e-3, Q=[[1.0, 2.0], [0.0, 1.0]])
-    with pytest.raises(DesignError, match="strictly increasing"):
+    with pytest.raises(ParameterError, match="strictly increasing"):
         ltv_game_filter(m, "f1", ["f2"], [1.0, 0.0], gamma=1e-3)
     with pytest.raises(ModelError, match="must be a function of time"):
         LTVModel(np.eye(3), lambda t: ws.C, {"f": lambda t: ws.Bf})

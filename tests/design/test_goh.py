@@ -18,7 +18,7 @@ from fdikit.design import resolve_faults
 from fdikit.design.game import single_fault_game_filter
 from fdikit.design.goh import goh_riccati, goh_riccati_transient, goh_transformation, oblique_projector
 from fdikit.design.reduced_order import goh_detector, goh_filter
-from fdikit.errors import DesignError
+from fdikit.errors import DesignError, ParameterError
 from fdikit.plants.f16xl import f16xl_longitudinal
 from fdikit.plants.path_longitudinal import path_longitudinal_7, path_longitudinal_7_fault_maps
 from fdikit.plants.white_speyer import white_speyer
@@ -211,7 +211,7 @@ def test_stable_zero_direction_is_a_degenerate_equilibrium_of_the_flow_from_zero
 def test_goh_riccati_rejects_bad_weights():
     m = path_longitudinal_7()
     F = np.hstack(list(path_longitudinal_7_fault_maps().values()))
-    with pytest.raises(DesignError, match="positive definite"):
+    with pytest.raises(ParameterError, match="positive definite"):
         goh_riccati(m.A, m.C, F, V=0.0, Q=1.0)
     with pytest.raises(DesignError, match="Q"):
         goh_riccati(m.A, m.C, F, V=0.8, Q=50.0)  # V⁻¹ − Q = −48.75: indefinite, no positive S̄
@@ -408,9 +408,9 @@ def test_goh_filter_rejects_bad_input():
     m = path_longitudinal_7()
     with pytest.raises(DesignError, match="discrete"):
         goh_detector(m.discretize(0.01), "air_mass", ["engine_speed"])
-    with pytest.raises(DesignError, match="not targets"):
+    with pytest.raises(ParameterError, match="not targets"):
         goh_filter(white_speyer(), ["f1", "f2"], Q={"f1": 1e-3, "f9": 1e-3})
-    with pytest.raises(DesignError, match="missing"):
+    with pytest.raises(ParameterError, match="missing"):
         goh_filter(white_speyer(), ["f1", "f2"], Q={"f1": 1e-3})
 
 

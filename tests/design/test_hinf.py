@@ -12,7 +12,7 @@ from fdikit import FaultModel, linalg
 from fdikit.design.beard_jones import beard_jones
 from fdikit.design.detection_gain import detection_gain_family
 from fdikit.design.hinf import enhancement_direction, hinf_detection_filter
-from fdikit.errors import DesignError, ModelError
+from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.faults import Bias, FaultScenario
 from fdikit.plants.f16xl import F16XL_DRYDEN_GAIN, f16xl_gust
 from fdikit.simulate import simulate
@@ -205,7 +205,7 @@ def test_printed_gust_gain_is_infeasible_at_gamma_1_2():
 
 
 def test_bad_input_is_rejected(plant):
-    with pytest.raises(DesignError, match="gamma must be a positive"):
+    with pytest.raises(ParameterError, match="gamma must be a positive"):
         hinf_detection_filter(plant, FAULTS, gamma=0.0)
     with pytest.raises(DesignError, match="singular"):
         hinf_detection_filter(f16xl_gust(pitch_rate_noise=0.0), FAULTS, gamma=2.0)
@@ -213,7 +213,7 @@ def test_bad_input_is_rejected(plant):
         hinf_detection_filter(plant, FAULTS, gamma=2.0, disturbances=["wind"])
     with pytest.raises(ModelError, match="not a disturbance or noise input"):
         hinf_detection_filter(plant, FAULTS, gamma=2.0, disturbances=["gust"])
-    with pytest.raises(ModelError, match="form"):
+    with pytest.raises(ParameterError, match="form"):
         hinf_detection_filter(plant, FAULTS, gamma=2.0, form="exact")
 
 

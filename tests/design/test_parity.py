@@ -20,7 +20,7 @@ from fdikit.design.lpv import (
     uncertain_stacked_matrices,
 )
 from fdikit.design.parity import lpv_parity_residuals, minimal_horizon, parity_design, parity_matrix, regular_rows
-from fdikit.errors import DataError, DesignError, ModelError
+from fdikit.errors import DataError, DesignError, ModelError, ParameterError
 from fdikit.plants.varrier_lateral import varrier_lateral_lpv, varrier_uncertainty
 from fdikit.trace import Trace
 
@@ -251,7 +251,7 @@ def test_bad_input_is_refused():
         parity_design(m, 0)  # (s+1) p = 2 <= n = 3
     with pytest.raises(DesignError, match="trivial"):
         parity_design(m, 2, W2=np.zeros(3))
-    with pytest.raises(ModelError, match="horizon"):
+    with pytest.raises(ParameterError, match="horizon"):
         stacked_matrices(m)
     with pytest.raises(ModelError, match="same"):
         LPVModel({0: m, 1: m.replace(dt=0.2)})

@@ -8,6 +8,7 @@ from fdikit.design.beard_jones import (
     restricted_diagonal,
 )
 from fdikit.design.dae_parity import DAEModel, PolynomialParityDesign, dae_form, minimal_degree, parity_filter
+from fdikit.design.detection_gain import DetectionGainFamily, detection_gain_family
 from fdikit.design.game import (
     GameBankDesign,
     GameDesign,
@@ -19,7 +20,6 @@ from fdikit.design.game import (
 from fdikit.design.game_discrete import dgtfdf, dgtmfdf, discrete_game_setup
 from fdikit.design.game_ltv import LTVGameDesign, ltv_feasibility, ltv_game_filter
 from fdikit.design.game_riccati import game_riccati, solve_game_are
-from fdikit.design.detection_gain import DetectionGainFamily, detection_gain_family
 from fdikit.design.game_setup import GameProblem, game_problem
 from fdikit.design.hinf import Enhancement, HinfDesign, enhancement_direction, hinf_detection_filter
 from fdikit.design.lpv import LPVModel, stacked_matrices

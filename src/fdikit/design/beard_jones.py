@@ -39,9 +39,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from fdikit import linalg
+from fdikit import linalg, validate
 from fdikit.design.observer import observer_generator
-from fdikit.errors import DesignError, ModelError
+from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.model import FaultModel, actuator_fault_name, sensor_fault_name
 from fdikit.residuals import ResidualGenerator, stack_generators
 
@@ -57,10 +57,13 @@ def resolve_faults(model: FaultModel, faults: Mapping[str, np.ndarray] | Sequenc
     (Douglas et al. 1996 §4.1, the air-mass fix), a control name the actuator fault
     ``B[:, j]`` (named ``<control>_actuator``), a fault input of the model its own map.
     """
+    validate.instance("model", model, FaultModel)
+    if isinstance(faults, str):
+        faults = [faults]
     if isinstance(faults, Mapping):
         out = {}
         for name, F in faults.items():
-            F = np.atleast_2d(np.asarray(F, dtype=float))
+            F = np.atleast_2d(validate.as_array(f"fault map {name!r}", F, error=ModelError))
             if F.shape[0] != model.n and F.shape[1] == model.n:
                 F = F.T
             if F.shape[0] != model.n:
@@ -230,16 +233,20 @@ def _assign(model, spaces, sets, sweeps, seed, rtol):
 def _check_sets(model, dims, eigenvalues, complement):
     n, discrete = model.n, model.is_discrete
     scale = max(np.linalg.norm(model.A, 2), 1.0)
+    if not isinstance(eigenvalues, Mapping):
+        raise ParameterError("eigenvalues must be a mapping fault name -> eigenvalues, got "
+                             f"{type(eigenvalues).__name__}; e.g. {{{next(iter(dims), 'fault')!r}: [-1.0]}}")
     sets = {}
     for name, nu in dims.items():
         if name not in eigenvalues:
             raise DesignError(f"no eigenvalues given for fault {name!r}; it needs {nu} (its detection-space dimension)")
-        sets[name] = np.atleast_1d(np.asarray(eigenvalues[name], dtype=complex))
+        sets[name] = validate.as_complex_vector(f"eigenvalues[{name!r}]", eigenvalues[name])
     unknown = set(eigenvalues) - set(dims)
     if unknown:
         raise ModelError(f"eigenvalues given for unknown fault(s) {sorted(unknown)}; faults are {list(dims)}")
     nu0 = n - sum(dims.values())
-    sets["complement"] = np.atleast_1d(np.asarray(complement if complement is not None else [], dtype=complex))
+    sets["complement"] = (validate.as_complex_vector("complement", complement) if complement is not None
+                          else np.zeros(0, dtype=complex))
     wanted = dict(dims, complement=nu0)
     for name, lam in sets.items():
         if lam.size != wanted[name]:
@@ -303,7 +310,13 @@ def beard_jones(
         detectable (the extra zeros are named); an invariant zero of a fault missing from
         its set; a set of the wrong size, unstable, not self-conjugate or repeated; an
         eigenvalue that admits no left eigenvector.
+    ParameterError
+        A bad argument: not a FaultModel, eigenvalues that are not finite numbers, negative sweeps.
     """
+    validate.integer("sweeps", sweeps, minimum=0)
+    validate.integer("seed", seed, minimum=0)
+    if rtol is not None:
+        validate.non_negative("rtol", rtol)
     maps = resolve_faults(model, faults)
     A, C = model.A, model.C
     spaces = {k: linalg.detection_space(A, C, F, rtol) for k, F in maps.items()}
@@ -381,9 +394,10 @@ def restricted_diagonal(
     maps = resolve_faults(model, faults)
     if len(maps) < 2:
         raise DesignError("a restricted-diagonal bank needs at least two faults")
-    poles = np.asarray(poles, dtype=complex)
+    poles = validate.as_complex_vector("poles", poles)
     if poles.size != model.n:
-        raise DesignError(f"need n = {model.n} poles, got {poles.size}")
+        raise ParameterError(f"need n = {model.n} poles, got {poles.size}")
+    validate.integer("sweeps", sweeps, minimum=0)
     filters, spaces, gens = {}, {}, []
     A, C = model.A, model.C
     for target, F in maps.items():

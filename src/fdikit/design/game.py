@@ -34,7 +34,7 @@ import numpy as np
 import scipy.linalg
 import scipy.optimize
 
-from fdikit import linalg
+from fdikit import linalg, validate
 from fdikit.design.beard_jones import resolve_faults
 from fdikit.design.game_riccati import (
     _continuous,
@@ -48,7 +48,7 @@ from fdikit.design.game_riccati import (
 )
 from fdikit.design.game_setup import GameProblem, game_problem, weight
 from fdikit.design.observer import observer_generator
-from fdikit.errors import DesignError
+from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.residuals import ResidualGenerator, stack_generators
 
@@ -62,10 +62,15 @@ __all__ = [
 ]
 
 
+#: Methods of :func:`scipy.optimize.minimize` (lower case; scipy compares case-insensitively).
+_MINIMIZE_METHODS = ("nelder-mead", "powell", "cg", "bfgs", "newton-cg", "l-bfgs-b", "tnc", "cobyla", "cobyqa",
+                     "slsqp", "trust-constr", "dogleg", "trust-ncg", "trust-exact", "trust-krylov")
+
+
 # ---------------------------------------------------------------------------- helpers
 def _inv_pd(name: str, W: np.ndarray) -> np.ndarray:
     if W.size and np.linalg.eigvalsh(W).min() <= 1e-14 * max(1.0, np.abs(W).max()):
-        raise DesignError(f"weight {name} must be positive definite (it is inverted)")
+        raise ParameterError(f"weight {name} must be positive definite (it is inverted)")
     return np.linalg.inv(W)
 
 
@@ -426,6 +431,14 @@ def game_filter(
     """
     _continuous(model)
     g = _gamma(gamma)
+    if not callable(method):
+        validate.choice("optimiser method", method.lower() if isinstance(method, str) else method, _MINIMIZE_METHODS)
+    for nm, val in (("eps_stab", eps_stab), ("eps_ham", eps_ham), ("barrier", barrier)):
+        validate.non_negative(nm, val)
+    if options is not None and not isinstance(options, Mapping):
+        raise ParameterError(
+            f"options must be a mapping of scipy.optimize.minimize options, got {type(options).__name__}"
+        )
     prob = game_problem(model, targets, nuisance)
     given = _given_names(targets)
     tg = _targets(prob, g, Q, M, K, N, given)

@@ -47,10 +47,10 @@ import numpy as np
 import scipy.linalg
 import scipy.optimize
 
-from fdikit import linalg
+from fdikit import linalg, validate
 from fdikit.design.game_setup import GameProblem, game_problem, weight
 from fdikit.design.observer import observer_generator
-from fdikit.errors import DesignError
+from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.residuals import ResidualGenerator
 
@@ -111,14 +111,16 @@ def _per_target(kind: str, value, dims: Mapping[str, int]) -> dict[str, np.ndarr
     if isinstance(value, Mapping):
         missing = [nm for nm in dims if nm not in value]
         if missing:
-            raise DesignError(f"weight {kind} has no entry for target(s) {missing}; give one per target {list(dims)}")
+            raise ParameterError(
+                f"weight {kind} has no entry for target(s) {missing}; give one per target {list(dims)}"
+            )
         return {nm: weight(f"{kind}[{nm}]", value[nm], d) for nm, d in dims.items()}
     return {nm: weight(f"{kind}[{nm}]", value, d) for nm, d in dims.items()}
 
 
 def _positive(name: str, W: np.ndarray) -> np.ndarray:
     if W.size and np.linalg.eigvalsh(W).min() <= 0:
-        raise DesignError(f"weight {name} must be positive definite")
+        raise ParameterError(f"weight {name} must be positive definite")
     return W
 
 
@@ -160,10 +162,12 @@ def discrete_game_setup(
     """
     if not model.is_discrete:
         raise DesignError("the discrete game filter needs a discrete model; sample the plant with model.discretize(dt)")
+    validate.instance("model", model, FaultModel)
+    gamma = validate.number("gamma", gamma, finite=False)
     if not (np.isfinite(gamma) and gamma > 0):
-        raise DesignError(f"gamma must be a positive attenuation bound, got {gamma}")
-    if int(steps) != steps or steps < 1:
-        raise DesignError(f"steps must be a positive integer horizon, got {steps}")
+        raise ParameterError(f"gamma must be a positive finite attenuation bound, got {gamma}")
+    if isinstance(steps, bool) or not isinstance(steps, int | np.integer | float) or int(steps) != steps or steps < 1:
+        raise ParameterError(f"steps must be a positive integer horizon, got {steps}")
     s = np.linalg.svd(model.A, compute_uv=False)
     if s[-1] <= 1e-12 * max(s[0], 1.0):
         raise DesignError(f"Φ = model.A is singular (σ_min = {s[-1]:.3g}); Murray 2012 Ch. 5 assumes an invertible "
@@ -394,6 +398,7 @@ def dgtfdf(setup: DiscreteGameSetup, target: str | None = None, settle_rtol: flo
     >>> d.settled, bool(np.all(np.abs(d.poles) < 1))
     (True, True)
     """
+    validate.instance("setup", setup, DiscreteGameSetup, "build it with discrete_game_setup(...)")
     if target is None and len(setup.names) > 1:
         raise DesignError(f"the setup has targets {list(setup.names)}; name the one the single-fault filter detects")
     target = setup.names[0] if target is None else target
@@ -498,10 +503,13 @@ def dgtmfdf(
         Bad ``method`` or ``max_radius``, all cost weights zero (the multiplier vanishes, §5.2.2), or
         an unacceptable ``L0`` (no acceptable default).
     """
+    validate.instance("setup", setup, DiscreteGameSetup, "build it with discrete_game_setup(...)")
     if method not in ("auto", "fixed-point", "gradient"):
-        raise DesignError(f"unknown method {method!r}; use 'auto', 'fixed-point' or 'gradient'")
+        raise ParameterError(f"unknown method {method!r}; use 'auto', 'fixed-point' or 'gradient'")
+    validate.integer("maxiter", maxiter, minimum=1)
+    max_radius = validate.number("max_radius", max_radius)
     if not 0 < max_radius < 1:
-        raise DesignError(f"max_radius must lie in (0, 1) so that the filter is stable, got {max_radius}")
+        raise ParameterError(f"max_radius must lie in (0, 1) so that the filter is stable, got {max_radius}")
     if not any(np.any(setup.cost_weight(t)) for t in setup.names):
         raise DesignError("the secondary cost weights K_i and N_i are all zero: the multiplier Δ_i vanishes and (5.41) "
                           "gives no gain (Murray 2012, §5.2.2); set K (complementary) and N (target) weights")
@@ -515,7 +523,7 @@ def dgtmfdf(
                               "every target; give L0 (e.g. a Beard–Jones gain), raise γ or M, or lower Q")
         L, (J, g) = min(scored, key=lambda cr: cr[1][0])
     else:
-        L = np.asarray(L0, dtype=float)
+        L = validate.as_matrix("L0", L0, (m.n, m.p))
         if L.shape != (m.n, m.p):
             raise DesignError(f"L0 has shape {L.shape}; it must be n x p = {m.n} x {m.p}")
         if (res := _try_cost(setup, L, 1e-10, max_radius)) is None:

@@ -36,7 +36,7 @@ from scipy.integrate import solve_ivp
 
 from fdikit.design.game_setup import weight
 from fdikit.design.ltv import LTVModel, MatrixFunction, invariant_generators, ltv_projector
-from fdikit.errors import DataError, DesignError, ModelError
+from fdikit.errors import DataError, DesignError, ModelError, ParameterError
 from fdikit.residuals import Residuals
 
 __all__ = [
@@ -189,7 +189,7 @@ def _expm_batch(A: np.ndarray) -> np.ndarray:
 def _complements(model: LTVModel, targets: Sequence[str], nuisance: Sequence[str]) -> dict[str, tuple[str, ...]]:
     targets, nuisance = [str(k) for k in targets], [str(k) for k in nuisance]
     if not targets:
-        raise DesignError("no target fault given; name at least one fault to detect")
+        raise ParameterError("no target fault given; name at least one fault to detect")
     for k in targets + nuisance:
         if k not in model.faults:
             raise ModelError(f"no fault named {k!r}; the LTV model has {list(model.faults)}")
@@ -202,7 +202,7 @@ def _complements(model: LTVModel, targets: Sequence[str], nuisance: Sequence[str
 def _grid(t) -> np.ndarray:
     t = np.asarray(t, dtype=float).ravel()
     if t.size < 2 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
-        raise DesignError("the time grid t must be finite, strictly increasing, with t0 and t1 (≥ 2 points)")
+        raise ParameterError("the time grid t must be finite, strictly increasing, with t0 and t1 (≥ 2 points)")
     return t
 
 
@@ -223,7 +223,7 @@ def _riccati(model: LTVModel, target: str, comp: tuple[str, ...], t: np.ndarray,
     The exact Jacobian is ``I⊗K + K⊗I`` with ``K = K0 − P S``.
     """
     if not (isinstance(gamma, int | float) and math.isfinite(gamma) and gamma > 0):
-        raise DesignError(f"gamma must be a positive attenuation bound (small = strong blocking), got {gamma!r}")
+        raise ParameterError(f"gamma must be a positive attenuation bound (small = strong blocking), got {gamma!r}")
     A0, C0 = model.matrix("A", t[0]), model.matrix("C", t[0])
     p, n = C0.shape
     if A0.shape != (n, n):
@@ -233,7 +233,7 @@ def _riccati(model: LTVModel, target: str, comp: tuple[str, ...], t: np.ndarray,
     Vw, Pw = weight("V", V, p), weight("P0", P0, n)
     for name, W in (("V", Vw), ("P0", Pw)):
         if np.linalg.eigvalsh(W).min() <= 0:
-            raise DesignError(f"weight {name} must be positive definite")
+            raise ParameterError(f"weight {name} must be positive definite")
     Vinv = np.linalg.inv(Vw)
 
     @functools.lru_cache(maxsize=8)

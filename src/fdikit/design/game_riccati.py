@@ -35,8 +35,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
+from fdikit import validate
 from fdikit.design.game_setup import GameProblem, weight
-from fdikit.errors import DesignError
+from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 
 __all__ = ["RiccatiSolution", "solve_game_are", "hamiltonian_margin", "game_riccati", "game_cost"]
@@ -120,8 +121,13 @@ def solve_game_are(
     >>> round(float(sol.X[0, 0]), 6), sol.stabilizing       # 0.5 x² − 2x + 1 = 0, x = 2 − √2
     (0.585786, True)
     """
-    A, R, Q = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (A, R, Q))
+    A = validate.as_square("A", A)
     n = A.shape[0]
+    R = validate.as_square("R", R, n)
+    Q = validate.as_square("Q", Q, n)
+    validate.integer("refine", refine, minimum=0)
+    axis_tol = validate.non_negative("axis_tol", axis_tol)
+    max_residual = validate.positive("max_residual", max_residual)
     R, Q = (R + R.T) / 2, (Q + Q.T) / 2
     if n == 0:
         return RiccatiSolution(np.zeros((0, 0)), np.inf, np.zeros(0), 0.0)
@@ -197,18 +203,20 @@ def _per_target(name: str, value, problem: GameProblem, given: Sequence[str]):
     for key, v in value.items():
         t = alias.get(key, key)
         if t not in problem.targets:
-            raise DesignError(f"weight {name} is given for {key!r}, which is not a target; targets are {problem.names}")
+            raise ParameterError(
+                f"weight {name} is given for {key!r}, which is not a target; targets are {problem.names}"
+            )
         out[t] = v
     missing = [t for t in problem.names if t not in out]
     if missing:
-        raise DesignError(f"weight {name} is missing for target(s) {missing}; give a value per target or one scalar")
+        raise ParameterError(f"weight {name} is missing for target(s) {missing}; give a value per target or one scalar")
     return out
 
 
 def _gamma(gamma: float) -> float:
-    g = float(gamma)
+    g = validate.number("gamma", gamma, finite=False)
     if not (np.isfinite(g) and g > 0):
-        raise DesignError(f"the attenuation bound gamma must be a positive finite number, got {gamma!r}")
+        raise ParameterError(f"the attenuation bound gamma must be a positive finite number, got {gamma!r}")
     return g
 
 

@@ -18,9 +18,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fdikit import linalg
+from fdikit import linalg, validate
 from fdikit.design.beard_jones import resolve_faults
-from fdikit.errors import DesignError
+from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 
 __all__ = ["GameProblem", "game_problem", "weight"]
@@ -61,21 +61,21 @@ def weight(name: str, value, dim: int) -> np.ndarray:
     A scalar means ``value · I``; a vector a diagonal; a matrix is checked for shape and
     symmetry.  Raises :class:`DesignError` naming the weight when it is not usable.
     """
-    W = np.asarray(value, dtype=float)
+    W = validate.as_array(f"weight {name}", value, finite=False)
     if W.ndim == 0:
         W = float(W) * np.eye(dim)
     elif W.ndim == 1:
         if W.size != dim:
-            raise DesignError(f"weight {name} has {W.size} diagonal entries; it must be {dim} x {dim}")
+            raise ParameterError(f"weight {name} has {W.size} diagonal entries; it must be {dim} x {dim}")
         W = np.diag(W)
     if W.shape != (dim, dim):
-        raise DesignError(f"weight {name} has shape {W.shape}; it must be {dim} x {dim} (or a scalar)")
+        raise ParameterError(f"weight {name} has shape {W.shape}; it must be {dim} x {dim} (or a scalar)")
     if not np.all(np.isfinite(W)):
-        raise DesignError(f"weight {name} has non-finite entries")
+        raise ParameterError(f"weight {name} has non-finite entries")
     if not np.allclose(W, W.T, rtol=1e-10, atol=1e-14 * max(1.0, np.abs(W).max(initial=0.0))):
-        raise DesignError(f"weight {name} must be symmetric")
+        raise ParameterError(f"weight {name} must be symmetric")
     if dim and np.linalg.eigvalsh((W + W.T) / 2).min() < -1e-12 * max(1.0, np.abs(W).max()):
-        raise DesignError(f"weight {name} must be positive semidefinite")
+        raise ParameterError(f"weight {name} must be positive semidefinite")
     return (W + W.T) / 2
 
 
@@ -123,7 +123,7 @@ def game_problem(
     T = resolve_faults(model, targets)
     N = resolve_faults(model, nuisance) if (isinstance(nuisance, Mapping) or len(nuisance)) else {}
     if not T:
-        raise DesignError("no target fault given; name at least one fault to detect")
+        raise ParameterError("no target fault given; name at least one fault to detect")
     both = set(T) & set(N)
     if both:
         raise DesignError(f"{sorted(both)} given both as target and as nuisance; each fault is one or the other")

@@ -55,7 +55,7 @@ from scipy.integrate import solve_ivp
 
 from fdikit import linalg
 from fdikit.design.game_setup import weight
-from fdikit.errors import DesignError, ModelError
+from fdikit.errors import DesignError, ModelError, ParameterError
 
 __all__ = [
     "GohTransformation",
@@ -278,7 +278,7 @@ def _weights(C: np.ndarray, V, Q) -> tuple[np.ndarray, np.ndarray]:
     p = C.shape[0]
     Vw = weight("V", V, p)
     if np.linalg.eigvalsh(Vw).min() <= 1e-14 * max(1.0, np.abs(Vw).max()):
-        raise DesignError("weight V must be positive definite (it is inverted); e.g. V = 1.0")
+        raise ParameterError("weight V must be positive definite (it is inverted); e.g. V = 1.0")
     return Vw, weight("Q", Q, p)
 
 

@@ -49,10 +49,10 @@ from typing import Literal
 import numpy as np
 import scipy.linalg
 
-from fdikit import linalg
+from fdikit import linalg, validate
 from fdikit.design.detection_gain import DetectionGainFamily, detection_gain_family
 from fdikit.design.observer import observer_generator
-from fdikit.errors import DesignError, ModelError
+from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.residuals import ResidualGenerator
 
@@ -306,10 +306,14 @@ def hinf_detection_filter(
     >>> bool(d.hinf_norm <= d.bound), bool(np.all(d.poles.real < 0))
     (True, True)
     """
+    validate.instance("model", model, FaultModel)
+    gamma = validate.number("gamma", gamma, finite=False)
     if not (np.isfinite(gamma) and gamma > 0):
-        raise DesignError(f"gamma must be a positive number, got {gamma!r}")
+        raise ParameterError(f"gamma must be a positive number, got {gamma!r}")
     if form not in ("corrected", "printed"):
-        raise ModelError(f"form must be 'corrected' or 'printed', got {form!r}")
+        raise ParameterError(f"form must be 'corrected' or 'printed', got {form!r}")
+    horizon = validate.positive("horizon", horizon)
+    steady_tol = validate.positive("steady_tol", steady_tol)
     import control
 
     fam = detection_gain_family(model, faults, rtol)

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fdikit.errors import ModelError
+from fdikit.errors import ModelError, ParameterError
 from fdikit.model import GROUPS, FaultModel
 
 __all__ = [
@@ -118,7 +118,9 @@ class LPVModel:
                 )
             out.append(term)
         object.__setattr__(self, "terms", tuple(out))
-        object.__setattr__(self, "scheduling", str(scheduling))
+        if not isinstance(scheduling, str) or not scheduling.strip():
+            raise ParameterError(f"scheduling must be a non-empty name of the scheduling parameter, got {scheduling!r}")
+        object.__setattr__(self, "scheduling", scheduling)
         for name in "ABCD":
             arr = np.stack([getattr(t, name) for t in out])
             arr.setflags(write=False)
@@ -234,7 +236,7 @@ def _stack(A, B, C, D, groups: Mapping[str, slice], s: int) -> StackedMatrices:
 
 def _check_s(s) -> int:
     if isinstance(s, bool) or not isinstance(s, int | np.integer) or s < 0:
-        raise ModelError(f"the horizon s must be an integer >= 0, got {s!r}")
+        raise ParameterError(f"the horizon s must be an integer >= 0 (a non-negative integer), got {s!r}")
     return int(s)
 
 
@@ -258,10 +260,11 @@ def stacked_matrices(model: FaultModel | Sequence[FaultModel], s: int | None = N
     """
     models = [model] if isinstance(model, FaultModel) else list(model)
     if not models or not all(isinstance(m, FaultModel) for m in models):
-        raise ModelError("stacked_matrices needs a FaultModel or a non-empty sequence of FaultModel objects")
+        raise ParameterError("stacked_matrices needs a FaultModel or a non-empty sequence of FaultModel objects "
+                             f"as model, got {type(model).__name__}")
     if len(models) == 1:
         if s is None:
-            raise ModelError("give the horizon s for a single model (e.g. stacked_matrices(model, 3))")
+            raise ParameterError("give the horizon s for a single model (e.g. stacked_matrices(model, 3))")
         s = _check_s(s)
         models = models * (s + 1)
     elif s is not None and _check_s(s) != len(models) - 1:

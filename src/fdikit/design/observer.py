@@ -22,7 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from fdikit.errors import DesignError, ModelError
+from fdikit import validate
+from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.residuals import ResidualGenerator
 
@@ -52,7 +53,9 @@ class ObserverDesign:
 
 def unobservable_modes(A: np.ndarray, C: np.ndarray) -> np.ndarray:
     """Eigenvalues λ of ``A`` with ``rank [A − λI; C] < n`` (PBH test, scale-aware tolerance)."""
+    A = validate.as_square("A", A)
     n = A.shape[0]
+    C = validate.as_matrix("C", C, (None, n))
     scale = max(np.linalg.norm(A, 2), np.linalg.norm(C, 2), 1.0)
     out = []
     for lam in scipy.linalg.eigvals(A):
@@ -76,8 +79,10 @@ def observer_generator(
     ``outputs`` names the generator's residual outputs (default: the model's output names, or
     ``r0, r1 …`` with a projection).
     """
+    validate.instance("model", model, FaultModel)
     A, C, Bu, Du = model.A, model.C, model.Bu, model.Du
-    Q = np.eye(model.p) if projection is None else np.asarray(projection, dtype=float)
+    L = validate.as_matrix("L (the observer gain)", L, (model.n, model.p))
+    Q = np.eye(model.p) if projection is None else validate.as_matrix("projection", projection, (model.p, None))
     if outputs is None:
         outputs = model.outputs if projection is None else tuple(f"r{k}" for k in range(Q.shape[1]))
     return ResidualGenerator(
@@ -132,18 +137,16 @@ def observer(model: FaultModel, poles: Sequence[complex], method: str = "place")
     """
     import control
 
-    poles = np.asarray(poles, dtype=complex)
-    if poles.shape != (model.n,):
-        raise DesignError(f"need {model.n} observer poles (one per state), got {poles.size}")
+    validate.instance("model", model, FaultModel)
+    poles = _poles(poles, model.n)
+    validate.choice("placement method", method, ("place", "varga"))
+    fn = {"place": control.place, "varga": control.place_varga}[method]
     modes = unobservable_modes(model.A, model.C)
     if modes.size:
         raise DesignError(
             f"(C, A) is not observable: modes {np.round(modes, 6).tolist()} do not reach the outputs; "
             "pole placement needs every mode observable (use kalman() for a detectable model)"
         )
-    fn = {"place": control.place, "varga": control.place_varga}.get(method)
-    if fn is None:
-        raise ModelError(f"unknown placement method {method!r}; use 'place' or 'varga'")
     try:
         L = np.asarray(fn(model.A.T, model.C.T, poles)).T
     except Exception as exc:  # python-control/slycot raise assorted types
@@ -153,16 +156,26 @@ def observer(model: FaultModel, poles: Sequence[complex], method: str = "place")
     return ObserverDesign(observer_generator(model, L), L, achieved)
 
 
+def _poles(poles, n: int) -> np.ndarray:
+    """``n`` finite poles as a complex vector (ParameterError otherwise)."""
+    out = validate.as_complex_vector("poles", poles)
+    if out.shape != (n,):
+        raise ParameterError(f"need {n} observer poles (one per state), got {out.size}")
+    return out
+
+
 def _cov(name: str, value, k: int) -> np.ndarray:
-    arr = np.atleast_2d(np.asarray(value, dtype=float))
+    arr = np.atleast_2d(validate.as_array(name, value))
     if arr.shape == (1, 1) and k != 1:
         arr = arr[0, 0] * np.eye(k)
     if arr.shape != (k, k):
-        raise ModelError(f"{name} must be a {k}x{k} covariance matrix (use np.diag(variances)), got shape {arr.shape}")
+        raise ParameterError(
+            f"{name} must be a {k}x{k} covariance matrix (use np.diag(variances)), got shape {arr.shape}"
+        )
     if not np.allclose(arr, arr.T, atol=1e-12 * max(1.0, np.abs(arr).max())):
-        raise ModelError(f"{name} must be symmetric")
+        raise ParameterError(f"{name} must be symmetric")
     if np.linalg.eigvalsh(arr).min() < -1e-12 * max(1.0, np.abs(arr).max()):
-        raise ModelError(f"{name} must be positive semidefinite")
+        raise ParameterError(f"{name} must be positive semidefinite")
     return arr
 
 
@@ -189,6 +202,7 @@ def kalman(model: FaultModel, Q, R) -> ObserverDesign:
     DesignError
         When the Riccati equation has no stabilising solution (e.g. an undetectable mode).
     """
+    validate.instance("model", model, FaultModel)
     n, p = model.n, model.p
     if model.noise:
         G, H = model.Bw, model.Dw

@@ -43,7 +43,7 @@ import scipy.linalg
 from fdikit import linalg
 from fdikit.design.game_setup import GameProblem, game_problem
 from fdikit.design.goh import GohRiccatiSolution, goh_riccati
-from fdikit.errors import DesignError
+from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.residuals import ResidualGenerator
 
@@ -105,10 +105,10 @@ def _per_target(value, names: Sequence[str], given: Sequence[str]) -> dict[str, 
     out = {alias.get(k, k): v for k, v in value.items()}
     unknown = sorted(set(out) - set(names))
     if unknown:
-        raise DesignError(f"weight Q is given for {unknown}, which are not targets; targets are {list(names)}")
+        raise ParameterError(f"weight Q is given for {unknown}, which are not targets; targets are {list(names)}")
     missing = [t for t in names if t not in out]
     if missing:
-        raise DesignError(f"weight Q is missing for target(s) {missing}; give one value or one per target")
+        raise ParameterError(f"weight Q is missing for target(s) {missing}; give one value or one per target")
     return out
 
 

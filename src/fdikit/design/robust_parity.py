@@ -36,6 +36,7 @@ from itertools import product
 import numpy as np
 import scipy.linalg
 
+from fdikit import validate
 from fdikit.design.lpv import LPVModel, Uncertainty, lpv_stacked_matrices, uncertain_stacked_matrices
 from fdikit.design.parity import lpv_parity_residuals, parity_matrix, regular_rows
 from fdikit.design.polytope import (
@@ -47,7 +48,7 @@ from fdikit.design.polytope import (
     repair_vertex,
     scheduling_weights,
 )
-from fdikit.errors import DesignError, ModelError
+from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.residuals import Residuals
 from fdikit.trace import Trace
 
@@ -152,9 +153,11 @@ def theorem1(gamma1: np.ndarray, gamma2: np.ndarray, *, sign_ref: np.ndarray | N
     >>> round(theorem1(np.diag([1.0, 2.0]), np.diag([1.0, 4.0])).lambda_min, 12)
     0.5
     """
-    G1, G2 = np.asarray(gamma1, dtype=float), np.asarray(gamma2, dtype=float)
-    if G1.ndim != 2 or G1.shape != G2.shape or G1.shape[0] != G1.shape[1]:
-        raise ModelError(f"Γ₁ and Γ₂ must be square matrices of one size, got {G1.shape} and {G2.shape}")
+    G1 = validate.as_square("gamma1 (Γ₁)", gamma1)
+    G2 = validate.as_matrix("gamma2 (Γ₂)", gamma2)
+    if G1.shape != G2.shape:
+        raise ParameterError(f"Γ₁ and Γ₂ must be square matrices of one size, got gamma1 shape {G1.shape} and "
+                             f"gamma2 shape {G2.shape}")
     G1, G2 = (G1 + G1.T) / 2, (G2 + G2.T) / 2
     scale = max(np.linalg.norm(G1, 2), np.finfo(float).tiny)
     e1 = np.linalg.eigvalsh(G1)

@@ -57,7 +57,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from fdikit import linalg
+from fdikit import linalg, validate
 from fdikit.errors import DesignError, ModelError
 from fdikit.model import FaultModel
 from fdikit.residuals import ResidualGenerator
@@ -346,7 +346,7 @@ def uio(
     if poles is None:
         K1 = Zo @ _kalman_gain(Ao, Co, discrete)
     elif no or np.size(poles):
-        poles = np.atleast_1d(np.asarray(poles, dtype=complex))
+        poles = validate.as_complex_vector("poles", poles)
         if poles.shape != (no,):
             raise DesignError(
                 f"need {no} UIO poles (n = {n} minus {n - no} fixed modes {_fmt(fixed)}), got {poles.size}"

@@ -46,7 +46,8 @@ import scipy.signal
 from numpy.lib.stride_tricks import sliding_window_view
 from numpy.typing import ArrayLike
 
-from fdikit.errors import DataError, DesignError, ModelError
+from fdikit import validate
+from fdikit.errors import DataError, DesignError, ModelError, ParameterError
 
 __all__ = [
     "SteeringFaultEstimate",
@@ -79,11 +80,14 @@ def lateral_fault_map(pole: float = 0.9048, zero: float = -0.97294, dt: float = 
     >>> round(float(np.polyval(G.num, 1.0) / np.polyval(G.den, 1.0)), 12)
     1.0
     """
-    p, z0 = float(pole), float(zero)
+    p = validate.number("pole", pole, finite=False)
+    z0 = validate.number("zero", zero, finite=False)
+    dt = validate.positive("dt", dt)
     if not (np.isfinite(p) and abs(p) < 1):
-        raise DesignError(f"pole must lie strictly inside the unit circle for a stable filter, got {pole!r}")
+        raise ParameterError(f"pole must lie strictly inside the unit circle (|pole| < 1) for a stable filter, "
+                             f"got {pole!r}")
     if not (np.isfinite(z0) and z0 != 1.0):
-        raise DesignError(f"zero must be finite and not at q = 1 (the DC gain would vanish), got {zero!r}")
+        raise ParameterError(f"zero must be finite and not at q = 1 (the DC gain would vanish), got {zero!r}")
     gain = (1.0 - p) ** 3 / (1.0 - z0)
     return scipy.signal.TransferFunction(gain * np.array([1.0, -z0]), np.poly([p, p, p]), dt=dt)
 
@@ -182,16 +186,20 @@ class IsolatorStep(NamedTuple):
 
 def _check_window(n) -> int:
     if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 2:
-        raise DataError(f"window length n must be an integer >= 2 (a regression on [1, E] needs 2 samples), got {n!r}")
+        raise ParameterError(
+            f"window length n must be a positive integer >= 2 (a regression on [1, E] needs 2 samples), got {n!r}"
+        )
     return int(n)
 
 
 def _check_guard(min_variance: float, rtol: float) -> tuple[float, float]:
-    mv, rt = float(min_variance), float(rtol)
+    mv = validate.number("min_variance", min_variance, finite=False)
+    rt = validate.number("rtol", rtol, finite=False)
     if not (np.isfinite(mv) and mv >= 0):
-        raise DataError(f"min_variance must be a finite number >= 0 (in units of E squared), got {min_variance!r}")
+        raise ParameterError(f"min_variance must be a finite non-negative number >= 0 (in units of E squared), "
+                             f"got {min_variance!r}")
     if not (np.isfinite(rt) and 0 <= rt < 1):
-        raise DataError(f"rtol must be in [0, 1) (threshold on V_n/σ_n² of the regressor), got {rtol!r}")
+        raise ParameterError(f"rtol must be in [0, 1) (threshold on V_n/σ_n² of the regressor), got {rtol!r}")
     return mv, rt
 
 
@@ -290,15 +298,16 @@ def isolate_steering_faults(
     """
     n = _check_window(n)
     min_var, rt = _check_guard(min_variance, rtol)
-    r = np.asarray(residual, dtype=float)
-    E = np.asarray(setpoint, dtype=float)
+    nominal_gain = validate.number("nominal_gain", nominal_gain)
+    r = validate.as_array("residual", residual, error=DataError, finite=False)
+    E = validate.as_array("setpoint", setpoint, error=DataError, finite=False)
     if r.ndim != 1 or E.shape != r.shape:
         raise DataError(
-            f"residual and setpoint must be 1-D arrays of equal length, got shapes {r.shape} and {E.shape}; "
-            "pass one residual and the matching steering set-point samples"
+            f"residual and setpoint must be 1-D arrays of equal length (samples), got shapes {r.shape} and "
+            f"{E.shape}; pass one residual and the matching steering set-point samples"
         )
     N = r.size
-    tt = np.arange(N, dtype=float) if t is None else np.asarray(t, dtype=float)
+    tt = np.arange(N, dtype=float) if t is None else validate.as_array("t", t, error=DataError)
     if tt.shape != (N,):
         raise DataError(f"t has shape {tt.shape}, need ({N},): one time per sample")
     coeffs = None
@@ -359,7 +368,7 @@ class SteeringFaultIsolator:
     ) -> None:
         self.n = _check_window(n)
         self.min_variance, self.rtol = _check_guard(min_variance, rtol)
-        self.nominal_gain = float(nominal_gain)
+        self.nominal_gain = validate.number("nominal_gain", nominal_gain)
         self.prefilter = None
         if prefilter is not None:
             self.prefilter = fault_map_coefficients(prefilter)
@@ -387,8 +396,10 @@ class SteeringFaultIsolator:
 
     def step(self, residual: float, setpoint: float) -> IsolatorStep:
         """Push one sample; return the estimate of the window ending at it."""
-        self._E.append(self._filter(float(setpoint)))
-        self._r.append(float(residual))
+        setpoint = validate.number("setpoint", setpoint, error=DataError, finite=False)
+        residual = validate.number("residual", residual, error=DataError, finite=False)
+        self._E.append(self._filter(setpoint))
+        self._r.append(residual)
         if len(self._E) < self.n:
             return IsolatorStep(float("nan"), float("nan"), False)
         Ew = np.array(self._E)[None, :]
