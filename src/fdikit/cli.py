@@ -1,4 +1,11 @@
-"""The ``fdikit`` command line."""
+"""The ``fdikit`` command line.
+
+Every command checks all of its arguments before any work and answers bad input with one line
+``error: ...`` naming the option and what would be accepted (exit code 2, no traceback).  The long
+commands (``compare-evaluators``, ``multiple-model``) store each finished result at once and resume
+after a kill when rerun with the same arguments; ``--fresh`` starts over (see :mod:`fdikit.resume`).
+Every file is written atomically (:mod:`fdikit.atomic`).
+"""
 
 from __future__ import annotations
 
@@ -9,16 +16,24 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-from fdikit.errors import FdiError
+from fdikit.errors import FdiError, ParameterError
 
 app = typer.Typer(help="fdikit: model-based fault detection and isolation for vehicles and aircraft.",
                   no_args_is_help=True, add_completion=False)
 console = Console()
+err_console = Console(stderr=True)
 
 
 def _fail(exc: Exception) -> None:
-    console.print(f"[red]error:[/red] {exc}")
+    """Print ``error: <message>`` (unwrapped, no markup) on stderr and exit with code 2."""
+    err_console.print("[red]error:[/red] ", end="")
+    err_console.print(str(exc), markup=False, highlight=False, soft_wrap=True)
     raise typer.Exit(code=2)
+
+
+def _fresh_option():
+    return typer.Option(False, "--fresh", help="Start over even when OUT holds a resumable run (the old results "
+                        "stay until the new run is complete).")
 
 
 @app.command()
@@ -28,10 +43,12 @@ def demo(
     method: str = typer.Option("bank", help="'bank': PATH Beard-Jones filter bank; 'kalman': Kalman detection only."),
 ) -> None:
     """End-to-end diagnosis of faults on the PATH vehicle: detection, isolation, report."""
-    from fdikit.demo import run_demo, run_kalman_demo
+    from fdikit.demo import check_demo_arguments, run_demo, run_kalman_demo
 
-    if method not in ("bank", "kalman"):
-        _fail(FdiError(f"unknown method {method!r}; use 'bank' or 'kalman'"))
+    try:
+        check_demo_arguments(out=out, seed=seed, method=method)
+    except FdiError as exc:
+        _fail(exc)
     start = time.perf_counter()
     with console.status("designing, calibrating thresholds on 10 min fault-free data, diagnosing ..."):
         try:
@@ -97,16 +114,19 @@ def simulate(
     """Simulate a named plant under faults and save the trace as Parquet."""
     from fdikit.faults import FaultScenario, parse_fault
     from fdikit.plants import get_plant
+    from fdikit.resume import check_nonnegative, check_output_file, check_positive, check_seed
     from fdikit.simulate import simulate as run
 
     try:
-        kw = {}
-        for p in param:
-            key, _, value = p.partition("=")
-            if not value:
-                raise typer.BadParameter(f"--param needs name=value, got {p!r}")
-            kw[key] = float(value)
+        duration = check_positive(duration, "duration", hint=" s")
+        dt = check_positive(dt, "dt", hint=" s")
+        if dt > duration:
+            raise ParameterError(f"dt (--dt) = {dt:g} s must not exceed duration (--duration) = {duration:g} s")
+        noise = check_nonnegative(noise, "noise")
+        seed = check_seed(seed)
+        kw = _plant_params(plant, param)
         model = get_plant(plant, **kw)
+        out = check_output_file(out)
         scenario = FaultScenario([parse_fault(s) for s in fault])
         with console.status(f"simulating {plant} for {duration:g} s ..."):
             trace = run(model, scenario, duration=duration, dt=dt, measurement_noise=noise or None, rng=seed,
@@ -117,20 +137,63 @@ def simulate(
     console.print(f"{trace!r}\nwrote {path}")
 
 
+def _plant_params(plant: str, param: list[str]) -> dict:
+    """``--param name=value`` pairs: numbers, or text for a parameter annotated ``str``."""
+    import inspect
+    import math
+
+    from fdikit.plants import PLANTS
+
+    signature = inspect.signature(PLANTS[plant]) if plant in PLANTS else None
+    kw: dict = {}
+    for p in param:
+        key, sep, value = p.partition("=")
+        key, value = key.strip(), value.strip()
+        if not sep or not key or not value:
+            raise ParameterError(f"--param needs name=value (e.g. speed=20), got {p!r}")
+        if key in kw:
+            raise ParameterError(f"--param {key} is given twice; give each parameter once")
+        annotation = None
+        if signature is not None and key in signature.parameters:
+            annotation = signature.parameters[key].annotation
+        if annotation in (str, "str"):
+            kw[key] = value
+            continue
+        try:
+            number = float(value)
+        except ValueError:
+            raise ParameterError(f"--param {key}={value}: {value!r} is not a number") from None
+        if not math.isfinite(number):
+            raise ParameterError(f"--param {key}={value}: the value must be finite")
+        kw[key] = number
+    return kw
+
+
 @app.command("compare-evaluators")
 def compare_evaluators(
     runs_per_fault: int = typer.Option(2, help="Test runs per fault (15 faults)."),
     healthy_runs: int = typer.Option(5, help="Fault-free test runs."),
     seed: int = typer.Option(0, help="Seed of the training and test runs."),
     bnn: bool = typer.Option(True, help="Include the Bayesian neural network (slowest to train)."),
+    evaluators: str = typer.Option(None, help="Comma-separated evaluators to compare (default: all): threshold, "
+                                   "cusum, glr, sprt, cusum-whitened, glr-whitened, sprt-whitened, mhsprt, "
+                                   "gaussian-ml, bnn."),
     out: Path = typer.Option(Path("out/compare"), help="Folder for scores.csv and comparison.md."),
+    fresh: bool = _fresh_option(),
 ) -> None:
-    """Score every residual evaluator on the same PATH bank residuals and tabulate them side by side."""
-    from fdikit.monitors.path_compare import path_evaluator_comparison
+    """Score every residual evaluator on the same PATH bank residuals and tabulate them side by side.
+
+    Each test run's scores are stored in OUT as soon as the run is scored; rerunning the same command
+    after an interruption resumes where it stopped.
+    """
+    from fdikit.monitors.path_compare import check_comparison_arguments, path_evaluator_comparison
 
     start = time.perf_counter()
     try:
-        result = path_evaluator_comparison(runs_per_fault, healthy_runs, seed, out, progress=True, bnn=bnn)
+        chosen = None if evaluators is None else evaluators.split(",")
+        check_comparison_arguments(runs_per_fault, healthy_runs, seed, bnn, evaluators=chosen)
+        result = path_evaluator_comparison(runs_per_fault, healthy_runs, seed, out, progress=True, bnn=bnn,
+                                           evaluators=chosen, fresh=fresh)
     except FdiError as exc:
         _fail(exc)
     table = Table(title=f"PATH bank residuals: {runs_per_fault} runs per fault, {healthy_runs} fault-free runs")
@@ -150,14 +213,19 @@ def target_tracking(
     out: Path = typer.Option(Path("out/target_tracking"), help="Folder for summary.md and rmse.png."),
 ) -> None:
     """Convex-model filters vs the IMM on the maneuvering-target benchmark (Hallouzi 2008, §2.4.2)."""
+    from fdikit.atomic import write_text
+    from fdikit.resume import check_count, check_output_folder, check_seed
     from fdikit.scenarios.target_tracking import plot_target_tracking, target_tracking_monte_carlo
 
     start = time.perf_counter()
     try:
-        result = target_tracking_monte_carlo(runs=runs, seed=seed)
+        check_count(runs, "runs")
+        check_seed(seed)
+        check_output_folder(out)
+        with console.status(f"target tracking: {runs} Monte-Carlo runs ..."):
+            result = target_tracking_monte_carlo(runs=runs, seed=seed)
     except FdiError as exc:
         _fail(exc)
-    out.mkdir(parents=True, exist_ok=True)
     intervals = list(next(iter(result.summary.values())))
     table = Table(title=f"mean RMSE per interval over {runs} runs: position [m] / velocity [m/s] / B")
     table.add_column("filter", no_wrap=True)
@@ -169,8 +237,8 @@ def target_tracking(
         table.add_row(name, *cells)
         lines.append(f"| {name} | " + " | ".join(cells) + " |")
     console.print(table)
-    (out / "summary.md").write_text("\n".join(lines) + "\n")
     plot_target_tracking(result, out / "rmse.png")
+    write_text(out / "summary.md", "\n".join(lines) + "\n")
     console.print(f"wrote {out / 'summary.md'} and {out / 'rmse.png'} in {time.perf_counter() - start:.0f} s")
 
 
@@ -181,12 +249,23 @@ def multiple_model(
     msd_dt: float = typer.Option(0.01, help="MSD sample time [s] (thesis 2.5e-3; at most 0.02)."),
     model_sets: int = typer.Option(15, help="Random model sets of Example 3.1 (thesis: 15)."),
     out: Path = typer.Option(Path("out/multiple_model"), help="Folder for summary.md and the plots."),
+    fresh: bool = _fresh_option(),
 ) -> None:
-    """Hallouzi 2008 items 17–20: target tracking, B747, Example 3.1 and the MSD model sets, with plots."""
+    """Hallouzi 2008 items 17–20: target tracking, B747, Example 3.1 and the MSD model sets, with plots.
+
+    Each finished item is stored in OUT at once; rerunning the same command after an interruption
+    resumes where it stopped.  summary.md is written when all four items are done.
+    """
     from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 
-    from fdikit.scenarios.multiple_model_report import multiple_model_report
+    from fdikit.resume import check_output_folder
+    from fdikit.scenarios.multiple_model_report import check_multiple_model_arguments, multiple_model_report
 
+    try:
+        check_multiple_model_arguments(runs=runs, seed=seed, msd_dt=msd_dt, model_sets=model_sets)
+        check_output_folder(out)
+    except FdiError as exc:
+        _fail(exc)
     start = time.perf_counter()
     with Progress(SpinnerColumn(), TextColumn("{task.description}"), TimeElapsedColumn(), console=console) as bar:
         task = bar.add_task("starting", total=4)
@@ -198,7 +277,7 @@ def multiple_model(
 
         try:
             summary = multiple_model_report(out, runs=runs, seed=seed, msd_dt=msd_dt, model_sets=model_sets,
-                                            progress=step)
+                                            progress=step, fresh=fresh)
         except FdiError as exc:
             _fail(exc)
         bar.advance(task)

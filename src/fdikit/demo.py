@@ -28,17 +28,18 @@ import numpy as np
 from fdikit.decision import ThresholdEvaluator
 from fdikit.design import ObserverDesign, kalman
 from fdikit.diagnosis import Diagnosis
+from fdikit.errors import ParameterError
 from fdikit.faults import Bias, FaultScenario
 from fdikit.metrics import Score, score
 from fdikit.model import FaultModel, sensor_fault_name
 from fdikit.plants import path_vehicle_12
-from fdikit.report import plot_residuals
+from fdikit.report import plot_residuals, save_figure
 from fdikit.residuals import Residuals
 from fdikit.simulate import simulate
 from fdikit.trace import Trace
 
-__all__ = ["DemoResult", "BankDemoResult", "demo_model", "run_demo", "run_kalman_demo", "SENSOR_NOISE_STD",
-           "ACTUATOR_NOISE_STD"]
+__all__ = ["DemoResult", "BankDemoResult", "demo_model", "run_demo", "run_kalman_demo", "check_demo_arguments",
+           "SENSOR_NOISE_STD", "ACTUATOR_NOISE_STD"]
 
 #: Sensor noise standard deviations (per sample at 100 Hz), in App. D output order.
 SENSOR_NOISE_STD = {
@@ -61,6 +62,33 @@ class DemoResult:
     files: dict
 
 
+def check_demo_arguments(*, out="out/demo", seed=2026, method="bank", onset=10.0, duration=30.0,
+                         calibration_minutes=10.0, dt=0.01, **positive) -> Path:
+    """Check the demo's arguments before any work; return the output folder (created, writable).
+
+    Raises
+    ------
+    ParameterError
+        Naming the argument: ``method`` 'bank' or 'kalman', ``seed`` an integer >= 0, ``onset`` < ``duration``,
+        times and the other keyword values (``fault_size``, ``noise_fraction``, ``false_alarms_per_hour``)
+        finite and > 0, ``out`` a writable folder.
+    """
+    from fdikit.resume import check_output_folder, check_positive, check_seed
+
+    if method not in ("bank", "kalman"):
+        raise ParameterError(f"unknown method (--method) {method!r}; use 'bank' or 'kalman'")
+    check_seed(seed)
+    for name, value in {"onset": onset, "duration": duration, "calibration_minutes": calibration_minutes, "dt": dt,
+                        **positive}.items():
+        check_positive(value, name)
+    if onset >= duration:
+        raise ParameterError(f"onset (--onset) = {onset:g} s must lie before the end of the run, duration = "
+                             f"{duration:g} s")
+    if dt >= duration:
+        raise ParameterError(f"dt = {dt:g} s must be smaller than duration = {duration:g} s")
+    return check_output_folder(out)
+
+
 def demo_model(dt: float = 0.01) -> FaultModel:
     """The 12-state PATH model, actuator jitter as its noise group, sampled at ``dt``."""
     m = path_vehicle_12()
@@ -78,8 +106,13 @@ def run_kalman_demo(
     false_alarms_per_hour: float = 1.0,
     dt: float = 0.01,
 ) -> DemoResult:
-    """Run the demo; writes ``report.png`` and ``trace.parquet`` to ``out_dir``."""
-    out = Path(out_dir)
+    """Run the demo; writes ``report.png`` and ``trace.parquet`` to ``out_dir`` (each atomically).
+
+    Every argument is checked first (:func:`check_demo_arguments`).
+    """
+    out = check_demo_arguments(out=out_dir, seed=seed, method="kalman", onset=onset, duration=duration,
+                               calibration_minutes=calibration_minutes, dt=dt, fault_size=fault_size,
+                               false_alarms_per_hour=false_alarms_per_hour)
     model = demo_model(dt)
     W = np.diag([ACTUATOR_NOISE_STD[c] ** 2 for c in model.controls])
     v_std = np.array([SENSOR_NOISE_STD[o] for o in model.outputs])
@@ -142,12 +175,14 @@ def run_demo(
     The plant is the 14-state App. D model (``tiny='midpoint'``) sampled at ``dt`` with white
     sensor noise of ``noise_fraction`` times each sensor's nominal fault size (the
     reconstructed filters amplify noise strongly; see ``docs/methods/beard_jones.md``).
-    Thresholds: 1 false alarm per hour on a fault-free run, persistence 5 of 10.
+    Thresholds: 1 false alarm per hour on a fault-free run, persistence 5 of 10.  Every argument is
+    checked first (:func:`check_demo_arguments`); every file is written atomically.
     """
     from fdikit.analysis import fault_to_residual_gain
     from fdikit.monitors import path_bank, path_fault_model
 
-    out = Path(out_dir)
+    out = check_demo_arguments(out=out_dir, seed=seed, method="bank", onset=onset, duration=duration,
+                               calibration_minutes=calibration_minutes, dt=dt, noise_fraction=noise_fraction)
     bank = path_bank()
     gen = bank.generator.discretize(dt)
     plant = path_fault_model(14).discretize(dt)
@@ -171,8 +206,7 @@ def run_demo(
         panels.append((label, residuals, diagnosis, [n for n, g in zip(residuals.names, bank.groups) if g == group]))
     files["report"] = _bank_report(panels, evaluator, onset, out / "report.png")
     table = fault_to_residual_gain(gen, plant, np.logspace(-2, np.log10(np.pi / dt), 40))
-    table.plot(out / "structure.png")
-    files["structure"] = out / "structure.png"
+    files["structure"] = save_figure(table.plot(), out / "structure.png")
     return BankDemoResult(traces, diagnoses, scores, evaluator, noise, files)
 
 
@@ -203,7 +237,6 @@ def _bank_report(panels, evaluator, onset, path: Path) -> Path:
         axes[0, col].set_title(f"{label}: {names[0].split(':')[0]} residuals (scaled, nominal fault = 1)", fontsize=9)
         axes[-1, col].set_xlabel("time [s]")
     fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
     return path

@@ -10,7 +10,34 @@ import numpy as np
 from fdikit.diagnosis import Diagnosis
 from fdikit.residuals import Residuals
 
-__all__ = ["plot_residuals"]
+__all__ = ["plot_residuals", "save_figure", "figure_bytes"]
+
+
+def save_figure(fig, path, dpi: int = 120):
+    """Write ``fig`` to ``path`` atomically (:mod:`fdikit.atomic`); the format follows the suffix (PNG default).
+
+    A kill or an error during the write leaves the previous file at ``path`` (if any) untouched.
+    ``path`` may also be a binary file object (written as PNG, not atomic: the caller owns it).
+    """
+    from fdikit.atomic import atomic_path
+
+    if hasattr(path, "write"):
+        fig.savefig(path, format="png", dpi=dpi)
+        return path
+    path = Path(path)
+    fmt = path.suffix.lstrip(".").lower() or "png"
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format=fmt, dpi=dpi)
+    return path
+
+
+def figure_bytes(fig, dpi: int = 120, fmt: str = "png") -> bytes:
+    """The figure encoded as ``fmt`` (PNG by default), for storing it with a result part."""
+    import io
+
+    buf = io.BytesIO()
+    fig.savefig(buf, format=fmt, dpi=dpi)
+    return buf.getvalue()
 
 
 def plot_residuals(
@@ -25,7 +52,8 @@ def plot_residuals(
 ):
     """One panel per residual with its threshold band, alarm samples and the fault onset.
 
-    Returns the matplotlib figure; writes it to ``path`` (PNG, PDF ...) when given.
+    Returns the matplotlib figure; writes it to ``path`` (PNG, PDF ...; atomically, see
+    :func:`save_figure`) when given.
     """
     import matplotlib
 
@@ -54,8 +82,6 @@ def plot_residuals(
         fig.suptitle(title, fontsize=10)
     fig.tight_layout()
     if path is not None:
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(path, dpi=120)
+        save_figure(fig, path)
         plt.close(fig)
     return fig

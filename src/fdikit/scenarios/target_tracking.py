@@ -205,8 +205,13 @@ def target_tracking_monte_carlo(runs: int = 100, seed: int | None = 0, *, lam: f
 
 
 def plot_target_tracking(result: TargetTrackingResult, path) -> None:
-    """Figs 2.4–2.5 style plot (position, velocity and B RMSE, mean left-turn weight) to ``path`` (Agg)."""
+    """Figs 2.4–2.5 style plot (position, velocity and B RMSE, mean left-turn weight) to ``path`` (Agg).
+
+    ``path`` is written atomically (:func:`fdikit.report.save_figure`); a binary file object also works.
+    """
     import matplotlib
+
+    from fdikit.report import save_figure
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -230,5 +235,5 @@ def plot_target_tracking(result: TargetTrackingResult, path) -> None:
         ax.legend(fontsize=7, loc="upper right")
     axes[0].set_title(f"Hallouzi 2008 §2.4.2, {result.runs} Monte-Carlo runs")
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path, dpi=120)
     plt.close(fig)
