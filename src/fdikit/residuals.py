@@ -595,6 +595,9 @@ class ResidualStepper:
         self._rec = _Recovery(self._rule)
 
     def _vector(self, values, names: tuple[str, ...], what: str) -> np.ndarray:
+        if values is None or isinstance(values, (str, bytes)):
+            raise DataError(f"step() {what} must be {len(names)} numbers {list(names)} (NaN marks a missing value), "
+                            f"got {values!r}")
         if isinstance(values, Mapping):
             keys = list(values)
             missing = [nm for nm in names if nm not in values]
