@@ -206,7 +206,9 @@ class ResidualGenerator:
         a gap are *recovering* (finite residuals, ``valid`` False, ``recovering`` True) until the gap
         transient has decayed below ``recovery_tol`` noise standard deviations.  Stretches of valid
         samples are processed by the blocked recursion of :func:`fdikit.lti.dlsim_blocked`; only the
-        invalid samples and the recovery bookkeeping are stepped one by one.
+        invalid samples and the recovery bookkeeping are stepped one by one (by superposition: the
+        response to the usable inputs and the response to the gap rule's state corrections are each
+        one blocked solve over the whole trace).
 
         Parameters
         ----------
@@ -246,33 +248,50 @@ class ResidualGenerator:
             _GapRule(g, residual_cov, recovery_tol)  # validates the options alike on clean data
             return Residuals(trace.t, r, self.residuals, self.isolates, meta=meta)
         rule = _GapRule(g, residual_cov, recovery_tol)
-        N, q = v.shape[0], len(self.residuals)
-        r = np.full((N, q), np.nan)
+        N, n = v.shape[0], g.n
+        # Superposition: x = X0 + c, X0 the response to the usable inputs (bad entries 0) from rest, c the
+        # response to x0 and to the state corrections E the gap rule applies on invalid samples.  Only the
+        # invalid samples (and the recovery bookkeeping) are stepped; both responses are one blocked solve.
+        v0 = np.where(ok_ch, v, 0.0)
+        r0, X0, _ = dlsim_blocked(g.A, g.B, g.C, g.D, v0)
+        E = np.zeros((N, n))
         valid = np.zeros(N, bool)
         recovering = np.zeros(N, bool)
-        bad_idx = np.flatnonzero(~ok)
-        last = np.zeros(v.shape[1])
-        x = x0
         rec = _Recovery(rule)
-        k = 0
-        while k < N:
-            if ok[k]:
-                nxt = bad_idx[np.searchsorted(bad_idx, k)] if bad_idx[-1] > k else N
-                r[k:nxt], _, x = dlsim_blocked(g.A, g.B, g.C, g.D, v[k:nxt], x)
-                i = k
-                while i < nxt and rec.active:
-                    valid[i] = rec.valid_sample()
-                    recovering[i] = not valid[i]
-                    i += 1
-                valid[i:nxt] = True
-                last = v[nxt - 1].copy()
-                k = nxt
-            else:
-                x = rule.propagate(x, v[k], ok_ch[k], last)
+        last = np.zeros(v.shape[1])
+        c, kc = x0.copy(), 0
+        bad_idx = np.flatnonzero(~ok)
+        starts = bad_idx[np.concatenate([[True], np.diff(bad_idx) > 1])]
+        ends = bad_idx[np.concatenate([np.diff(bad_idx) > 1, [True]])] + 1
+        prev = 0
+        for a, b in zip(starts.tolist(), ends.tolist()):
+            self._flags(rec, valid, recovering, prev, a)
+            if a > prev:
+                last = v[a - 1].copy()
+            c = np.linalg.matrix_power(g.A, a - kc) @ c if n else c
+            for k in range(a, b):
+                x = X0[k] + c
+                znew = rule.propagate(x, v[k], ok_ch[k], last)
+                E[k] = znew - (g.A @ x + g.B @ v0[k])
+                c = g.A @ c + E[k]
                 last[ok_ch[k]] = v[k, ok_ch[k]]
                 rec.invalid_sample(ok_ch[k])
-                k += 1
+            kc, prev = b, b
+        self._flags(rec, valid, recovering, prev, N)
+        rc, _, _ = dlsim_blocked(g.A, np.eye(n), g.C, np.zeros((len(self.residuals), n)), E, x0)
+        r = r0 + rc
+        r[~ok] = np.nan
         return Residuals(trace.t, r, self.residuals, self.isolates, valid, meta=meta, recovering=recovering)
+
+    @staticmethod
+    def _flags(rec: _Recovery, valid: np.ndarray, recovering: np.ndarray, start: int, stop: int) -> None:
+        """Flags of the valid samples ``start … stop − 1`` (recovering while the gap transient lasts)."""
+        i = start
+        while i < stop and rec.active:
+            valid[i] = rec.valid_sample()
+            recovering[i] = not valid[i]
+            i += 1
+        valid[i:stop] = True
 
     def online(
         self, x0: np.ndarray | None = None, dt: float | None = None, *, residual_cov=None, recovery_tol: float = 0.1
