@@ -450,8 +450,9 @@ class Trace:
             The Parquet file.
         verify : bool, default True
             Require the content digest that :meth:`save` writes.  ``False`` also accepts a file
-            without one (written by another program or an older fdikit); the page checksums,
-            the structure and a digest that is present are checked either way.
+            without one (written by another program or an older fdikit, which stored NaN as
+            null: such nulls read as NaN); the page checksums, the structure and a digest that
+            is present are checked either way.
 
         Returns
         -------
@@ -511,35 +512,37 @@ class Trace:
         unexpected = [c for c in present if c not in set(expected)]
         if unexpected:
             raise DataError(f"{path} has unexpected column(s) {unexpected} that its fdikit metadata does not list")
+        for c in expected[:-1]:
+            if table.schema.field(c).type != pa.float64():
+                raise DataError(f"{path}: column {c!r} has type {table.schema.field(c).type}; trace signals must be "
+                                "float64 (double)")
+        cls._check_label_column(path, table.column("fault"), pa, pc)
+
+        # ---- integrity: the content digest must be there (unless verify=False) and match
+        stored = md.get(_DIGEST_KEY)
+        if stored is None and verify:
+            raise DataError(
+                f"{path} has no content digest ('fdikit.sha256' metadata): it was not written by Trace.save, "
+                "or its metadata is damaged. Trace.load(path, verify=False) reads it without that check"
+            )
         arrays: dict[str, np.ndarray] = {}
         for c in expected[:-1]:
             col = table.column(c)
-            if col.type != pa.float64():
-                raise DataError(f"{path}: column {c!r} has type {col.type}; trace signals must be float64 (double)")
-            if col.null_count:
+            if col.null_count and stored is not None:
                 first = int(np.flatnonzero(pc.is_null(col).to_numpy(zero_copy_only=False))[0])
                 raise DataError(
-                    f"{path}: column {c!r} has {col.null_count} null value(s), the first at sample {first}; "
-                    "a trace marks missing samples with NaN, never null"
+                    f"trace file {path} is corrupted: column {c!r} has {col.null_count} null value(s), the first at "
+                    f"sample {first}; Trace.save writes NaN, never null"
                 )
-            arrays[c] = np.array(col.to_numpy(), dtype=float)  # a writable copy
+            # a writable float64 copy; nulls (only in files without a digest: fdikit before the digest
+            # stored NaN as null) read as NaN, as they were written
+            arrays[c] = np.array(col.to_numpy(zero_copy_only=False), dtype=float)
         fault = cls._labels_from(path, table.column("fault"), pa, pc)
-
-        # ---- integrity: the content digest
-        stored = md.get(_DIGEST_KEY)
-        if stored is None:
-            if verify:
-                raise DataError(
-                    f"{path} has no content digest ('fdikit.sha256' metadata): it was not written by Trace.save, "
-                    "or its metadata is damaged. Trace.load(path, verify=False) reads it without that check"
-                )
-        else:
-            actual = _digest(raw, list(arrays.items()), fault)
-            if stored != actual.encode("ascii"):
-                raise DataError(
-                    f"trace file {path} is corrupted: its content digest (SHA-256 over the metadata and every column) "
-                    "does not match the stored one, so the file changed after it was written; restore it from a copy"
-                )
+        if stored is not None and stored != _digest(raw, list(arrays.items()), fault).encode("ascii"):
+            raise DataError(
+                f"trace file {path} is corrupted: its content digest (SHA-256 over the metadata and every column) "
+                "does not match the stored one, so the file changed after it was written; restore it from a copy"
+            )
 
         n = len(fault)
         blocks = {}
@@ -579,8 +582,8 @@ class Trace:
         return out
 
     @staticmethod
-    def _labels_from(path: Path, col, pa, pc) -> np.ndarray:
-        """The 'fault' column as a numpy str array; refuses non-strings, nulls and NUL characters."""
+    def _check_label_column(path: Path, col, pa, pc) -> None:
+        """The 'fault' column must hold strings and no null."""
         typ = col.type
         value_type = typ.value_type if pa.types.is_dictionary(typ) else typ
         is_text = pa.types.is_string(value_type) or pa.types.is_large_string(value_type) or (
@@ -593,9 +596,13 @@ class Trace:
                 f"{path}: column 'fault' has a null label at sample {first} ({col.null_count} nulls in all); "
                 f"every sample needs a label ({NO_FAULT!r} where healthy)"
             )
+
+    @staticmethod
+    def _labels_from(path: Path, col, pa, pc) -> np.ndarray:
+        """The (checked) 'fault' column as a numpy str array; refuses NUL characters."""
         arr = col.combine_chunks()
         if pa.types.is_dictionary(arr.type):
-            arr = arr.cast(value_type)
+            arr = arr.cast(arr.type.value_type)
         enc = pc.dictionary_encode(arr)
         labels = enc.dictionary.to_pylist()
         if any("\x00" in s for s in labels):

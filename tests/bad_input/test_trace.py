@@ -128,6 +128,16 @@ def _meta_edited(name: str) -> Path:
     return path
 
 
+def _null_in_saved(name: str) -> Path:
+    """A saved trace (with its digest) rewritten with one sample of 'y:b' null."""
+    path = _saved(name)
+    table = pq.read_table(path)
+    j = table.schema.get_field_index("y:b")
+    table = table.set_column(j, "y:b", pa.array([None] + [0.0] * (N - 1), pa.float64()))
+    pq.write_table(table, path)
+    return path
+
+
 def _over_existing_folder() -> Path:
     folder = _dir() / "a_folder.parquet"
     folder.mkdir(exist_ok=True)
@@ -246,9 +256,7 @@ CASES = [
          DataError, "fn.parquet", "fault", "null", "sample 7"),
     case("col-fault-empty", lambda: Trace.load(_raw("fe.parquet", _columns(fault=pa.array(_labels(7, "")))),
                                                verify=False), DataError, "fe.parquet", "fault", "empty"),
-    case("col-y-null", lambda: Trace.load(_raw("yn.parquet", _columns(y__b=pa.array([None] + [0.0] * (N - 1),
-                                                                                      pa.float64())))),
-         DataError, "yn.parquet", "y:b", "null"),
+    case("col-y-null", lambda: Trace.load(_null_in_saved("yn.parquet")), DataError, "yn.parquet", "y:b", "null"),
     case("col-t-decreasing", lambda: Trace.load(_raw("td.parquet", _columns(t=pa.array(-np.arange(N) * 0.1))),
                                                 verify=False), DataError, "td.parquet", "strictly increasing"),
     # ---------------------------------------------------------------- load: integrity
