@@ -457,8 +457,8 @@ def parse_fault(spec: str) -> Fault:
                              f"with kind one of {sorted(_KINDS)}, e.g. 'bias:yaw_rate:0.02@10'")
     kind, target = head[0], head[1]
     if kind not in _KINDS:
-        raise ParameterError(f"cannot read fault spec {spec!r}: unknown fault kind {kind!r}; "
-                             f"the kinds are {sorted(_KINDS)}")
+        raise ParameterError(f"cannot read fault spec {spec!r}: unknown fault kind {kind!r}; write {_GRAMMAR} "
+                             f"with kind one of {sorted(_KINDS)}, e.g. 'bias:yaw_rate:0.02@10'")
     if not _TARGET.match(target):
         raise ParameterError(f"cannot read fault spec {spec!r}: the target must be a signal name (letters, digits, "
                              f"'_' and '.'), got {target!r}")

@@ -104,17 +104,17 @@ def _human(nbytes: float) -> str:
     return f"{nbytes / 1024:.3g} KiB"
 
 
-def _available_memory() -> tuple[float, str]:
+def _available_memory(meminfo: str = "/proc/meminfo") -> tuple[float, str]:
     """Bytes of memory available to a new allocation, and where the figure comes from.
 
     ``MemAvailable`` of ``/proc/meminfo`` (Linux), else ``os.sysconf`` free pages; when neither
     can be read, a ceiling of 1 PiB (no machine holds such an array).
     """
     try:
-        with open("/proc/meminfo", encoding="ascii") as fh:
+        with open(meminfo, encoding="ascii") as fh:
             for line in fh:
                 if line.startswith("MemAvailable:"):
-                    return float(line.split()[1]) * 1024, "MemAvailable in /proc/meminfo"
+                    return float(line.split()[1]) * 1024, f"MemAvailable in {meminfo}"
     except (OSError, ValueError, IndexError):
         pass
     try:
