@@ -88,6 +88,19 @@ class Residuals:
         return Residuals(self.t[mask], self.r[mask], self.names, self.isolates, self.valid[mask], dict(self.meta),
                          self.recovering[mask])
 
+    def select(self, names: Sequence[str]) -> Residuals:
+        """The residuals ``names``, in that order (e.g. to match the order an evaluator was fitted on).
+
+        Raises :class:`DataError` naming the residuals that are not in the series.
+        """
+        names = (names,) if isinstance(names, str) else tuple(names)
+        missing = [nm for nm in names if nm not in self.names]
+        if missing:
+            raise DataError(f"residuals {missing} are not in the series (it has {list(self.names)})")
+        idx = [self.names.index(nm) for nm in names]
+        return Residuals(self.t, self.r[:, idx], names, tuple(self.isolates[i] for i in idx), self.valid,
+                         dict(self.meta), self.recovering)
+
     def to_pandas(self):
         import pandas as pd
 

@@ -92,7 +92,8 @@ def check_fitted_names(names, fitted, evaluator: str = "the evaluator") -> None:
     moved = [f"{n!r} at {i} (fitted at {fitted.index(n)})" for i, n in enumerate(names) if fitted[i] != n]
     raise DataError(
         f"residuals are reordered: got {list(names)}, {evaluator} was fitted on {list(fitted)} "
-        f"({', '.join(moved)}); its thresholds would apply to the wrong residuals — reorder the columns by name"
+        f"({', '.join(moved)}); its thresholds would apply to the wrong residuals — reorder them by name with "
+        f"residuals.select({list(fitted)})"
     )
 
 
