@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from filterpy.kalman import KalmanFilter
 
-from fdikit.errors import DataError, ModelError
+from fdikit.errors import DataError, ModelError, ParameterError
 from fdikit.multimodel.convex import (
     convex_model_set,
     dual_convex_filter,
@@ -234,11 +234,11 @@ def test_fault_size_and_nearest_model_reconstruction():
 
 def test_bad_input_is_named():
     ms = convex_model_set(np.eye(2), np.ones((2, 2, 1)), np.eye(2), Q=np.eye(2), R=np.eye(2))
-    with pytest.raises(ModelError, match="Q_mu"):
+    with pytest.raises(ParameterError, match="Q_mu"):
         augmented_ekf(ms, np.zeros((3, 2)), np.zeros((3, 1)), np.zeros(2), np.eye(2))
     with pytest.raises(DataError, match="y must be"):
         dual_convex_filter(ms, np.zeros((3, 3)), np.zeros((3, 1)), np.zeros(2), np.eye(2))
-    with pytest.raises(ModelError, match="lambda"):
+    with pytest.raises(ParameterError, match="lambda"):
         dual_convex_filter(ms, np.zeros((3, 2)), np.zeros((3, 1)), np.zeros(2), np.eye(2), lam=1.5)
     with pytest.raises(ModelError, match="positive definite"):
         convex_model_set(np.eye(2), np.ones((2, 2, 1)), np.eye(2), Q=np.eye(2), R=np.zeros((2, 2)))
@@ -328,11 +328,11 @@ def test_dual_cmf_options_and_prior():
     y, u = np.zeros((50, 2)), np.zeros((50, 1))  # no excitation: the weights are not identifiable
     r = dual_convex_filter(ms, y, u, np.zeros(2), np.eye(2), mu0=[1.0, 0.0], lam=0.9, prior_std=0.3)
     assert np.allclose(r.mu[-1], [1.0, 0.0], atol=1e-9)
-    with pytest.raises(ModelError, match="form"):
+    with pytest.raises(ParameterError, match="form"):
         dual_convex_filter(ms, y, u, np.zeros(2), np.eye(2), form="dual")
-    with pytest.raises(ModelError, match="metric"):
+    with pytest.raises(ParameterError, match="metric"):
         dual_convex_filter(ms, y, u, np.zeros(2), np.eye(2), metric="euclid")
-    with pytest.raises(ModelError, match="constrain"):
+    with pytest.raises(ParameterError, match="constrain"):
         dual_convex_filter(ms, y, u, np.zeros(2), np.eye(2), constrain="cube")
 
 

@@ -9,7 +9,7 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from fdikit.errors import DataError, DesignError
+from fdikit.errors import DataError, ParameterError
 from fdikit.multimodel.isolation import GroupThresholdLogic, mode_diagnosis, table_4_7_logic
 
 
@@ -82,9 +82,9 @@ def test_latch_and_hold_and_diagnosis():
 
 
 def test_bad_logic_and_data_raise():
-    with pytest.raises(DesignError, match="nominal model 7 is also listed"):
+    with pytest.raises(ParameterError, match="nominal model 7 is also listed"):
         GroupThresholdLogic(groups={"a": (0, 7)}, nominal=7)
-    with pytest.raises(DesignError, match="threshold"):
+    with pytest.raises(ParameterError, match="threshold"):
         GroupThresholdLogic(groups={"a": (0,)}, nominal=1, threshold=1.5)
     with pytest.raises(DataError, match="columns"):
         table_4_7_logic().signatures(np.ones((3, 5)) / 5)

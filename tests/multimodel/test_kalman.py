@@ -15,7 +15,7 @@ import scipy.stats
 from filterpy.kalman import ExtendedKalmanFilter as FpEKF
 from filterpy.kalman import KalmanFilter as FpKF
 
-from fdikit.errors import DataError, ModelError
+from fdikit.errors import DataError, ModelError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.multimodel.ekf import (
     ExtendedKalmanFilter,
@@ -228,7 +228,7 @@ def test_discrete_fault_model_input(case):
     np.testing.assert_array_equal(a.x_filt, b.x_filt)
     with pytest.raises(ModelError, match="discretize"):
         kalman_filter(fm.replace(dt=None), u, y, x0, P0, Q=model.Q, R=model.R)
-    with pytest.raises(ModelError, match="pass Q"):
+    with pytest.raises(ParameterError, match="pass Q"):
         kalman_filter(fm, u, y, x0, P0)
 
 
@@ -242,15 +242,15 @@ def test_bad_input_errors(case):
         LinearGaussianModel(model.A, model.C, Q=model.Q, R=np.zeros((2, 2)))
     with pytest.raises(ModelError, match="C has shape"):
         LinearGaussianModel(model.A, np.ones((2, 3)), Q=model.Q, R=model.R)
-    with pytest.raises(ModelError, match="P0 is not positive semi-definite"):
+    with pytest.raises(ParameterError, match="P0 is not positive semi-definite"):
         KalmanFilter(model, x0, -P0)
-    with pytest.raises(DataError, match="x0 has 3 entries"):
+    with pytest.raises(ParameterError, match="x0 has 3 entries"):
         KalmanFilter(model, x0[:3], P0)
     with pytest.raises(DataError, match="y must be an N x 2"):
         kalman_filter(model, u, y[:, :1], x0, P0)
     with pytest.raises(DataError, match="u must be an N x 2"):
         kalman_filter(model, u[:10], y, x0, P0)
-    with pytest.raises(ModelError, match="form must be"):
+    with pytest.raises(ParameterError, match="form must be"):
         KalmanFilter(model, x0, P0, form="information")
     with pytest.raises(ModelError, match="Q is not positive semi-definite"):
         NonlinearGaussianModel(f=lambda x, u: x, h=lambda x, u: x, Q=[[-1.0]], R=[[1.0]])

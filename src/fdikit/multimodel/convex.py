@@ -24,7 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from fdikit.errors import DataError, ModelError
+from fdikit import validate
+from fdikit.errors import DataError, ModelError, ParameterError
 from fdikit.multimodel.kalman_steps import _tria, psd_sqrt, srcf_step, srkf_predict, srkf_update
 from fdikit.multimodel.simplex import constrain_weights, project_to_simplex
 
@@ -90,7 +91,7 @@ class ConvexModelSet:
         return self.C.shape[1]
 
     def check_weights(self, mu) -> np.ndarray:
-        mu = np.asarray(mu, dtype=float).ravel()
+        mu = validate.as_array("weights", mu, error=DataError, finite=False).ravel()
         if mu.size != self.N or not np.all(np.isfinite(mu)):
             raise DataError(f"weights must be {self.N} finite numbers (one per model), got {mu.size}")
         return mu
@@ -224,8 +225,9 @@ def rls_weight_step(T_prev, xi_prev, Phi, Gamma, lam: float):
     >>> float(mu[0])
     0.5
     """
+    lam = validate.number("lam (the forgetting factor)", lam, finite=False)
     if not 0.0 < lam <= 1.0:
-        raise ModelError(f"forgetting factor lambda must be in (0, 1], got {lam}")
+        raise ParameterError(f"forgetting factor lam (lambda) must be in (0, 1], got {lam}")
     T_prev = np.asarray(T_prev, dtype=float)
     N = T_prev.shape[0]
     Phi = np.atleast_2d(np.asarray(Phi, dtype=float))
@@ -256,13 +258,16 @@ class ConvexFilterResult:
 
 
 def _check_data(models: ConvexModelSet, y, u):
-    y = np.asarray(y, dtype=float)
+    y = validate.as_array("y", y, error=DataError, finite=False)
     if y.ndim != 2 or y.shape[1] != models.p:
         raise DataError(f"y must be (K, {models.p}) measurements, got shape {y.shape}")
     K = y.shape[0]
     if u is None:
         u = np.zeros((K, models.m))
-    u = np.asarray(u, dtype=float).reshape(K, -1)
+    u = validate.as_array("u", u, error=DataError, finite=False)
+    if u.size != K * models.m:
+        raise DataError(f"u must be (K, {models.m}) inputs with K = {K} (as y), got shape {u.shape}")
+    u = u.reshape(K, -1)
     if u.shape[1] != models.m:
         raise DataError(f"u must be (K, {models.m}) inputs, got shape {u.shape}")
     if not (np.all(np.isfinite(y)) and np.all(np.isfinite(u))):
@@ -346,23 +351,34 @@ def dual_convex_filter(models: ConvexModelSet, y, u, x0, P0, mu0=None, lam: floa
     Neither form is stable on the §3.6 MSD (the f2·x2 scale of sensor 2 is weakly observable and, with no
     prior on the weights, drifts); the thesis uses the augmented EKF there.
     """
+    validate.instance("models", models, ConvexModelSet, "build the set with convex_model_set(...)")
     if form not in ("corrected", "thesis"):
-        raise ModelError(f"form must be 'corrected' or 'thesis' (Table 2.2 as printed), got {form!r}")
+        raise ParameterError(f"form must be 'corrected' or 'thesis' (Table 2.2 as printed), got {form!r}")
     metric = metric or ("information" if form == "corrected" else "identity")
     if metric not in ("information", "identity"):
-        raise ModelError(f"metric must be 'information' (W = T'T) or 'identity' (W = I), got {metric!r}")
+        raise ParameterError(f"metric must be 'information' (W = T'T) or 'identity' (W = I), got {metric!r}")
     write_back = (form == "corrected") if write_back is None else write_back
     if constrain not in (True, False, "simplex", "affine", "box"):
-        raise ModelError(f"constrain must be True/'simplex', 'affine', 'box' or False, got {constrain!r}")
+        raise ParameterError(f"constrain must be True/'simplex', 'affine', 'box' or False, got {constrain!r}")
+    validate.choice("ordering", ordering, ("michelot", "thesis"))
+    if weighting not in ("whitened", "inverse"):
+        raise ParameterError(f"weighting must be 'whitened' (Q^-1/2, R^-1/2) or 'inverse' (Q^-1, R^-1), "
+                             f"got {weighting!r}")
+    lam = validate.number("lam (the forgetting factor)", lam, finite=False)
+    if not 0.0 < lam <= 1.0:
+        raise ParameterError(f"forgetting factor lam (lambda) must be in (0, 1], got {lam}")
+    T0_scale = validate.positive("T0_scale", T0_scale)
+    if prior_std is not None:
+        prior_std = validate.positive("prior_std", prior_std)
+    if mu0 is not None:
+        validate.as_vector("mu0", mu0, models.N)
     if form == "thesis" and models.offset is not None:
         raise ModelError("the printed weight step (2.33) has no offset term; use form='corrected' for limit-value sets")
     y, u = _check_data(models, y, u)
     N, n = models.N, models.n
     mu = np.full(N, 1.0 / N) if mu0 is None else models.check_weights(mu0)
-    x_pred = np.asarray(x0, dtype=float).ravel()
-    if x_pred.size != n:
-        raise DataError(f"x0 must have {n} entries, got {x_pred.size}")
-    S_pred = psd_sqrt(P0, "P0")
+    x_pred = validate.as_vector("x0", x0, n)
+    S_pred = psd_sqrt(validate.as_covariance("P0", P0, n, scalar_ok=False), "P0")
     Q_sqrt, R_sqrt = psd_sqrt(models.Q, "Q"), np.linalg.cholesky(models.R)
     T, xi = T0_scale * np.eye(N), T0_scale * mu.copy()
     mu_prior = mu.copy()

@@ -17,7 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from fdikit.errors import DataError, ModelError
+from fdikit import validate
+from fdikit.errors import ParameterError
 from fdikit.multimodel.convex import (
     ConvexFilterResult,
     ConvexModelSet,
@@ -76,22 +77,29 @@ def augmented_ekf(models: ConvexModelSet, y, u, x0, P0, mu0=None, Q_mu=None, P_m
         correlated with and the filter keeps no variance along ``1ᵀμ``.  Negative weights are then zeroed by
         the same projection (active set, §2.3.2), leaving ``P`` unchanged for them.
     """
+    validate.instance("models", models, ConvexModelSet, "build the set with convex_model_set(...)")
     if projection not in ("euclidean", "covariance"):
-        raise ModelError(f"projection must be 'euclidean' (W = I) or 'covariance' (W = P^-1), got {projection!r}")
-    y, u = _check_data(models, y, u)
+        raise ParameterError(f"projection must be 'euclidean' (W = I) or 'covariance' (W = P^-1), got {projection!r}")
+    validate.choice("ordering", ordering, ("michelot", "thesis"))
+    if constrain not in (True, False, "simplex", "affine", "box"):
+        raise ParameterError(f"constrain must be True/'simplex', 'affine', 'box' or False, got {constrain!r}")
     N, n = models.N, models.n
-    mu = np.full(N, 1.0 / N) if mu0 is None else models.check_weights(mu0)
-    x = np.asarray(x0, dtype=float).ravel()
-    if x.size != n:
-        raise DataError(f"x0 must have {n} entries, got {x.size}")
+    if mu0 is not None:
+        validate.as_vector("mu0", mu0, N)
+    x = validate.as_vector("x0", x0, n)
     if Q_mu is None:
-        raise ModelError("give Q_mu, the (N x N) random-walk covariance of the weights (2.39), e.g. 1e-2 * I")
-    Q_mu = np.asarray(Q_mu, dtype=float)
-    P_mu0 = np.eye(N) / 12.0 if P_mu0 is None else np.asarray(P_mu0, dtype=float)
-    P0 = np.asarray(P0, dtype=float)
+        raise ParameterError("give Q_mu, the (N x N) random-walk covariance of the weights (2.39), e.g. 1e-2 * I")
+    Q_mu = validate.as_matrix("Q_mu", Q_mu)
+    P_mu0 = np.eye(N) / 12.0 if P_mu0 is None else validate.as_matrix("P_mu0", P_mu0)
+    P0 = validate.as_matrix("P0", P0)
     if Q_mu.shape != (N, N) or P_mu0.shape != (N, N) or P0.shape != (n, n):
-        raise ModelError(f"need Q_mu and P_mu0 of {N} x {N} and P0 of {n} x {n}; "
-                         f"got {Q_mu.shape}, {P_mu0.shape}, {P0.shape}")
+        raise ParameterError(f"need Q_mu and P_mu0 of {N} x {N} and P0 of {n} x {n}; "
+                             f"got {Q_mu.shape}, {P_mu0.shape}, {P0.shape}")
+    Q_mu = validate.as_covariance("Q_mu", Q_mu, N)
+    P_mu0 = validate.as_covariance("P_mu0", P_mu0, N)
+    P0 = validate.as_covariance("P0", P0, n)
+    y, u = _check_data(models, y, u)
+    mu = np.full(N, 1.0 / N) if mu0 is None else models.check_weights(mu0)
     Qa = np.zeros((n + N, n + N))
     Qa[:n, :n], Qa[n:, n:] = models.Q, Q_mu
     P = np.zeros((n + N, n + N))

@@ -22,6 +22,7 @@ import scipy.linalg
 import scipy.optimize
 import scipy.spatial
 
+from fdikit import validate
 from fdikit.errors import DesignError
 from fdikit.multimodel.model_set import _as_model_matrix, gap_rank
 
@@ -129,6 +130,11 @@ def cp_model_set(models, rank: int | None = None, min_gap: float = 10.0, n_verti
     DesignError
         If the samples are affinely degenerate (fewer than two distinct models).
     """
+    min_gap = validate.positive("min_gap", min_gap)
+    if rank is not None:
+        rank = validate.integer("rank", rank, minimum=1)
+    if n_vertices is not None:
+        n_vertices = validate.integer("n_vertices", n_vertices, minimum=1)
     M = _as_model_matrix(models)
     U, s, Vt = np.linalg.svd(M, full_matrices=False)
     n_g = gap_rank(s, min_gap) if rank is None else int(rank)
@@ -157,7 +163,8 @@ def cp_model_set(models, rank: int | None = None, min_gap: float = 10.0, n_verti
             hull_points = local
     n_h = d + 1 if n_vertices is None else int(n_vertices)
     if n_h < d + 1:
-        raise DesignError(f"n_vertices must be at least d + 1 = {d + 1} to enclose a {d}-dimensional set")
+        raise DesignError(f"n_vertices must be at least d + 1 = {d + 1} to enclose a {d}-dimensional set, "
+                          f"got {n_h}")
     if optimize or n_h > d + 1:
         V_opt, ok = fit_enclosing_polytope(hull_points, vertices_local, n_h)
         if n_h == d + 1:  # a simplex: barycentric coordinates, exact

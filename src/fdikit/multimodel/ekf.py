@@ -33,7 +33,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from fdikit.errors import DataError, ModelError
+from fdikit import validate
+from fdikit.errors import DataError, ModelError, ParameterError
 from fdikit.multimodel.kalman import KalmanResult, KalmanStep, _check_record, _collect
 from fdikit.multimodel.kalman_steps import _as_matrix, _as_vector, _check_psd, gaussian_log_likelihood
 
@@ -152,6 +153,12 @@ class NonlinearGaussianModel:
         object.__setattr__(self, "R", _check_psd("R", R))
         if not callable(self.f) or not callable(self.h):
             raise ModelError("f and h must be callables f(x, u) -> x_next, h(x, u) -> y")
+        object.__setattr__(self, "n_inputs", validate.integer("n_inputs", self.n_inputs, minimum=0, error=ModelError))
+        for nm in ("f_jacobian", "h_jacobian"):
+            if getattr(self, nm) is not None and not callable(getattr(self, nm)):
+                raise ModelError(
+                    f"{nm} must be a callable (x, u) -> matrix or None, got {type(getattr(self, nm)).__name__}"
+                )
         if np.linalg.eigvalsh(self.R)[0] <= 0:
             raise ModelError("R must be positive definite (the innovation covariance must be invertible)")
 
@@ -180,8 +187,8 @@ class ExtendedKalmanFilter:
         if not isinstance(model, NonlinearGaussianModel):
             raise ModelError(f"model must be a NonlinearGaussianModel, got {type(model).__name__}")
         self.model = model
-        self.x = _as_vector("x0", x0, model.n)
-        self.P = _check_psd("P0", _as_matrix("P0", P0, model.n, model.n))
+        self.x = _as_vector("x0", x0, model.n, error=ParameterError, finite=True)
+        self.P = _check_psd("P0", _as_matrix("P0", P0, model.n, model.n, error=ParameterError), error=ParameterError)
 
     def step(self, u, y) -> KalmanStep:
         """Update with ``y(k)`` (skipped if it has a NaN), then predict with ``u(k)``."""

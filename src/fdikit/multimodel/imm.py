@@ -28,9 +28,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fdikit.errors import DataError, ModelError
+from fdikit import validate
+from fdikit.errors import DataError, ModelError, ParameterError
 from fdikit.multimodel.isolation import GroupThresholdLogic, mode_diagnosis
 from fdikit.multimodel.kalman import LinearGaussianModel
+from fdikit.multimodel.kalman_steps import _check_psd
 from fdikit.trace import Trace
 
 __all__ = ["IMMFilter", "IMMStepper", "IMMStep", "IMMResult"]
@@ -128,27 +130,33 @@ class IMMFilter:
                     f"mode {md.name!r} has (n, m, p) = {(md.n, md.m, md.p)} but the first mode has {(n, m, p)}; "
                     "all modes must share the state, input and output dimensions (pad with zeros)"
                 )
-        Pi = np.atleast_2d(np.asarray(self.transition, dtype=float))
+        Pi = np.atleast_2d(validate.as_array("transition", self.transition, error=ModelError, finite=False))
+        if not np.all(np.isfinite(Pi)):
+            raise ModelError("transition matrix Π must be finite; every entry is a probability in [0, 1]")
         if Pi.shape != (M, M) or np.any(Pi < 0) or not np.allclose(Pi.sum(axis=1), 1.0, atol=1e-10):
             raise ModelError(
                 f"transition matrix Π must be ({M}, {M}), non-negative, with rows summing to 1 "
                 f"(Π[i, j] = P(s_k+1 = j | s_k = i)); got shape {Pi.shape}, row sums {np.round(Pi.sum(axis=1), 6)}"
             )
-        mu0 = np.full(M, 1.0 / M) if self.mu0 is None else np.asarray(self.mu0, dtype=float).ravel()
+        mu0 = np.full(M, 1.0 / M) if self.mu0 is None else validate.as_array("mu0", self.mu0).ravel()
         if mu0.shape != (M,) or np.any(mu0 < 0) or not np.isclose(mu0.sum(), 1.0):
-            raise ModelError(f"mu0 must be {M} non-negative probabilities summing to 1; got {mu0}")
-        x0 = np.zeros(n) if self.x0 is None else np.asarray(self.x0, dtype=float)
+            raise ParameterError(f"mu0 must be {M} non-negative probabilities that sum to 1; got {mu0}")
+        x0 = np.zeros(n) if self.x0 is None else validate.as_array("x0", self.x0)
         x0 = np.broadcast_to(x0, (M, n)).copy() if x0.shape in ((n,), (M, n)) else None
         if x0 is None:
-            raise ModelError(f"x0 must have shape ({n},) or ({M}, {n})")
-        P0 = np.eye(n) if self.P0 is None else np.asarray(self.P0, dtype=float)
+            raise ParameterError(f"x0 must have shape ({n},) or ({M}, {n})")
+        P0 = np.eye(n) if self.P0 is None else validate.as_array("P0", self.P0)
         P0 = np.broadcast_to(P0, (M, n, n)).copy() if P0.shape in ((n, n), (M, n, n)) else None
         if P0 is None:
-            raise ModelError(f"P0 must have shape ({n}, {n}) or ({M}, {n}, {n})")
-        if not 0 <= self.nominal < M:
-            raise ModelError(f"nominal = {self.nominal} is not a mode index in [0, {M})")
-        if not 0.0 <= self.min_probability < 1.0 / M:
-            raise ModelError(f"min_probability must lie in [0, 1/M) = [0, {1.0 / M:g})")
+            raise ParameterError(f"P0 must have shape ({n}, {n}) or ({M}, {n}, {n})")
+        for i in range(M):
+            _check_psd("P0" if M == 1 else f"P0[{i}]", P0[i], error=ParameterError)
+        nominal = validate.integer("nominal", self.nominal)
+        if not 0 <= nominal < M:
+            raise ParameterError(f"nominal = {nominal} is not a mode index in [0, {M})")
+        min_probability = validate.number("min_probability", self.min_probability)
+        if not 0.0 <= min_probability < 1.0 / M:
+            raise ParameterError(f"min_probability must lie in [0, 1/M) = [0, {1.0 / M:g}), got {min_probability}")
         names = tuple(md.name or f"mode{i}" for i, md in enumerate(modes))
         if len(set(names)) != M:
             raise ModelError(f"mode names must be unique; got {names}")
@@ -180,15 +188,21 @@ class IMMFilter:
         if isinstance(u, Trace):
             u, y, t = u.u, u.y, u.t
         md = self.modes[0]
-        u = np.asarray(u, dtype=float).reshape(-1, md.m) if md.m else np.zeros((np.shape(y)[0], 0))
-        y = np.asarray(y, dtype=float)
+        y = validate.as_array("y", y, error=DataError, finite=False)
         y = y.reshape(-1, 1) if y.ndim == 1 and md.p == 1 else y
+        if y.ndim != 2:
+            raise DataError(f"y must have shape (N, {md.p}), got shape {y.shape}")
         N = y.shape[0]
-        if y.shape != (N, md.p) or u.shape[0] != N:
+        u = validate.as_array("u", u, error=DataError, finite=False) if md.m else np.zeros((N, 0))
+        if md.m and u.size % md.m == 0 and u.ndim <= 2:
+            u = u.reshape(-1, md.m)
+        if y.shape != (N, md.p) or u.shape != (N, md.m):
             raise DataError(f"need y of shape (N, {md.p}) and u of shape (N, {md.m}); got {y.shape} and {u.shape}")
         if not np.all(np.isfinite(u)):
             raise DataError("inputs u contain NaN/inf; the IMM cannot predict without the input, clean u first")
-        t = np.arange(N, dtype=float) if t is None else np.asarray(t, dtype=float)
+        t = np.arange(N, dtype=float) if t is None else validate.as_array("t", t, error=DataError).ravel()
+        if t.shape != (N,):
+            raise DataError(f"t has {t.size} samples but y has {N}; give one time per sample")
         M, n = len(self.modes), md.n
         X = np.empty((N, n))
         P = np.empty((N, n, n)) if store_covariance else None

@@ -27,8 +27,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fdikit import validate
 from fdikit.diagnosis import UNKNOWN_FAULT, Diagnosis
-from fdikit.errors import DataError, DesignError
+from fdikit.errors import DataError, ParameterError
 from fdikit.faults import NO_FAULT
 
 __all__ = ["GroupThresholdLogic", "table_4_7_logic", "most_probable_mode", "mode_diagnosis"]
@@ -63,18 +64,29 @@ class GroupThresholdLogic:
     tol: float = 1e-12
 
     def __post_init__(self) -> None:
-        groups = {str(k): tuple(int(i) for i in v) for k, v in dict(self.groups).items()}
+        if not isinstance(self.groups, Mapping):
+            raise ParameterError(
+                f"groups must be a mapping fault name -> model indices, got {type(self.groups).__name__}"
+            )
+        groups = {str(k): tuple(validate.integer(f"model index of group {k!r}", i) for i in v)
+                  for k, v in dict(self.groups).items()}
+        object.__setattr__(self, "nominal", validate.integer("nominal", self.nominal))
+        object.__setattr__(self, "threshold", validate.number("threshold", self.threshold))
+        object.__setattr__(self, "tol", validate.non_negative("tol", self.tol))
         if not groups or any(len(v) == 0 for v in groups.values()):
-            raise DesignError("GroupThresholdLogic needs at least one fault group, each with at least one model index")
+            raise ParameterError(
+                "GroupThresholdLogic needs at least one fault group, each with at least one model index"
+            )
         if NO_FAULT in groups or UNKNOWN_FAULT in groups:
-            raise DesignError(f"fault group names {NO_FAULT!r} and {UNKNOWN_FAULT!r} are reserved; rename the group")
+            raise ParameterError(f"fault group names {NO_FAULT!r} and {UNKNOWN_FAULT!r} are reserved; rename the group")
         members = [i for v in groups.values() for i in v]
         if min(members + [self.nominal]) < 0:
-            raise DesignError("model indices of GroupThresholdLogic are 0-based and must be non-negative")
+            raise ParameterError("model indices of GroupThresholdLogic are 0-based and must be non-negative, got index "
+                                 f"{min(members + [self.nominal])} (-1 is not allowed)")
         if self.nominal in members:
-            raise DesignError(f"the nominal model {self.nominal} is also listed in a fault group; remove it there")
+            raise ParameterError(f"the nominal model {self.nominal} is also listed in a fault group; remove it there")
         if not 0.0 < self.threshold < 1.0:
-            raise DesignError(f"threshold T_f = {self.threshold} must lie in (0, 1) (Table 4.7 uses 0.2)")
+            raise ParameterError(f"threshold T_f = {self.threshold} must lie in (0, 1) (Table 4.7 uses 0.2)")
         object.__setattr__(self, "groups", groups)
 
     @property
@@ -88,7 +100,9 @@ class GroupThresholdLogic:
         return 1 + max([self.nominal, *(i for v in self.groups.values() for i in v)])
 
     def _mu(self, mu) -> np.ndarray:
-        mu = np.atleast_2d(np.asarray(mu, dtype=float))
+        mu = np.atleast_2d(validate.as_array("mu (model weights)", mu, error=DataError, finite=False))
+        if mu.ndim != 2:
+            raise DataError(f"mu (model weights) must be an N x models array, got shape {mu.shape}")
         if mu.shape[1] < self.n_models:
             raise DataError(
                 f"model weights have {mu.shape[1]} columns but the logic refers to model index {self.n_models - 1}; "

@@ -28,7 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fdikit.errors import DataError, ModelError
+from fdikit import validate
+from fdikit.errors import DataError, ModelError, ParameterError
 from fdikit.lti import dlsim_blocked
 from fdikit.model import FaultModel
 from fdikit.multimodel.kalman_steps import (
@@ -158,13 +159,13 @@ class KalmanResult:
 def _as_model(model, Q=None, R=None) -> LinearGaussianModel:
     if isinstance(model, LinearGaussianModel):
         if Q is not None or R is not None:
-            raise ModelError("Q and R are already in the LinearGaussianModel; do not pass them again")
+            raise ParameterError("Q and R are already in the LinearGaussianModel; do not pass them again")
         return model
     if isinstance(model, FaultModel):
         if Q is None or R is None:
-            raise ModelError("a FaultModel carries no noise covariances; pass Q (n x n) and R (p x p)")
+            raise ParameterError("a FaultModel carries no noise covariances; pass Q (n x n) and R (p x p)")
         return LinearGaussianModel.from_fault_model(model, Q, R)
-    raise ModelError(f"model must be a LinearGaussianModel or a discrete FaultModel, got {type(model).__name__}")
+    raise ParameterError(f"model must be a LinearGaussianModel or a discrete FaultModel, got {type(model).__name__}")
 
 
 class KalmanFilter:
@@ -190,12 +191,12 @@ class KalmanFilter:
 
     def __init__(self, model, x0, P0, *, form: str = "covariance", Q=None, R=None) -> None:
         if form not in ("covariance", "square_root"):
-            raise ModelError(f"form must be 'covariance' or 'square_root', got {form!r}")
+            raise ParameterError(f"form must be 'covariance' or 'square_root', got {form!r}")
         self.model = _as_model(model, Q, R)
         n = self.model.n
         self.form = form
-        self.x = _as_vector("x0", x0, n)
-        P0 = _check_psd("P0", _as_matrix("P0", P0, n, n))
+        self.x = _as_vector("x0", x0, n, error=ParameterError, finite=True)
+        P0 = _check_psd("P0", _as_matrix("P0", P0, n, n, error=ParameterError), error=ParameterError)
         self.P = P0
         self._S = psd_sqrt(P0, "P0")
         self._Qs = psd_sqrt(self.model.Q, "Q")
@@ -273,7 +274,7 @@ class KalmanFilter:
 
 
 def _check_record(u, y, m: int, p: int) -> tuple[np.ndarray, np.ndarray]:
-    y = np.asarray(y, dtype=float)
+    y = validate.as_array("y", y, error=DataError, finite=False)
     if y.ndim == 1 and p == 1:
         y = y.reshape(-1, 1)
     if y.ndim != 2 or y.shape[1] != p:
@@ -281,7 +282,7 @@ def _check_record(u, y, m: int, p: int) -> tuple[np.ndarray, np.ndarray]:
     N = y.shape[0]
     if u is None:
         u = np.zeros((N, m))
-    u = np.asarray(u, dtype=float)
+    u = validate.as_array("u", u, error=DataError, finite=False)
     if u.ndim == 1 and m == 1:
         u = u.reshape(-1, 1)
     if u.ndim != 2 or u.shape != (N, m):

@@ -31,6 +31,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg
 
+from fdikit import validate
 from fdikit.errors import DataError, ModelError
 
 __all__ = ["kf_predict", "kf_update", "srkf_predict", "srkf_update", "srcf_step", "psd_sqrt", "gaussian_log_likelihood"]
@@ -39,38 +40,39 @@ _LOG_2PI = float(np.log(2.0 * np.pi))
 
 
 # ---------------------------------------------------------------------------------------- helpers
-def _as_matrix(name: str, value, rows: int | None = None, cols: int | None = None) -> np.ndarray:
-    out = np.atleast_2d(np.asarray(value, dtype=float))
+def _as_matrix(name: str, value, rows: int | None = None, cols: int | None = None, *,
+               error: type[Exception] = ModelError) -> np.ndarray:
+    out = np.atleast_2d(validate.as_array(name, value, error=error, finite=False))
     if out.ndim != 2:
-        raise ModelError(f"{name} must be a 2-D matrix, got an array with {out.ndim} dimensions")
+        raise error(f"{name} must be a 2-D matrix, got an array with {out.ndim} dimensions")
     if rows is not None and out.shape[0] != rows:
-        raise ModelError(f"{name} has shape {out.shape} but must have {rows} rows; give a {rows} x {cols} matrix")
+        raise error(f"{name} has shape {out.shape} but must have {rows} rows; give a {rows} x {cols} matrix")
     if cols is not None and out.shape[1] != cols:
-        raise ModelError(f"{name} has shape {out.shape} but must have {cols} columns; give a {rows} x {cols} matrix")
+        raise error(f"{name} has shape {out.shape} but must have {cols} columns; give a {rows} x {cols} matrix")
     if not np.all(np.isfinite(out)):
-        raise ModelError(f"{name} has a non-finite entry; every entry must be a finite number")
+        raise error(f"{name} has a non-finite entry; every entry must be a finite number")
     return out
 
 
-def _as_vector(name: str, value, size: int) -> np.ndarray:
-    out = np.asarray(value, dtype=float).reshape(-1)
+def _as_vector(name: str, value, size: int, *, error: type[Exception] = DataError, finite: bool = False) -> np.ndarray:
+    out = validate.as_array(name, value, error=error, finite=finite).reshape(-1)
     if out.size != size:
-        raise DataError(f"{name} has {out.size} entries but must have {size}; pass a vector of length {size}")
+        raise error(f"{name} has {out.size} entries but must have {size}; pass a vector of length {size}")
     return out
 
 
-def _check_psd(name: str, M: np.ndarray) -> np.ndarray:
+def _check_psd(name: str, M: np.ndarray, *, error: type[Exception] = ModelError) -> np.ndarray:
     """Symmetric part of ``M`` after checking symmetry and positive semi-definiteness."""
     scale = max(1.0, float(np.max(np.abs(M)))) if M.size else 1.0
     if M.shape[0] != M.shape[1]:
-        raise ModelError(f"{name} must be square, got shape {M.shape}")
+        raise error(f"{name} must be square, got shape {M.shape}")
     if np.max(np.abs(M - M.T), initial=0.0) > 1e-8 * scale:
-        raise ModelError(f"{name} is not symmetric; pass a symmetric covariance matrix (e.g. (M + M.T) / 2)")
+        raise error(f"{name} is not symmetric; pass a symmetric covariance matrix (e.g. (M + M.T) / 2)")
     Ms = 0.5 * (M + M.T)
     if M.size:
         lam = float(np.linalg.eigvalsh(Ms)[0])
         if lam < -1e-10 * scale:
-            raise ModelError(
+            raise error(
                 f"{name} is not positive semi-definite (smallest eigenvalue {lam:.3g}); "
                 "a covariance matrix must have non-negative eigenvalues"
             )
