@@ -11,6 +11,12 @@ App. A), Hallouzi 2008 Ch. 4 (lock-in-place, loss of effectiveness) and the
 usual taxonomy of Simulink Fault Analyzer (bias, drift, stuck, scale factor,
 noise, intermittent).
 
+Every number of a fault (onset, end, size) must be finite (a :class:`~fdikit.errors.ParameterError`
+otherwise), and a fault never changes a sample before its onset.  A fault reads from and writes
+to a spec string, ``kind:target[:value][@onset[-end]][#sensor|#actuator]`` (the CLI's
+``--fault``): :func:`parse_fault` and :func:`format_fault`, with
+``parse_fault(format_fault(f)) == f``.
+
 Examples
 --------
 >>> from fdikit.faults import Bias, FaultScenario

@@ -10,6 +10,20 @@ reads a frozen, noise-free value).
 Parameter-varying plants (a family ``ρ -> discrete FaultModel`` and a measured schedule ρ)
 are simulated by :func:`simulate_scheduled` with ρ frozen over each sample, the "complete
 discretisation" of van der Ploeg 2018, Sec. 4-3-4; faults act as in :func:`simulate`.
+
+What the simulators promise (issue 12):
+
+* every argument is checked before any work: bad arguments (duration, dt, x0, noise levels,
+  seeds, options, fault targets) raise :class:`~fdikit.errors.ParameterError`, bad signal data
+  (u, d, t, the schedule) :class:`~fdikit.errors.DataError`;
+* a run whose arrays would not fit in the available memory (``MemAvailable`` of
+  ``/proc/meminfo``, else ``os.sysconf``) is refused at once, with the bytes it needs;
+* no trace is non-finite: a run that overflows raises a DataError naming the first bad sample
+  (index and time), the signal and the likely cause (the unstable eigenvalue, Re λ > 0 or
+  |λ| > 1, or an input or fault size too large for the float range);
+* a fault changes no sample before its onset (bit for bit, against the fault-free run with the
+  same seed), a fault that acts on no sample gives an :class:`~fdikit.errors.FdiWarning`, and the
+  same seed gives the same trace, bit for bit.
 """
 
 from __future__ import annotations
@@ -694,6 +708,17 @@ def simulate_scheduled(
         Initial state (default zero).
     rng : numpy.random.Generator or int seed
         Source of random fault signals.
+
+    Raises
+    ------
+    ParameterError
+        For a family that is not callable, a bad ``schedule_name``, ``x0`` or seed, an unknown
+        fault target, or a run that would not fit in memory.
+    DataError
+        For a schedule that is not 2+ finite numbers, bad ``u`` / ``d``, or a run that would
+        return non-finite samples (the message names the most unstable frozen model ``A(ρ)``).
+    ModelError
+        When ``family`` does not return matching discrete FaultModels.
 
     Examples
     --------
