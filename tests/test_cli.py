@@ -28,6 +28,18 @@ def test_simulate_single_track_param(tmp_path):
     assert Trace.load(out).outputs == ("yaw_rate", "lateral_error", "heading_error")
 
 
+def test_simulate_text_param_and_atomic_overwrite(tmp_path):
+    """A parameter annotated ``str`` is passed as text; a refused run leaves an existing trace intact."""
+    out = tmp_path / "t.parquet"
+    res = runner.invoke(app, ["simulate", "path14", "-p", "tiny=midpoint", "--duration", "1", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    before = out.read_bytes()
+    res = runner.invoke(app, ["simulate", "path14", "-p", "tiny=midpoint", "--duration", "1", "--dt", "nan",
+                              "--out", str(out)])
+    assert res.exit_code == 2 and "dt (--dt)" in res.output
+    assert out.read_bytes() == before and [p.name for p in tmp_path.iterdir()] == ["t.parquet"]
+
+
 def test_simulate_bad_input():
     res = runner.invoke(app, ["simulate", "path12", "-f", "bias:nope:1@1"])
     assert res.exit_code == 2 and "no signal named 'nope'" in res.output
@@ -61,7 +73,8 @@ def test_demo_kalman(tmp_path):
 
 
 def test_help_everywhere():
-    for cmd in ([], ["demo"], ["simulate"], ["plants"]):
+    for cmd in ([], ["demo"], ["simulate"], ["plants"], ["compare-evaluators"], ["target-tracking"],
+                ["multiple-model"]):
         res = runner.invoke(app, [*cmd, "--help"])
         assert res.exit_code == 0 and "Usage" in res.output
 

@@ -46,3 +46,37 @@ def test_compare_matches_direct_scoring(tmp_path):
     assert "| loose | 4 |" in c.to_markdown()
     with pytest.raises(DataError):
         compare_evaluators({}, runs)
+
+
+def test_scores_csv_is_not_truncated_when_scoring_fails(tmp_path):
+    """The CSV is written atomically once every run is scored: a failure mid-way leaves the old file intact."""
+    out = tmp_path / "scores.csv"
+    out.write_text("earlier results\n")
+
+    class Broken:
+        calls = 0
+
+        def run(self, residuals):
+            Broken.calls += 1
+            if Broken.calls == 2:
+                raise RuntimeError("killed")
+            return ThresholdEvaluator(thresholds=[2.0, 2.0]).run(residuals)
+
+    with pytest.raises(RuntimeError):
+        compare_evaluators({"broken": Broken()}, [_run(0, None), _run(1, 0)], scores_csv=out)
+    assert out.read_text() == "earlier results\n"
+    assert [p.name for p in tmp_path.iterdir()] == ["scores.csv"]  # no temporary file left
+
+
+def test_path_comparison_test_runs_are_those_of_path_runs():
+    """The resumable comparison simulates each test run on its own, exactly as path_runs does in one go."""
+    from fdikit.monitors.path_bank import path_bank, path_runs
+    from fdikit.monitors.path_compare import _test_run, _test_specs
+
+    full = path_runs(path_bank(), runs_per_fault=1, healthy_runs=1, onset=5.0, seed=12)
+    specs = _test_specs(1, 1, 12)
+    assert len(specs) == len(full) == 16
+    for k in (0, 1, 9, 15):
+        trace, res = _test_run(specs[k], 1e-4)
+        assert np.array_equal(trace.y, full[k][0].y) and np.array_equal(trace.fault, full[k][0].fault)
+        assert np.array_equal(res.r, full[k][1].r, equal_nan=True) and res.names == full[k][1].names
