@@ -30,7 +30,7 @@ class StepDecision:
 
     ``fired`` are the per-residual (or per-hypothesis) decisions, ``probabilities`` the
     per-hypothesis probabilities when the evaluator has them, ``valid`` False when the
-    sample was bad and the previous decision was held.
+    sample was bad or passed with ``valid=False`` (recovering) and the previous decision was held.
     """
 
     alarm: bool
@@ -55,7 +55,9 @@ class Diagnosis:
     alarms : the rising edges of ``alarm``.
     probabilities : (N, H) per-hypothesis probabilities, or None.
     hypotheses : names of the columns of ``probabilities``.
-    valid : (N,) bool, False where the input sample was bad (decision held).
+    valid : (N,) bool, False where the evaluator did not use the sample — a NaN/inf residual (a gap) or
+        a residual marked not valid (``Residuals.valid``: e.g. recovering after a gap) — and held the
+        previous decision.
     """
 
     t: np.ndarray
