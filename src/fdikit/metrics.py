@@ -22,8 +22,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fdikit import validate
 from fdikit.diagnosis import UNKNOWN_FAULT, Diagnosis
-from fdikit.errors import DataError
+from fdikit.errors import DataError, ParameterError
 from fdikit.faults import NO_FAULT
 from fdikit.trace import Trace
 
@@ -62,7 +63,18 @@ class Score:
 
 def score(truth: Trace | np.ndarray, diagnosis: Diagnosis) -> Score:
     """Score one diagnosis against a trace (or its per-sample truth labels)."""
-    labels = truth.fault if isinstance(truth, Trace) else np.asarray(truth, dtype=str)
+    validate.instance("diagnosis", diagnosis, Diagnosis, "pass the Diagnosis an evaluator's run() returned")
+    if isinstance(truth, Trace):
+        labels = truth.fault
+    else:
+        raw = np.asarray(truth)
+        if raw.dtype.kind not in "UO":
+            raise DataError(f"truth must be per-sample fault labels (strings) or a Trace, got an array of {raw.dtype}")
+        if raw.dtype.kind == "O" and not all(isinstance(v, str) for v in raw.ravel()):
+            raise DataError("truth labels must all be strings (e.g. 'none'); found a non-string label such as None")
+        labels = raw.astype(str)
+    if labels.ndim != 1:
+        raise DataError(f"truth must be a 1-D array of per-sample labels, got shape {labels.shape}")
     t = diagnosis.t
     if labels.shape != t.shape:
         raise DataError(f"truth has {labels.size} samples but the diagnosis {t.size}; score the trace it was run on")
@@ -113,11 +125,25 @@ class Summary:
         return d
 
 
+def _scores(scores) -> list[Score]:
+    """The scores as a non-empty list of :class:`Score` (DataError if empty, ParameterError if not scores)."""
+    try:
+        scores = list(scores)
+    except TypeError:
+        raise ParameterError(f"scores must be an iterable of Score, got {type(scores).__name__}") from None
+    if not scores:
+        raise DataError("no scores to summarise; score at least one trace")
+    bad = next((s for s in scores if not isinstance(s, Score)), None)
+    if bad is not None:
+        raise ParameterError(f"scores must be Score objects (from metrics.score), got a {type(bad).__name__}")
+    return scores
+
+
 def confusion_matrix(scores: Iterable[Score]):
     """Counts of true label (rows) vs outcome (columns: isolated fault, ``'unknown'``, ``'missed'``, ``'none'``)."""
     import pandas as pd
 
-    scores = list(scores)
+    scores = _scores(scores)
     rows = sorted({s.label for s in scores})
     cols = sorted({s.outcome for s in scores} | set(rows))
     df = pd.DataFrame(0, index=pd.Index(rows, name="true"), columns=pd.Index(cols, name="diagnosed"))
@@ -128,9 +154,7 @@ def confusion_matrix(scores: Iterable[Score]):
 
 def summarize(scores: Iterable[Score]) -> Summary:
     """Rates and means over traces; the false-alarm rate pools fault-free time over all runs."""
-    scores = list(scores)
-    if not scores:
-        raise DataError("no scores to summarise")
+    scores = _scores(scores)
     faulty = [s for s in scores if s.label != NO_FAULT]
     delays = np.array([s.detection_delay for s in faulty if s.detected], dtype=float)
     hours = sum(s.fault_free_hours for s in scores)
@@ -160,14 +184,16 @@ def vaf(reference, estimate):
     Raises
     ------
     DataError
-        If the shapes differ, there are fewer than 2 samples, or a reference column is constant.
+        If the shapes differ, there are fewer than 2 samples, a value is not a finite number, or a
+        reference column is constant.
 
     Examples
     --------
     >>> float(vaf([0.0, 1.0, 2.0, 3.0], [0.0, 1.0, 2.0, 4.0]))
     85.0
     """
-    y, yh = np.asarray(reference, dtype=float), np.asarray(estimate, dtype=float)
+    y = validate.as_array("reference", reference, error=DataError)
+    yh = validate.as_array("estimate", estimate, error=DataError)
     if y.shape != yh.shape or y.ndim == 0 or y.shape[0] < 2:
         raise DataError(f"vaf needs two equally long signals of 2+ samples, got shapes {y.shape} and {yh.shape}")
     y2, e2 = y.reshape(y.shape[0], -1), (y - yh).reshape(y.shape[0], -1)

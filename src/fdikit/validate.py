@@ -24,9 +24,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from fdikit.errors import ParameterError
+from fdikit.errors import ModelError, ParameterError
 
 __all__ = [
+    "ModelArgumentError",
     "as_array",
     "as_matrix",
     "as_square",
@@ -41,6 +42,15 @@ __all__ = [
     "choice",
     "instance",
 ]
+
+
+class ModelArgumentError(ParameterError, ModelError):
+    """A bad argument of a model method (e.g. the ``dt`` of :meth:`FaultModel.discretize`).
+
+    A :class:`~fdikit.errors.ParameterError` (the class for bad arguments); also a
+    :class:`~fdikit.errors.ModelError`, which these methods raised before, so existing
+    ``except ModelError`` code keeps working.
+    """
 
 
 def _show(value) -> str:

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from fdikit.errors import ModelError
+from fdikit.errors import ParameterError
 from fdikit.plants.b747 import B747_FAULT_SCHEDULE, B747_MODEL_NAMES, B747_TRANSITION, b747_longitudinal, b747_model_set
 
 
@@ -64,7 +64,7 @@ def test_zoh_discretisation_and_observability():
 
 
 def test_bad_names():
-    with pytest.raises(ModelError, match="nominal"):
+    with pytest.raises(ParameterError, match="nominal"):
         b747_longitudinal("rudder")
-    with pytest.raises(ModelError, match="corrected"):
+    with pytest.raises(ParameterError, match="corrected"):
         b747_longitudinal(a35="6.83e-5")

@@ -9,7 +9,7 @@ import pytest
 import scipy.linalg
 
 from fdikit import linalg
-from fdikit.errors import ModelError
+from fdikit.errors import ParameterError
 from fdikit.plants.f16xl import F16XL_A, F16XL_DRYDEN_GAIN, f16xl_gust, f16xl_longitudinal
 
 
@@ -78,5 +78,5 @@ def test_noise_channels_and_options():
     np.testing.assert_array_equal(m.Dw[:, 1:], np.diag([0.02, 0.143, 0.245, 0.245]))
     assert not np.any(m.Dw[:, 0]) and not np.any(m.Bw[:, 1:]) and m.Bw[4, 0] == 1.57
     assert m.C[2, 1] == 1.0517 and f16xl_gust().C[2, 1] == -1.0517
-    with pytest.raises(ModelError, match="pitch_rate_noise"):
+    with pytest.raises(ParameterError, match="pitch_rate_noise"):
         f16xl_gust(pitch_rate_noise=-0.01)

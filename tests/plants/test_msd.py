@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fdikit.errors import ModelError
+from fdikit.errors import ParameterError
 from fdikit.multimodel.model_set import vectorize
 from fdikit.plants.msd import msd, msd_matrices, msd_model_vectors, msd_parameter_grid
 
@@ -54,9 +54,9 @@ def test_grid_and_model_vectors():
 
 
 def test_bad_parameters():
-    with pytest.raises(ModelError, match="outside its range"):
+    with pytest.raises(ParameterError, match="outside its range"):
         msd_matrices(k1=2.0)
-    with pytest.raises(ModelError, match="positive"):
+    with pytest.raises(ParameterError, match="positive"):
         msd_matrices(m3=-1.0, allow_outside=True)
-    with pytest.raises(ModelError, match="dt"):
+    with pytest.raises(ParameterError, match="dt"):
         msd(dt=0.0)

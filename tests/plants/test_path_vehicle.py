@@ -187,9 +187,9 @@ def test_rounding_intervals_encode_the_print_format():
 
 
 def test_rounding_intervals_rejects_unknown_order():
-    from fdikit.errors import ModelError
+    from fdikit.errors import ParameterError
 
-    with pytest.raises(ModelError, match="12 or 14"):
+    with pytest.raises(ParameterError, match="12 or 14"):
         rounding_intervals(13)
 
 

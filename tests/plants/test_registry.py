@@ -7,7 +7,7 @@ import pytest
 
 import fdikit.plants as plants
 from fdikit import FaultModel
-from fdikit.errors import ModelError
+from fdikit.errors import ParameterError
 from fdikit.plants import PLANTS, get_plant, path_vehicle_12, path_vehicle_14, single_track
 
 
@@ -28,7 +28,7 @@ def test_get_plant_builds_models():
 
 
 def test_unknown_plant_names_the_known_ones():
-    with pytest.raises(ModelError) as info:
+    with pytest.raises(ParameterError) as info:
         get_plant("path13")
     message = str(info.value)
     assert "path13" in message
@@ -37,9 +37,9 @@ def test_unknown_plant_names_the_known_ones():
 
 
 def test_bad_parameters_for_a_known_plant():
-    with pytest.raises(ModelError, match="path12"):
+    with pytest.raises(ParameterError, match="path12"):
         get_plant("path12", speed=20.0)
-    with pytest.raises(ModelError, match="single-track"):
+    with pytest.raises(ParameterError, match="single-track"):
         get_plant("single-track")  # speed is required
 
 

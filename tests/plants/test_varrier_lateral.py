@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from fdikit.design.lpv import LPVModel
-from fdikit.errors import ModelError
+from fdikit.errors import ModelError, ParameterError
 from fdikit.plants.varrier_lateral import (
     RHO_STAR,
     SCENIC,
@@ -126,16 +126,16 @@ def test_uncertainty_readings():
     np.testing.assert_array_equal(lit.C[0], np.zeros((2, 2)))
     cont = varrier_uncertainty(mode="continuous")
     np.testing.assert_allclose(cont.A[0], 0.2 * 0.02 * varrier_lateral_continuous(1 / 0.048).A, rtol=1e-12)
-    with pytest.raises(ModelError, match="literal"):
+    with pytest.raises(ParameterError, match="literal"):
         varrier_uncertainty(mode="physical")
 
 
 def test_bad_input_is_refused():
-    with pytest.raises(ModelError, match="positive"):
+    with pytest.raises(ParameterError, match="positive"):
         varrier_lateral(0.0)
-    with pytest.raises(ModelError, match="positive"):
+    with pytest.raises(ParameterError, match="positive"):
         rho_from_speed([10.0, -1.0])
-    with pytest.raises(ModelError, match="dt"):
+    with pytest.raises(ParameterError, match="dt"):
         varrier_lateral_lpv(dt=0.0)
     assert rho_from_speed(20.0) == 0.05
     np.testing.assert_array_equal(rho_from_speed([10.0, 20.0]), [0.1, 0.05])

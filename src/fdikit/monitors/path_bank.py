@@ -33,12 +33,14 @@ assumption, documented here and in ``docs/methods/beard_jones.md``):
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
 
+from fdikit import validate
 from fdikit.design.beard_jones import BeardJonesDesign, beard_jones, resolve_faults
-from fdikit.errors import DesignError
+from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel, actuator_fault_name, sensor_fault_name
 from fdikit.plants.path_vehicle import OUTPUTS, path_vehicle_12, path_vehicle_14
 from fdikit.residuals import ResidualGenerator, stack_generators
@@ -100,6 +102,8 @@ def nominal_fault_sizes() -> dict[str, float]:
 
 def path_fault_model(n_states: int = 14) -> FaultModel:
     """The App. D model (``tiny='midpoint'``) with all 15 faults as inputs: 12 sensors, 3 actuators."""
+    if isinstance(n_states, bool) or n_states not in (12, 14):
+        raise ParameterError(f"n_states must be 12 or 14 (the PATH App. D models), got {n_states!r}")
     m = (path_vehicle_14 if n_states == 14 else path_vehicle_12)("midpoint")
     if n_states == 14:
         m = m.with_actuator_faults(m.controls)
@@ -142,7 +146,19 @@ def path_bank(dt: float | None = None, eigenvalues: dict | None = None) -> PathB
     ------
     DesignError
         When a filter cannot be designed (the message names the filter).
+    ParameterError
+        For a bad ``dt`` or ``eigenvalues`` that name no filter of :data:`FILTER_GROUPS`.
     """
+    if dt is not None:
+        dt = validate.positive("dt", dt)
+    if eigenvalues is not None:
+        if not isinstance(eigenvalues, Mapping):
+            raise ParameterError(f"eigenvalues must be a dict filter name -> (sets, complement), got "
+                                 f"{type(eigenvalues).__name__}")
+        unknown = sorted(set(eigenvalues) - set(FILTER_GROUPS))
+        if unknown:
+            raise ParameterError(f"eigenvalues given for unknown filter(s) {unknown}; the filters are "
+                                 f"{list(FILTER_GROUPS)}")
     eig = dict(EIGENVALUES, **(eigenvalues or {}))
     nominal = nominal_fault_sizes()
     designs, gens, groups, scales = {}, [], [], {}
@@ -212,6 +228,15 @@ def path_runs(
     from fdikit.faults import Bias, FaultScenario
     from fdikit.simulate import simulate
 
+    validate.instance("bank", bank, PathBank, "design it with path_bank()")
+    validate.integer("runs_per_fault", runs_per_fault, minimum=0)
+    validate.integer("healthy_runs", healthy_runs, minimum=0)
+    validate.integer("seed", seed, minimum=0)
+    duration = validate.positive("duration", duration)
+    onset = validate.non_negative("onset", onset)
+    size = validate.number("size", size)
+    noise_fraction = validate.non_negative("noise_fraction", noise_fraction)
+    dt = validate.positive("dt", dt)
     plant = path_fault_model(14).discretize(dt)
     gen = bank.generator.discretize(dt)
     noise = noise_fraction * np.array([bank.nominal[sensor_fault_name(o)] for o in plant.outputs])

@@ -30,7 +30,7 @@ from __future__ import annotations
 import inspect
 from collections.abc import Callable
 
-from fdikit.errors import ModelError
+from fdikit.errors import ParameterError
 from fdikit.model import FaultModel
 from fdikit.plants.b747 import b747_longitudinal, b747_model_set
 from fdikit.plants.f16xl import F16XL_DRYDEN_GAIN, f16xl_gust, f16xl_longitudinal
@@ -122,16 +122,16 @@ def get_plant(name: str, **params) -> FaultModel:
 
     Raises
     ------
-    ModelError
+    ParameterError
         If ``name`` is not a known plant, or the parameters do not fit its constructor.
     """
     try:
         factory = PLANTS[name]
     except (KeyError, TypeError):
-        raise ModelError(f"unknown plant {name!r}; known plants: {', '.join(sorted(PLANTS))}") from None
+        raise ParameterError(f"unknown plant {name!r}; known plants: {', '.join(sorted(PLANTS))}") from None
     signature = inspect.signature(factory)
     try:
         signature.bind(**params)
     except TypeError as exc:
-        raise ModelError(f"bad parameters for plant {name!r}: {exc}; its signature is {name}{signature}") from None
+        raise ParameterError(f"bad parameters for plant {name!r}: {exc}; its signature is {name}{signature}") from None
     return factory(**params)

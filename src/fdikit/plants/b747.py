@@ -21,7 +21,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from fdikit.errors import ModelError
+from fdikit import validate
+from fdikit.errors import ParameterError
 from fdikit.model import FaultModel
 
 __all__ = [
@@ -64,8 +65,8 @@ _A35 = {"corrected": 6.83e-7, "printed": 6.83e-1}
 
 
 def _matrices(a35: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    if a35 not in _A35:
-        raise ModelError(f"a35 must be 'corrected' (6.83e-7) or 'printed' (6.83e-1), got {a35!r}")
+    if not isinstance(a35, str) or a35 not in _A35:
+        raise ParameterError(f"a35 must be 'corrected' (6.83e-7) or 'printed' (6.83e-1), got {a35!r}")
     A = np.array([
         [-5.91e-1, -1.56e-4, -1.36, 0.0, -1.23e-6],
         [-1.47e-1, -8.72e-3, 4.83, -9.81, 5.31e-5],
@@ -102,8 +103,10 @@ def b747_longitudinal(model: str = "nominal", a35: str = "corrected", dt: float 
     >>> m.C[2].tolist()
     [0.0, 0.0, 0.0, 0.0, 0.0]
     """
-    if model not in B747_MODEL_NAMES:
-        raise ModelError(f"unknown B747 model {model!r}; choose one of {', '.join(B747_MODEL_NAMES)}")
+    if dt is not None:
+        dt = validate.positive("dt", dt)
+    if not isinstance(model, str) or model not in B747_MODEL_NAMES:
+        raise ParameterError(f"unknown B747 model {model!r}; choose one of {', '.join(B747_MODEL_NAMES)}")
     A, B, C = _matrices(a35)
     if model == "delta_c_loss":
         B[:, 0] = 0.0
@@ -119,4 +122,6 @@ def b747_longitudinal(model: str = "nominal", a35: str = "corrected", dt: float 
 
 def b747_model_set(a35: str = "corrected", dt: float | None = 0.01) -> tuple[FaultModel, ...]:
     """The five models of Table 2.5 in order (ZOH at ``dt = 0.01`` s by default, §2.4.1)."""
+    if dt is not None:
+        dt = validate.positive("dt", dt)
     return tuple(b747_longitudinal(name, a35=a35, dt=dt) for name in B747_MODEL_NAMES)

@@ -15,7 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from fdikit.errors import ModelError
+from fdikit import validate
+from fdikit.errors import ParameterError
 from fdikit.model import FaultModel
 
 __all__ = ["f16xl_longitudinal", "F16XL_A", "f16xl_gust", "F16XL_DRYDEN_GAIN", "F16XL_GUST_POLE"]
@@ -111,8 +112,11 @@ def f16xl_gust(
     >>> m.n, m.outputs, m.noise[0]
     (5, ('y_q', 'y_alpha', 'y_Az', 'y_Ax'), 'wind')
     """
+    gust_gain = validate.number("gust_gain", gust_gain)
+    az_w_coefficient = validate.number("az_w_coefficient", az_w_coefficient)
+    pitch_rate_noise = validate.number("pitch_rate_noise", pitch_rate_noise, finite=False)
     if not (np.isfinite(pitch_rate_noise) and pitch_rate_noise >= 0):
-        raise ModelError(f"pitch_rate_noise must be a finite standard deviation >= 0, got {pitch_rate_noise!r}")
+        raise ParameterError(f"pitch_rate_noise must be a finite standard deviation >= 0, got {pitch_rate_noise!r}")
     A = np.zeros((5, 5))
     A[:4, :4] = F16XL_A
     A[:3, 4] = F16XL_A[:3, 1]

@@ -24,7 +24,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from fdikit.errors import ModelError
+from fdikit import validate
+from fdikit.errors import ModelError, ParameterError
 from fdikit.model import FaultModel
 
 __all__ = [
@@ -54,14 +55,14 @@ _CONTROLS = ("u1", "u2")
 
 
 def _check(name: str, value: float, allow_outside: bool) -> float:
-    value = float(value)
+    value = validate.number(f"MSD parameter {name}", value, finite=False)
     if not np.isfinite(value):
-        raise ModelError(f"MSD parameter {name} must be finite, got {value}")
+        raise ParameterError(f"MSD parameter {name} must be finite, got {value}")
     if name == "m3" and value <= 0:
-        raise ModelError(f"MSD mass m3 must be positive, got {value}; its range is {MSD_RANGES['m3']}")
+        raise ParameterError(f"MSD mass m3 must be positive, got {value}; its range is {MSD_RANGES['m3']}")
     lo, hi = MSD_RANGES[name]
     if not allow_outside and not lo <= value <= hi:
-        raise ModelError(f"MSD parameter {name}={value} is outside its range [{lo}, {hi}]; "
+        raise ParameterError(f"MSD parameter {name}={value} is outside its range [{lo}, {hi}]; "
                          "pass allow_outside=True to extrapolate")
     return value
 
@@ -127,9 +128,9 @@ def msd(k1: float = 1.0, m3: float = 1.0, f1: float = 1.0, f2: float = 1.0, dt: 
     """
     A, B, C = msd_matrices(k1, m3, f1, f2, allow_outside=allow_outside)
     if dt is not None:
-        dt = float(dt)
+        dt = validate.number("dt", dt, finite=False)
         if not np.isfinite(dt) or dt <= 0:
-            raise ModelError(f"dt must be a positive sample time or None (continuous), got {dt}")
+            raise ParameterError(f"dt must be a positive sample time or None (continuous), got {dt}")
         A, B = np.eye(6) + dt * A, dt * B
     model = FaultModel(A, C, Bu=B, states=_STATES, outputs=_OUTPUTS, controls=_CONTROLS, dt=dt)
     return model.with_actuator_faults(["u1"]).with_sensor_faults(["y2"])

@@ -63,7 +63,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from fdikit.errors import ModelError
+from fdikit.errors import ParameterError
 from fdikit.model import FaultModel
 
 __all__ = [
@@ -246,8 +246,8 @@ def _with_tiny(m: dict, tiny: str) -> dict[str, np.ndarray]:
     the midpoint of each rounding interval (half the last printed digit, with the printed
     sign) restores full rank.  This is an assumption, not report data (research note G3).
     """
-    if tiny not in ("zero", "midpoint"):
-        raise ModelError(f"tiny must be 'zero' or 'midpoint', got {tiny!r}")
+    if not isinstance(tiny, str) or tiny not in ("zero", "midpoint"):
+        raise ParameterError(f"tiny must be 'zero' or 'midpoint', got {tiny!r}")
     out = {}
     for key, (value, lo, hi) in m.items():
         out[key] = value if tiny == "zero" else np.where((value == 0) & (lo != hi), (lo + hi) / 2, value)
@@ -342,5 +342,5 @@ def rounding_intervals(n_states: int) -> dict[str, tuple[np.ndarray, np.ndarray]
     elif n_states == 14:
         m = _matrices_14()
     else:
-        raise ModelError(f"the PATH App. D models have 12 or 14 states, got n_states={n_states!r}")
+        raise ParameterError(f"the PATH App. D models have 12 or 14 states, got n_states={n_states!r}")
     return {key: (lo, hi) for key, (_, lo, hi) in m.items()}

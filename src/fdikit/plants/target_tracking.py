@@ -17,7 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from fdikit.errors import ModelError
+from fdikit import validate
+from fdikit.errors import ModelError, ParameterError
 from fdikit.multimodel.convex import ConvexModelSet, convex_model_set
 
 __all__ = [
@@ -54,8 +55,9 @@ def tracking_A(dt: float = TS) -> np.ndarray:
     >>> tracking_A(0.5)[0].tolist()
     [1.0, 0.5, 0.0, 0.0]
     """
-    if not dt > 0:
-        raise ModelError(f"sample time dt must be positive, got {dt}")
+    dt = validate.number("dt (the sample time)", dt, finite=False)
+    if not (np.isfinite(dt) and dt > 0):
+        raise ParameterError(f"sample time dt must be positive, got {dt}")
     A = np.eye(4)
     A[0, 1] = A[2, 3] = dt
     return A

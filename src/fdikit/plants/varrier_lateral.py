@@ -28,8 +28,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fdikit import validate
 from fdikit.design.lpv import LPVModel, Uncertainty
-from fdikit.errors import ModelError
+from fdikit.errors import ModelError, ParameterError
 from fdikit.model import FaultModel
 
 __all__ = [
@@ -96,9 +97,9 @@ def rho_from_speed(speed) -> np.ndarray | float:
     ModelError
         If a speed is not positive and finite.
     """
-    v = np.asarray(speed, dtype=float)
+    v = validate.as_array("speed", speed, finite=False)
     if not np.all(np.isfinite(v) & (v > 0)):
-        raise ModelError("speed must be positive and finite (m/s) to schedule on rho = 1/v; "
+        raise ParameterError("speed must be positive and finite (m/s) to schedule on rho = 1/v; "
                          f"got min {np.nanmin(v) if v.size else v}")
     rho = 1.0 / v
     return float(rho) if rho.ndim == 0 else rho
@@ -108,15 +109,15 @@ def _check_dt(dt) -> float:
     try:
         dt = float(dt)
     except (TypeError, ValueError):
-        raise ModelError(f"dt must be a positive sample time in s, got {dt!r}") from None
+        raise ParameterError(f"dt must be a positive sample time in s, got {dt!r}") from None
     if not (math.isfinite(dt) and dt > 0):
-        raise ModelError(f"dt must be a positive sample time in s, got {dt!r}")
+        raise ParameterError(f"dt must be a positive sample time in s, got {dt!r}")
     return dt
 
 
 def _check_params(params) -> VarrierParameters:
     if not isinstance(params, VarrierParameters):
-        raise ModelError(f"params must be a VarrierParameters, got {type(params).__name__}")
+        raise ParameterError(f"params must be a VarrierParameters, got {type(params).__name__}")
     return params
 
 
@@ -131,7 +132,7 @@ def varrier_lateral_continuous(speed: float, params: VarrierParameters = SCENIC)
     """
     rho = rho_from_speed(speed)
     if np.ndim(rho):
-        raise ModelError("speed must be a single number")
+        raise ParameterError("speed must be a single number")
     p = _check_params(params)
     cs, cd = p.c_V + p.c_H, p.l_H * p.c_H - p.l_V * p.c_V
     A = [[-cs / p.m * rho, cd / p.m * rho**2 - 1.0], [cd / p.I_z, -(p.l_V**2 * p.c_V + p.l_H**2 * p.c_H) / p.I_z * rho]]
@@ -156,6 +157,7 @@ def varrier_lateral_lpv(dt: float = T_D, params: VarrierParameters = SCENIC, *, 
     (2, ('lateral_acceleration', 'yaw_rate'))
     """
     dt, p = _check_dt(dt), _check_params(params)
+    rho_star = validate.positive("rho_star", rho_star)
     cs, cd = p.c_V + p.c_H, p.l_H * p.c_H - p.l_V * p.c_V
     cq = p.l_V**2 * p.c_V + p.l_H**2 * p.c_H
     A = [np.array([[1.0, -dt], [dt * cd / p.I_z, 1.0]]),
@@ -186,7 +188,7 @@ def varrier_lateral(speed: float = 1.0 / RHO_STAR, dt: float = T_D, params: Varr
     """
     rho = rho_from_speed(speed)
     if np.ndim(rho):
-        raise ModelError("speed must be a single number")
+        raise ParameterError("speed must be a single number")
     return varrier_lateral_lpv(dt, params).at(rho)
 
 
@@ -201,6 +203,8 @@ def varrier_uncertainty(dt: float = T_D, params: VarrierParameters = SCENIC, *, 
         20 % of the continuous dynamics (research note G4).
     scale : the 20 % of §5.3.
     """
+    scale = validate.number("scale", scale)
+    validate.choice("uncertainty mode", mode, ("literal", "continuous"))
     lpv = varrier_lateral_lpv(dt, params, rho_star=rho_star)
     A0 = lpv.matrices(rho_star)[0]
     if mode == "literal":
@@ -208,5 +212,5 @@ def varrier_uncertainty(dt: float = T_D, params: VarrierParameters = SCENIC, *, 
     elif mode == "continuous":
         A1 = scale * (A0 - np.eye(2))
     else:
-        raise ModelError(f"unknown uncertainty mode {mode!r}; use 'literal' (0.2 A0(rho*)) or 'continuous'")
+        raise ParameterError(f"unknown uncertainty mode {mode!r}; use 'literal' (0.2 A0(rho*)) or 'continuous'")
     return Uncertainty(A=A1, n=2, p=2, name="stiffness")

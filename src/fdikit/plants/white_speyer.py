@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from fdikit.errors import ModelError
+from fdikit.errors import ParameterError
 from fdikit.model import FaultModel
 
 __all__ = ["white_speyer", "WHITE_SPEYER_CASES"]
@@ -50,8 +50,8 @@ def white_speyer(case: str = "stable-zero") -> FaultModel:
     >>> m.Bf[:, 1].tolist()
     [-3.0, 1.0, 0.0]
     """
-    if case not in WHITE_SPEYER_CASES:
-        raise ModelError(f"unknown White–Speyer case {case!r}; choose one of {', '.join(WHITE_SPEYER_CASES)}")
+    if not isinstance(case, str) or case not in WHITE_SPEYER_CASES:
+        raise ParameterError(f"unknown White–Speyer case {case!r}; choose one of {', '.join(WHITE_SPEYER_CASES)}")
     A = np.array([[0.0, 3.0, 4.0], [1.0, 2.0, 3.0], [0.0, 2.0, 5.0]])
     C = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
     F = np.column_stack([[1.0, -0.5, 0.5], WHITE_SPEYER_CASES[case]])
