@@ -47,13 +47,13 @@ def demo(
 
     try:
         check_demo_arguments(out=out, seed=seed, method=method)
-    except FdiError as exc:
+    except (FdiError, OSError) as exc:
         _fail(exc)
     start = time.perf_counter()
     with console.status("designing, calibrating thresholds on 10 min fault-free data, diagnosing ..."):
         try:
             res = run_demo(out, seed=seed) if method == "bank" else run_kalman_demo(out, seed=seed)
-        except FdiError as exc:
+        except (FdiError, OSError) as exc:
             _fail(exc)
     if method == "bank":
         table = Table(title="PATH vehicle, bank of 4 Beard–Jones filters (15 faults), fault at t = 10 s")
@@ -132,7 +132,7 @@ def simulate(
             trace = run(model, scenario, duration=duration, dt=dt, measurement_noise=noise or None, rng=seed,
                         meta={"plant_name": plant, "plant_params": kw})
         path = trace.save(out)
-    except FdiError as exc:
+    except (FdiError, OSError) as exc:
         _fail(exc)
     console.print(f"{trace!r}\nwrote {path}")
 
@@ -194,7 +194,7 @@ def compare_evaluators(
         check_comparison_arguments(runs_per_fault, healthy_runs, seed, bnn, evaluators=chosen)
         result = path_evaluator_comparison(runs_per_fault, healthy_runs, seed, out, progress=True, bnn=bnn,
                                            evaluators=chosen, fresh=fresh)
-    except FdiError as exc:
+    except (FdiError, OSError) as exc:
         _fail(exc)
     table = Table(title=f"PATH bank residuals: {runs_per_fault} runs per fault, {healthy_runs} fault-free runs")
     table.add_column("evaluator", no_wrap=True)
@@ -224,7 +224,7 @@ def target_tracking(
         check_output_folder(out)
         with console.status(f"target tracking: {runs} Monte-Carlo runs ..."):
             result = target_tracking_monte_carlo(runs=runs, seed=seed)
-    except FdiError as exc:
+    except (FdiError, OSError) as exc:
         _fail(exc)
     intervals = list(next(iter(result.summary.values())))
     table = Table(title=f"mean RMSE per interval over {runs} runs: position [m] / velocity [m/s] / B")
@@ -237,8 +237,11 @@ def target_tracking(
         table.add_row(name, *cells)
         lines.append(f"| {name} | " + " | ".join(cells) + " |")
     console.print(table)
-    plot_target_tracking(result, out / "rmse.png")
-    write_text(out / "summary.md", "\n".join(lines) + "\n")
+    try:
+        plot_target_tracking(result, out / "rmse.png")
+        write_text(out / "summary.md", "\n".join(lines) + "\n")
+    except (FdiError, OSError) as exc:
+        _fail(exc)
     console.print(f"wrote {out / 'summary.md'} and {out / 'rmse.png'} in {time.perf_counter() - start:.0f} s")
 
 
@@ -264,7 +267,7 @@ def multiple_model(
     try:
         check_multiple_model_arguments(runs=runs, seed=seed, msd_dt=msd_dt, model_sets=model_sets)
         check_output_folder(out)
-    except FdiError as exc:
+    except (FdiError, OSError) as exc:
         _fail(exc)
     start = time.perf_counter()
     with Progress(SpinnerColumn(), TextColumn("{task.description}"), TimeElapsedColumn(), console=console) as bar:
@@ -278,7 +281,7 @@ def multiple_model(
         try:
             summary = multiple_model_report(out, runs=runs, seed=seed, msd_dt=msd_dt, model_sets=model_sets,
                                             progress=step, fresh=fresh)
-        except FdiError as exc:
+        except (FdiError, OSError) as exc:
             _fail(exc)
         bar.advance(task)
     console.print(summary.read_text())
