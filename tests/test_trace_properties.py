@@ -21,7 +21,8 @@ from fdikit.trace import Trace
 
 _TEXT = st.characters(exclude_categories=("Cs",))  # every code point but lone surrogates (not UTF-8)
 NAMES = st.text(_TEXT, min_size=1, max_size=8)
-LABELS = st.text(st.characters(exclude_categories=("Cs",), exclude_characters="\x00"), min_size=1, max_size=12)
+# a trailing NUL is refused (numpy str arrays drop it); any other code point may occur, NUL inside included
+LABELS = st.text(_TEXT, min_size=1, max_size=12).filter(lambda s: not s.endswith("\x00"))
 FLOATS = st.floats(allow_nan=True, allow_infinity=True, width=64)
 JSON = st.recursive(
     st.none() | st.booleans() | st.integers() | st.floats(allow_nan=False) | st.text(max_size=6),
@@ -82,7 +83,8 @@ def test_reconstructing_from_the_fields_gives_the_same_trace(tr):
     assert_same(tr, again)
 
 
-BAD_LABELS = st.none() | st.integers() | st.floats() | st.binary(max_size=4) | st.just("") | st.booleans()
+BAD_LABELS = (st.none() | st.integers() | st.floats() | st.binary(max_size=4) | st.just("") | st.booleans()
+              | st.text(max_size=3).map(lambda s: s + "\x00"))
 
 
 @given(n=st.integers(1, 25), data=st.data())

@@ -142,11 +142,6 @@ def _fault(fault, n: int) -> np.ndarray:
                 f"trace fault label at sample {empty[0]} is empty ({empty.size} empty labels); "
                 f"use {NO_FAULT!r} for a healthy sample"
             )
-        width = arr.dtype.itemsize // 4
-        codes = np.ascontiguousarray(arr).view(np.uint32).reshape(n, width)
-        nul = np.flatnonzero(np.char.str_len(arr) != np.count_nonzero(codes, axis=1))  # a NUL before the end
-        if nul.size:
-            raise DataError(f"trace fault label at sample {nul[0]} contains a NUL character; remove it")
         return arr
     if kind == "S":
         raise DataError(f"trace fault labels are bytes (dtype {arr.dtype}); give str labels (decode them first)")
@@ -162,8 +157,11 @@ def _fault(fault, n: int) -> np.ndarray:
             )
         if not v:
             raise DataError(f"trace fault label at sample {k} is empty; use {NO_FAULT!r} for a healthy sample")
-        if "\x00" in v:
-            raise DataError(f"trace fault label at sample {k} ({v!r}) contains a NUL character; remove it")
+        if v.endswith("\x00"):
+            raise DataError(
+                f"trace fault label at sample {k} ({v!r}) ends with a NUL character, which numpy string arrays "
+                "drop; remove it"
+            )
     return arr.astype(str) if n else np.full(0, NO_FAULT)
 
 
@@ -220,20 +218,35 @@ def _as_path(path) -> Path:
         raise ParameterError(f"path must be a file name (str or pathlib.Path): {exc}") from None
 
 
-def _digest(info: bytes, columns: Sequence[tuple[str, np.ndarray]], fault: np.ndarray) -> str:
-    """SHA-256 over the fdikit metadata bytes, the float64 columns (little-endian) and the labels (UCS-4)."""
+def _digest(info: bytes, columns: Sequence[tuple[str, np.ndarray]], labels: Sequence[str], codes) -> str:
+    """SHA-256 over the fdikit metadata bytes, the float64 columns (little-endian) and the fault labels.
+
+    The labels enter as their distinct values in order of first appearance (UTF-8, each with its
+    length) and the per-sample index into them, which is what :func:`pyarrow.compute.dictionary_encode`
+    gives for the same label sequence on save and on load.
+    """
     h = hashlib.sha256(_DIGEST_TAG)
     h.update(len(info).to_bytes(8, "little"))
     h.update(info)
-    h.update(len(fault).to_bytes(8, "little"))
     for name, col in columns:
         raw = name.encode("utf-8")
         h.update(len(raw).to_bytes(8, "little"))
         h.update(raw)
+        h.update(len(col).to_bytes(8, "little"))
         h.update(np.ascontiguousarray(col, dtype="<f8"))
-    width = max(1, int(np.char.str_len(fault).max())) if len(fault) else 1
-    h.update(np.ascontiguousarray(fault, dtype=f"<U{width}"))
+    h.update(len(labels).to_bytes(8, "little"))
+    for label in labels:
+        raw = label.encode("utf-8")
+        h.update(len(raw).to_bytes(8, "little"))
+        h.update(raw)
+    h.update(np.ascontiguousarray(codes, dtype="<i8"))
     return h.hexdigest()
+
+
+def _encode_labels(arr, pa, pc) -> tuple[list[str], np.ndarray]:
+    """Distinct labels (first-appearance order) and the per-sample codes of a pyarrow string array."""
+    enc = pc.dictionary_encode(arr)
+    return enc.dictionary.to_pylist(), enc.indices.to_numpy(zero_copy_only=False)
 
 
 def _read_error(path: Path, exc: BaseException) -> str:
@@ -256,7 +269,8 @@ class Trace:
     x : (N, n) true states, or an (N, 0) array when unknown.
     d : (N, nd) disturbances, or (N, 0).
     fault : (N,) str, the true active fault per sample (``'none'`` where healthy).  Every label
-        must be a non-empty string; a None, a number or bytes is refused, never converted.
+        must be a non-empty string that does not end with a NUL character (numpy drops those);
+        a None, a number or bytes is refused, never converted.
     controls, outputs, states, disturbances : names of the columns: non-empty strings, unique
         within each block.  A name may recur in another block (an output measuring a state of
         the same name); the kind (``'u'``, ``'y'``, ``'x'``, ``'d'``) tells them apart.
@@ -372,7 +386,7 @@ class Trace:
         for kind, attr in _BLOCKS:
             block = getattr(self, kind)
             cols += [(_PREFIX[kind] + nm, block[:, j]) for j, nm in enumerate(getattr(self, attr))]
-        return cols
+        return [(name, np.ascontiguousarray(col, dtype=np.float64)) for name, col in cols]
 
     def _info_bytes(self) -> bytes:
         info = {attr: list(getattr(self, attr)) for _, attr in _BLOCKS}
@@ -408,13 +422,14 @@ class Trace:
         digest of the content (see the module docstring).
         """
         import pyarrow as pa
+        import pyarrow.compute as pc
         import pyarrow.parquet as pq
 
         path = _as_path(path)
         info = self._info_bytes()
         columns = self._float_columns()
         try:
-            labels = pa.array(self.fault, type=pa.string())
+            labels = pa.array(self.fault.tolist(), type=pa.string())  # (from the numpy array, a NUL would cut a label)
         except (UnicodeError, pa.ArrowException):
             for k, label in enumerate(self.fault.tolist()):
                 try:
@@ -428,7 +443,7 @@ class Trace:
         table = pa.Table.from_arrays(
             [pa.array(col, type=pa.float64()) for _, col in columns] + [labels],
             names=[name for name, _ in columns] + ["fault"],
-            metadata={_META_KEY: info, _DIGEST_KEY: _digest(info, columns, self.fault).encode("ascii")},
+            metadata={_META_KEY: info, _DIGEST_KEY: _digest(info, columns, *_encode_labels(labels, pa, pc)).encode()},
         )
         try:
             with atomic_path(path, suffix=".parquet") as tmp:
@@ -534,11 +549,10 @@ class Trace:
                     f"trace file {path} is corrupted: column {c!r} has {col.null_count} null value(s), the first at "
                     f"sample {first}; Trace.save writes NaN, never null"
                 )
-            # a writable float64 copy; nulls (only in files without a digest: fdikit before the digest
-            # stored NaN as null) read as NaN, as they were written
-            arrays[c] = np.array(col.to_numpy(zero_copy_only=False), dtype=float)
-        fault = cls._labels_from(path, table.column("fault"), pa, pc)
-        if stored is not None and stored != _digest(raw, list(arrays.items()), fault).encode("ascii"):
+            # nulls (only in files without a digest: fdikit before the digest stored NaN as null) read as NaN
+            arrays[c] = np.asarray(col.to_numpy(), dtype=float)
+        fault, labels, codes = cls._labels_from(path, table.column("fault"), pa, pc)
+        if stored is not None and stored != _digest(raw, list(arrays.items()), labels, codes).encode("ascii"):
             raise DataError(
                 f"trace file {path} is corrupted: its content digest (SHA-256 over the metadata and every column) "
                 "does not match the stored one, so the file changed after it was written; restore it from a copy"
@@ -550,7 +564,7 @@ class Trace:
             cols = [arrays[_PREFIX[kind] + nm] for nm in names[attr]]
             blocks[kind] = np.column_stack(cols) if cols else np.zeros((n, 0))
         try:
-            return cls(t=arrays["t"], u=blocks["u"], y=blocks["y"], x=blocks["x"], d=blocks["d"], fault=fault,
+            return cls(t=np.array(arrays["t"]), u=blocks["u"], y=blocks["y"], x=blocks["x"], d=blocks["d"], fault=fault,
                        meta=meta, **names)
         except DataError as exc:
             raise DataError(f"trace file {path}: {exc}") from None
@@ -598,19 +612,17 @@ class Trace:
             )
 
     @staticmethod
-    def _labels_from(path: Path, col, pa, pc) -> np.ndarray:
-        """The (checked) 'fault' column as a numpy str array; refuses NUL characters."""
+    def _labels_from(path: Path, col, pa, pc) -> tuple[np.ndarray, list[str], np.ndarray]:
+        """The (checked) 'fault' column as a numpy str array, with its distinct labels and codes."""
         arr = col.combine_chunks()
         if pa.types.is_dictionary(arr.type):
             arr = arr.cast(arr.type.value_type)
-        enc = pc.dictionary_encode(arr)
-        labels = enc.dictionary.to_pylist()
-        if any("\x00" in s for s in labels):
-            raise DataError(f"{path}: a label in column 'fault' contains a NUL character")
-        if not labels:
-            return np.full(0, NO_FAULT)
-        idx = enc.indices.to_numpy(zero_copy_only=False)
-        return np.asarray(labels, dtype=str)[idx]
+        labels, codes = _encode_labels(arr, pa, pc)
+        bad = [s for s in labels if s.endswith("\x00")]
+        if bad:
+            raise DataError(f"{path}: the label {bad[0]!r} in column 'fault' ends with a NUL character")
+        fault = np.asarray(labels, dtype=str)[codes] if labels else np.full(0, NO_FAULT)
+        return fault, labels, codes
 
     def __repr__(self) -> str:
         span = f"{self.t[0]:g}..{self.t[-1]:g} s" if len(self) else "empty"
