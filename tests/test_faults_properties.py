@@ -69,7 +69,7 @@ def faults(draw):
     return Intermittent(target, size=draw(FINITE), period=period, duty=duty, **kw)
 
 
-@settings(max_examples=300)
+@settings(max_examples=200)
 @given(faults())
 def test_parse_of_format_is_the_fault(fault):
     spec = format_fault(fault)
@@ -78,7 +78,7 @@ def test_parse_of_format_is_the_fault(fault):
     assert fault.spec == spec
 
 
-@settings(max_examples=300)
+@settings(max_examples=200)
 @given(faults())
 def test_format_is_canonical(fault):
     spec = format_fault(fault)
