@@ -166,3 +166,58 @@ def test_dt_needs_two_samples():
     tr = Trace(t=[1.0], u=np.zeros((1, 0)), y=np.zeros((1, 1)), controls=[], outputs=["a"])
     with pytest.raises(DataError, match="fewer than 2 samples"):
         _ = tr.dt
+
+
+def test_a_null_label_is_refused_not_truncating_the_others():
+    """Issue 12, item 1: ``np.asarray(labels, dtype=str)`` with a None cut every label to 1 character."""
+    labels = ["none"] * 10 + ["steer_bias"] * 5
+    labels[3] = None
+    with pytest.raises(DataError, match=r"fault label at sample 3 is None \(NoneType\)"):
+        Trace(t=np.arange(15.0), u=np.zeros((15, 0)), y=np.zeros(15), controls=[], outputs=["a"], fault=labels)
+    labels[3] = "none"
+    tr = Trace(t=np.arange(15.0), u=np.zeros((15, 0)), y=np.zeros(15), controls=[], outputs=["a"], fault=labels)
+    assert tr.fault.tolist() == labels and tr.fault_onset == 10.0
+
+
+def test_labels_from_a_list_or_an_object_array_are_kept_exactly():
+    labels = ["none", "ünï+cödé", "f\x00inner", "none"]
+    for given in (labels, np.array(labels, dtype=object)):
+        tr = Trace(t=np.arange(4.0), u=np.zeros((4, 0)), y=np.zeros(4), controls=[], outputs=["a"], fault=given)
+        assert tr.fault.tolist() == labels
+
+
+def test_a_name_may_recur_in_another_block(tmp_path):
+    """An output that measures a state of the same name (the Varrier scenario has y- and x-'yaw_rate')."""
+    tr = _trace(outputs=["yaw_rate", "speed", "v"])
+    back = Trace.load(tr.save(tmp_path / "same_names.parquet"))
+    np.testing.assert_array_equal(back.signal("v", "y"), tr.y[:, 2])
+    np.testing.assert_array_equal(back.signal("v", "x"), tr.x[:, 0])
+
+
+def test_meta_is_kept_as_plain_json():
+    tr = _trace(meta={"rows": (1, 2), "seed": np.int64(7), "gain": np.float32(0.5), "on": np.bool_(True),
+                      "poles": np.array([-1.0, -2.0]), "nested": {"k": (None, "a")}})
+    assert tr.meta == {"rows": [1, 2], "seed": 7, "gain": 0.5, "on": True, "poles": [-1.0, -2.0],
+                       "nested": {"k": [None, "a"]}}
+    assert type(tr.meta["seed"]) is int and type(tr.meta["on"]) is bool
+    with pytest.raises(DataError, match=r"meta\['nested'\]\['f'\] is of type builtin_function"):
+        _trace(meta={"nested": {"f": len}})
+    with pytest.raises(DataError, match=r"key 3 \(int\)"):
+        _trace(meta={3: "x"})
+
+
+def test_meta_changed_after_construction_is_checked_on_save(tmp_path):
+    tr = _trace()
+    tr.meta["lateral_acceleration"] = np.float64(2.5)  # fine: a float
+    back = Trace.load(tr.save(tmp_path / "ok.parquet"))
+    assert back.meta["lateral_acceleration"] == 2.5
+    tr.meta["model"] = object()
+    with pytest.raises(DataError, match=r"meta\['model'\] is of type object"):
+        tr.save(tmp_path / "bad.parquet")
+    assert not (tmp_path / "bad.parquet").exists()
+
+
+def test_loaded_arrays_are_writable(tmp_path):
+    back = Trace.load(_trace().save(tmp_path / "w.parquet"))
+    for attr in ("t", "u", "y", "x", "d"):
+        assert getattr(back, attr).flags.writeable, attr

@@ -198,8 +198,8 @@ def _json_value(v, where: str, depth: int = 0):
             out[str(key)] = _json_value(x, f"{where}[{key!r}]", depth + 1)
         return out
     raise DataError(
-        f"{where} is a {type(v).__name__} ({v!r:.60}); trace meta must be JSON-serialisable: str, int, float, bool, "
-        "None, and lists and dicts of them"
+        f"{where} is of type {type(v).__name__} ({v!r:.60}); trace meta must be JSON-serialisable: str, int, float, "
+        "bool, None, and lists and dicts of them"
     )
 
 
