@@ -496,6 +496,8 @@ class Trace:
                 raise DataError(f"cannot read trace file {path}: it is a folder; give the .parquet file in it")
             if not path.exists():
                 raise DataError(f"no trace file at {path}")
+            if not path.is_file():
+                raise DataError(f"cannot read trace file {path}: it is not a regular file (a pipe or a device?)")
             with open(path, "rb"):
                 pass
             size = path.stat().st_size

@@ -208,6 +208,7 @@ CASES = [
     # ---------------------------------------------------------------- load: not a trace file
     case("load-missing", lambda: Trace.load(_dir() / "nope.parquet"), DataError, "nope.parquet", "no trace file"),
     case("load-folder", lambda: Trace.load(_dir()), DataError, "fdikit-bad-trace", "folder"),
+    case("load-device", lambda: Trace.load("/dev/null"), DataError, "/dev/null", "not a regular file"),
     case("load-empty", lambda: Trace.load(_bytes("empty.parquet", b"")), DataError, "empty.parquet", "empty"),
     case("load-text", lambda: Trace.load(_bytes("text.parquet", b"t,y\n0,1\n")), DataError, "text.parquet",
          "not a Parquet"),
