@@ -8,7 +8,7 @@ import scipy.optimize
 from fdikit.errors import ModelError
 from fdikit.metrics import vaf
 from fdikit.multimodel.model_set import vectorize
-from fdikit.plants.msd import msd_matrices
+from fdikit.plants.msd import msd_matrices, msd_model_vectors, msd_parameter_grid
 from fdikit.scenarios.msd import msd_od_model_set, run_msd_filter, simulate_msd
 
 DT = 0.01
@@ -54,14 +54,27 @@ def test_simulation_matches_expm_zoh_and_snr(sim):
 
 
 def test_od_set_structure_and_nominal_models_not_convex():
-    """§3.6.1: rank 5 → 6 models with f1 = 0 and f2 = 0 members.  The two nominal models span only a line in
+    """§3.6.1, Table 3.2: rank 5 → 6 models: two nominal, two with f1 = 0, two with f2 = 0, every fault
+    parameter at a limit (what the Fig. 3.9 sums need).  The two nominal models span only a line in
     (k1, 1/m3) (as Table 3.2's models 3 and 5 do), so the healthy centre (k1, m3) = (1, 1) has affine but no
-    convex weights: the reason run_msd_filter leaves the weights unprojected."""
+    convex weights: the reason run_msd_filter leaves the weights unprojected.
+
+    The members are fixed by the tie rule of ``pivoted_qr`` (not by LAPACK's rounding), so this exact set
+    is designed on every BLAS kernel; the 6th model, beyond the rank, is also the one farthest (in the
+    model-vector norm) from the first five among the models with both faults at a limit."""
     ms = msd_od_model_set(DT)
     assert ms.rank == 5 and ms.parameters.shape == (6, 4)
-    assert len(ms.actuator_fault) >= 1 and len(ms.sensor_fault) >= 1
+    np.testing.assert_allclose(ms.parameters, [[0.25, 0.2, 1, 1], [1.75, 1.8, 1, 1], [1.75, 0.2, 1, 0],
+                                                  [0.25, 1.8, 1, 0], [0.25, 0.2, 0, 1], [0.25, 0.6, 0, 1]], rtol=1e-15)
+    assert np.all(np.isin(ms.parameters[:, 2:], (0.0, 1.0)))
+    assert len(ms.actuator_fault) == 2 and len(ms.sensor_fault) == 2
     nominal = np.flatnonzero((ms.parameters[:, 2] == 1) & (ms.parameters[:, 3] == 1))
     assert len(nominal) == 2
+    grid = msd_parameter_grid(np.linspace(0.25, 1.75, 5), np.linspace(0.2, 1.8, 5), [0.0, 0.5, 1.0])
+    M = msd_model_vectors(grid, dt=DT)
+    at_limits = np.flatnonzero(np.isin(grid[:, 2], (0, 1)) & np.isin(grid[:, 3], (0, 1)))
+    gaps = [min(np.linalg.norm(M[:, j] - M[:, i]) for i in ms.indices[:5]) for j in at_limits]
+    assert at_limits[int(np.argmax(gaps))] == ms.indices[5]
     V = np.column_stack([vectorize(a, b, c) for a, b, c in zip(ms.A, ms.B, ms.C)])
     A, B, C = msd_matrices(1.0, 1.0)
     target = vectorize(np.eye(6) + DT * A, DT * B, C)
@@ -74,24 +87,27 @@ def test_od_set_structure_and_nominal_models_not_convex():
 
 
 def test_ekf_reconstructs_faults(sim, ekf):
-    """Fig. 3.9 relations f1 = 1 − Σμ̂(f1=0 models), f2 likewise.  Measured (seed 0): f2 mean 0.51 on [72, 80)
-    (truth 0.5), ≥ 0.99 when healthy; f1 converges in ≈ 10 s (only u1 excites it): mean 0.55 on [40, 50),
-    0.98 on [5, 30), 0.93 on [60, 70).  Tolerances are about twice the measured errors."""
+    """Fig. 3.9 relations f1 = 1 − Σμ̂(f1=0 models), f2 likewise.  Measured (seed 0, the same on the
+    Prescott, Haswell and SkylakeX kernels to 1e-11): f2 mean 0.523 on [72, 80) (truth 0.5), ≥ 0.995 when
+    healthy; f1 converges in ≈ 10 s (only u1 excites it): mean 0.527 on [40, 50), 0.995 on [5, 30), and
+    recovers as slowly after the fault: 0.57 at 50–52.5 s, 0.79 at 55–60 s, 0.89 at 62.5–70 s, mean 0.851
+    on [60, 70).  Tolerances are about twice the measured errors (seeds 1, 2 give the same figures to 0.01)."""
     f1, f2 = ekf.f1, ekf.f2
     assert abs(f2[_window(sim, 72, 80)].mean() - 0.5) < 0.05
     assert f2[_window(sim, 5, 70)].mean() > 0.98 and f2[_window(sim, 85, 100)].mean() > 0.98
     assert abs(f1[_window(sim, 40, 50)].mean() - 0.5) < 0.1
     assert f1[_window(sim, 5, 30)].mean() > 0.95
-    assert f1[_window(sim, 60, 70)].mean() > 0.85
+    assert f1[_window(sim, 60, 70)].mean() > 0.7
+    assert f1[_window(sim, 50, 55)].mean() < f1[_window(sim, 55, 60)].mean() < f1[_window(sim, 60, 70)].mean()
     # the reconstructed varying parameters follow the trajectory (mean abs error over 5–100 s)
     s = _window(sim, 5, 100)
     assert np.abs(ekf.params[s, 0] - sim.params[s, 0]).mean() < 0.1
-    assert np.abs(ekf.params[s, 1] - sim.params[s, 1]).mean() < 0.25  # measured 0.155 (k1: 0.072)
+    assert np.abs(ekf.params[s, 1] - sim.params[s, 1]).mean() < 0.25  # measured 0.218 (k1: 0.070)
 
 
 def test_ekf_state_vaf_table_3_3(ekf):
     """Table 3.3 (OD): x1 100, x2 95.9, x3 100, v1 99.2, v2 97.1, v3 99.1 %.  Measured here: 100, 99.5, 100,
-    99.1, 98.2, 99.1 %; all > 90 % and v2 lowest, as in the thesis (x2 is not second lowest here)."""
+    98.9, 98.2, 99.0 %; all > 90 % and v2 lowest, as in the thesis (x2 is not second lowest here)."""
     v = ekf.vaf
     assert min(v.values()) > 97.0
     assert v["x1"] > 99.9 and v["x3"] > 99.9
@@ -139,8 +155,10 @@ def test_table_3_3_all_sets_track_states_and_faults(sim, table_3_3):
     """Table 3.3 / item 20: state VAF > 90 % for the OD, CP and LV sets, v2 the lowest in each (thesis: x2, v2
     lowest); f1, f2 reconstructed in their fault windows and ≈ 1 outside.
 
-    Measured (seed 0, T_s = 0.01 s): VAF OD 100/99.5/100/99.1/98.2/99.1, CP 100/99.7/100/99.2/97.2/99.2,
-    LV 100/99.1/100/99.7/98.7/99.9 (thesis OD 100/95.9/100/99.2/97.1/99.1, CP …/95.4/…/96.8/…, LV …/91.5/…/95.7/…).
+    Measured (seed 0, T_s = 0.01 s): VAF OD 100/99.5/100/98.9/98.2/99.0, LV 100/99.1/100/99.7/98.7/99.9 on every
+    kernel; CP v2 95.2 (Prescott), 97.2 (Haswell), 98.4 (SkylakeX): its base simplex is still picked by LAPACK's
+    pivoted QR, whose ties rounding decides (thesis OD 100/95.9/100/99.2/97.1/99.1, CP …/95.4/…/96.8/…,
+    LV …/91.5/…/95.7/…).
     """
     for name, run in table_3_3.items():
         v = run.vaf

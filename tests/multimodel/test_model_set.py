@@ -6,9 +6,11 @@ import numpy as np
 import pytest
 import scipy.linalg
 import scipy.spatial
+from hypothesis import given
+from hypothesis import strategies as st
 from scipy.stats import norm
 
-from fdikit.errors import DesignError, ModelError
+from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.multimodel.cp_design import convex_weights, cp_model_set
 from fdikit.multimodel.model_set import (
     affine_weights,
@@ -19,6 +21,7 @@ from fdikit.multimodel.model_set import (
     nearest_model,
     observability_condition,
     od_model_set,
+    pivoted_qr,
     taylor_remainder_bound,
     unvectorize,
     vectorize,
@@ -118,6 +121,49 @@ def test_affine_projection_is_the_stacked_least_squares_and_exact_in_the_affine_
     np.testing.assert_allclose(affine_weights(Mr, inside).sum(axis=0), 1.0, atol=1e-12)
     with pytest.raises(ModelError, match="entries"):
         affine_weights(Mr, M[:5])
+
+
+def test_pivoted_qr_matches_lapack_without_ties():
+    """Without ties the pivots and |diag R| are those of Businger–Golub (LAPACK geqp3)."""
+    M = np.random.default_rng(11).normal(size=(8, 12)) * np.logspace(0, -3, 12)
+    piv, d = pivoted_qr(M)
+    _, R, lapack = scipy.linalg.qr(M, mode="economic", pivoting=True)
+    np.testing.assert_array_equal(piv, lapack)
+    np.testing.assert_allclose(d, np.abs(np.diag(R)), rtol=1e-10)
+
+
+@given(st.integers(0, 2**32 - 1), st.floats(1e-15, 1e-12))
+def test_pivoted_qr_ties_are_decided_by_the_key_not_by_rounding(seed, noise):
+    """Exact ties (a duplicated column) and a rank-deficient tail (7 columns of rank 5 in 6 rows: the 6th
+    step finds every residual numerically zero): relative perturbations of 1e-15 to 1e-12, above the
+    rounding differences between BLAS kernels, never change the pivots; ties go to the lowest priority."""
+    rng = np.random.default_rng(seed)
+    base = rng.normal(size=(6, 5))
+    M = np.hstack([base, base[:, :1], base[:, 1:3] @ [[1.0], [-2.0]]])  # col 5 = col 0, col 6 in the span
+    piv, d = pivoted_qr(M)
+    assert d[5] <= 1e-12 * d[0] and d[4] > 1e-6 * d[0]  # rank 5
+    for _ in range(3):
+        shaken = M * (1 + noise * rng.standard_normal(M.shape))
+        np.testing.assert_array_equal(pivoted_qr(shaken)[0], piv)
+    assert list(piv).index(0) < list(piv).index(5)  # the twins tie; the lower index wins
+    assert piv[5] == min(set(range(7)) - set(piv[:5].tolist()))  # zero-residual step: lowest free index
+    prio = np.zeros(7)
+    prio[0] = 1.0  # column 5 now preferred to its twin
+    piv2, _ = pivoted_qr(M, priority=prio)
+    assert list(piv2).index(5) < list(piv2).index(0)
+
+
+def test_pivoted_qr_bad_arguments():
+    with pytest.raises(ParameterError, match="tie_tol"):
+        pivoted_qr(np.eye(2), tie_tol=1.5)
+    with pytest.raises(ParameterError, match="tie_tol"):
+        pivoted_qr(np.eye(2), tie_tol="small")
+    with pytest.raises(ParameterError, match="priority"):
+        pivoted_qr(np.eye(2), priority=[0.0])
+    with pytest.raises(ParameterError, match="priority"):
+        pivoted_qr(np.eye(2), priority=["a", "b"])
+    with pytest.raises(ParameterError, match="rank"):
+        od_model_set(np.eye(3), rank=-1)
 
 
 def test_od_rejects_too_many_models_and_bad_input():

@@ -167,6 +167,18 @@ def msd_od_model_set(dt: float = MSD_SAMPLE_TIME, grid_levels: int = 5, fault_va
                      ) -> MSDModelSet:
     """Design the OD model set of the MSD (Hallouzi 2008, §3.6.1, (3.19)–(3.23)) on a uniform grid.
 
+    The pivoting criterion of (3.19)/(3.22) ties on this grid: the grid is symmetric (equal residual norms
+    up to rounding) and the 6th model is taken beyond the numerical rank 5, where every residual is
+    numerically zero.  Ties are broken by the documented rule of :func:`~fdikit.multimodel.model_set.pivoted_qr`
+    (tolerance ``1e-10`` of the largest column norm) with the secondary key: models whose fault parameters
+    both lie at a limit (``f ∈ {0, 1}``) first, then the grid order.  That key keeps the structure the
+    fault reconstruction of Fig. 3.9 needs — ``f = 1 − Σ_{f^(i)=0} μ̂^(i)`` equals the blended ``Σ μ̂^(i) f^(i)``
+    only if every member has ``f^(i) ∈ {0, 1}`` — and makes the set the same on every BLAS kernel.  Result
+    (5 × 5 grid, levels {0, 0.5, 1}): two nominal models (k1, m3) = (0.25, 0.2), (1.75, 1.8); two with
+    f2 = 0 at (1.75, 0.2), (0.25, 1.8); two with f1 = 0 at (0.25, 0.2), (0.25, 0.6) — the 2/2/2 structure of
+    Table 3.2.  (LAPACK's rounding-decided pivots gave, depending on the kernel, a 0.5-fault member, with
+    which f2 read 0.64 in its 0.5 fault, or a single nominal model.)
+
     Raises
     ------
     ModelError
@@ -176,7 +188,8 @@ def msd_od_model_set(dt: float = MSD_SAMPLE_TIME, grid_levels: int = 5, fault_va
         raise ModelError(f"grid_levels must be >= 2 so the grid holds both range limits, got {grid_levels}")
     grid = msd_parameter_grid(np.linspace(0.25, 1.75, grid_levels), np.linspace(0.2, 1.8, grid_levels),
                               np.asarray(fault_values, float))
-    od = od_model_set(msd_model_vectors(grid, dt=dt))
+    at_limits = np.isin(grid[:, 2], (0.0, 1.0)) & np.isin(grid[:, 3], (0.0, 1.0))
+    od = od_model_set(msd_model_vectors(grid, dt=dt), priority=np.where(at_limits, 0, 1))
     mats = [unvectorize(od.models[:, j], 6, 2, 3) for j in range(od.models.shape[1])]
     A, B, C = (np.stack([m[i] for m in mats]) for i in range(3))
     par = grid[list(od.indices)]
