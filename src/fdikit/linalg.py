@@ -127,6 +127,9 @@ def span_sum(*bases: np.ndarray, rtol: float | None = None) -> np.ndarray:
 def intersect(U: np.ndarray, V: np.ndarray, rtol: float | None = None) -> np.ndarray:
     """Orthonormal basis of ``Im U ∩ Im V``."""
     U, V = orth(U, rtol), orth(V, rtol)
+    if U.shape[0] != V.shape[0]:
+        raise ParameterError(f"intersect: U has {U.shape[0]} rows but V has {V.shape[0]}; both bases must live in "
+                             "the same space")
     if U.shape[1] == 0 or V.shape[1] == 0:
         return np.zeros((U.shape[0], 0))
     N = null(np.hstack([U, -V]), rtol)
@@ -191,6 +194,15 @@ def sensor_fault_map_tv(
     ``dF1`` gives the derivative; otherwise a central difference with ``step`` (default ``1e-6 · max(1, |t|)``).
     ``A`` and ``C`` are callables ``t -> matrix``; ``output`` is the output's index.
     """
+    for nm, fn in (("A", A), ("C", C), ("dF1", dF1)):
+        if fn is not None and not callable(fn):
+            raise ParameterError(f"{nm} must be a function of time t -> matrix, got {type(fn).__name__}")
+    t = validate.number("t", t)
+    validate.integer("output", output, minimum=0)
+    p0 = np.atleast_2d(np.asarray(C(t), dtype=float)).shape[0]
+    if output >= p0:
+        raise ParameterError(f"output index {output} is out of range; C(t) has {p0} outputs (0 .. {p0 - 1})")
+
     def f1(tau: float) -> np.ndarray:
         Ct = np.atleast_2d(np.asarray(C(tau), dtype=float))
         e = np.zeros(Ct.shape[0])
@@ -415,6 +427,11 @@ def output_separable(
     Returns the verdict and the pairs ``(i, j)`` whose images intersect (the faults that
     are "detection equivalent" and cannot be told apart by their residual directions).
     """
+    C = _mat("C", C)
+    spaces = [_mat(f"space {i}", T) for i, T in enumerate(spaces)]
+    for i, T in enumerate(spaces):
+        if T.shape[0] != C.shape[1]:
+            raise ParameterError(f"space {i} has {T.shape[0]} rows but C has {C.shape[1]} columns (states)")
     images = [orth(C @ T, rtol) for T in spaces]
     total = rank(np.hstack(images), rtol) if images else 0
     ok = total == sum(im.shape[1] for im in images)

@@ -14,12 +14,17 @@ from fdikit.design import (
     dgtfdf,
     dgtmfdf,
     discrete_game_setup,
+    enhancement_direction,
     game_filter,
     game_filter_bank,
     game_problem,
+    game_riccati,
+    goh_detector,
     goh_filter,
     hinf_detection_filter,
     kalman,
+    lpv_parity_residuals,
+    ltv_game_filter,
     observer,
     observer_generator,
     parity_design,
@@ -35,7 +40,7 @@ from fdikit.design import (
     unobservable_modes,
 )
 from fdikit.errors import DataError, DesignError, ModelError, ParameterError
-from fdikit.estimate import SteeringFaultIsolator, isolate_steering_faults, lateral_fault_map
+from fdikit.estimate import SteeringFaultIsolator, isolate_steering_faults, isolation_error_bound, lateral_fault_map
 from fdikit.plants import white_speyer
 
 
@@ -53,6 +58,12 @@ def _mh() -> FaultModel:
 def _dgs():
     return discrete_game_setup(white_speyer().discretize(0.01), ["f1", "f2"], gamma=1e-2, Vbar=1.0, Q=1e-3, M=5.0,
                                K=0.1, N=1.0, steps=50)
+
+
+def _ltv():
+    from fdikit.design import LTVModel
+
+    return LTVModel.from_lti(white_speyer(), ["f1", "f2"])
 
 
 def _md():
@@ -168,6 +179,32 @@ CASES = [
          "min_variance", "non-negative"),
     case("isolator-n-negative", lambda: SteeringFaultIsolator(-4), ParameterError, "n", "positive"),
     case("isolator-step-nan", lambda: SteeringFaultIsolator(5).step("x", 1.0), DataError, "residual", "number"),
+    case("ltv-gamma-string", lambda: ltv_game_filter(_ltv(), "f1", ["f2"], [0.0, 1.0], gamma="small"),
+         ParameterError, "gamma", "number"),
+    case("ltv-target-unknown", lambda: ltv_game_filter(_ltv(), "f9", ["f2"], [0.0, 1.0], gamma=1e-3), ModelError,
+         "f9"),
+    case("ltv-grid-nan", lambda: ltv_game_filter(_ltv(), "f1", ["f2"], [0.0, np.nan], gamma=1e-3), ParameterError,
+         "time grid t", "finite"),
+    case("ltv-method", lambda: ltv_game_filter(_ltv(), "f1", ["f2"], [0.0, 1.0], gamma=1e-3, method="euler"),
+         ParameterError, "method", "'euler'"),
+    case("goh-detector-V-zero", lambda: goh_detector(white_speyer(), "f1", ["f2"], V=0.0), ParameterError, "V",
+         "positive definite"),
+    case("game-riccati-target", lambda: game_riccati(game_problem(white_speyer(), ["f1", "f2"]), np.zeros((3, 2)),
+                                                     "f9"), ParameterError, "target", "f9"),
+    case("game-riccati-L-shape", lambda: game_riccati(game_problem(white_speyer(), ["f1", "f2"]), np.zeros((2, 2)),
+                                                      "f1"), ParameterError, "L", "3 x 2"),
+    case("enhancement-not-design", lambda: enhancement_direction("design", "f1"), ParameterError, "design",
+         "HinfDesign"),
+    case("uio-bank-also-unknown", lambda: uio_bank(_m(), ["y0_sensor"], also_decouple=["zz"]), ModelError, "zz"),
+    case("unknown-input-rtol", lambda: unknown_input_matrix(_m(), ["y0_sensor"], rtol=-1.0), ParameterError, "rtol",
+         "non-negative"),
+    case("parity-W2-shape", lambda: parity_design(_md(), s=2, W2=np.ones((2, 2))), ParameterError, "W2"),
+    case("lpv-residuals-s", lambda: lpv_parity_residuals(LPVModel([_md()]), None, 0.1, -1), ParameterError, "s",
+         "non-negative"),
+    case("bound-not-estimate", lambda: isolation_error_bound("est", _r, _r, 0.0, 1.0), ParameterError, "estimate",
+         "SteeringFaultEstimate"),
+    case("bound-length", lambda: isolation_error_bound(isolate_steering_faults(_r, _r, 10), _r[:50], _r, 0.0, 1.0),
+         DataError, "residual", "samples"),
     case("fault-map-dt-zero", lambda: lateral_fault_map(dt=0.0), ParameterError, "dt", "positive"),
     case("fault-map-pole-unstable", lambda: lateral_fault_map(pole=1.5), ParameterError, "pole", "1"),
 ]

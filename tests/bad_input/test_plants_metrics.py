@@ -31,6 +31,16 @@ from fdikit.plants.target_tracking import tracking_A
 N = 10
 
 
+_bank_cache: list = []
+
+
+def _BANK():
+    """The PATH bank, designed once (the path_runs cases check their arguments before simulating)."""
+    if not _bank_cache:
+        _bank_cache.append(path_bank())
+    return _bank_cache[0]
+
+
 def _diag(n=N):
     t = np.arange(n) * 0.1
     alarm = np.zeros(n, bool)
@@ -71,12 +81,24 @@ CASES = [
     case("f16xl-gust-noise", lambda: f16xl_gust(pitch_rate_noise=-1.0), ParameterError, "pitch_rate_noise", ">= 0"),
     case("f16xl-gust-gain-nan", lambda: f16xl_gust(gust_gain=float("nan")), ParameterError, "gust_gain", "finite"),
     case("tracking-dt-zero", lambda: tracking_A(0.0), ParameterError, "dt", "positive"),
+    case("msd-matrices-m3-string", lambda: msd_matrices(m3="heavy"), ParameterError, "m3", "number"),
+    case("b747-set-a35", lambda: b747_model_set(a35=None), ParameterError, "a35", "None"),
+    case("rho-from-speed-string", lambda: rho_from_speed("fast"), ParameterError, "speed", "number"),
+    case("get-plant-kw-type", lambda: get_plant("msd", k1="soft"), ParameterError, "k1", "number"),
+    case("tracking-dt-string", lambda: tracking_A("1s"), ParameterError, "dt", "number"),
     # ------------------------------------------------------------------ PATH monitor
     case("path-fault-model-13", lambda: path_fault_model(13), ParameterError, "n_states", "13"),
     case("path-bank-dt-negative", lambda: path_bank(dt=-0.01), ParameterError, "dt", "positive"),
     case("path-bank-eig-unknown", lambda: path_bank(eigenvalues={"filter9": [-1.0]}), ParameterError,
          "eigenvalues", "filter9"),
     case("path-runs-not-bank", lambda: path_runs("bank"), ParameterError, "bank", "PathBank"),
+    case("path-runs-duration", lambda: path_runs(_BANK(), duration=0.0), ParameterError, "duration", "positive"),
+    case("path-runs-count", lambda: path_runs(_BANK(), runs_per_fault=-1), ParameterError, "runs_per_fault",
+         "non-negative"),
+    case("path-runs-noise", lambda: path_runs(_BANK(), noise_fraction=float("nan")), ParameterError,
+         "noise_fraction", "finite"),
+    case("path-runs-onset-after-end", lambda: path_runs(_BANK(), duration=2.0, onset=5.0), ParameterError, "onset",
+         "duration"),
     # ------------------------------------------------------------------ metrics
     case("score-length", lambda: score(np.full(N + 2, "none"), _diag()), DataError, "truth", "samples"),
     case("score-not-diagnosis", lambda: score(np.full(N, "none"), "alarm"), ParameterError, "diagnosis",
@@ -88,6 +110,9 @@ CASES = [
     case("vaf-shapes", lambda: vaf([1.0, 2.0, 3.0], [1.0, 2.0]), DataError, "vaf", "shapes"),
     case("vaf-nan", lambda: vaf([1.0, np.nan, 3.0], [1.0, 2.0, 3.0]), DataError, "reference", "finite"),
     case("vaf-string", lambda: vaf(["a", "b"], [1.0, 2.0]), DataError, "reference", "number"),
+    case("score-truth-none-label", lambda: score(np.array(["none", None] * 5, dtype=object), _diag()), DataError,
+         "truth", "string"),
+    case("vaf-empty", lambda: vaf([], []), DataError, "vaf", "2+ samples"),
     case("vaf-constant", lambda: vaf([1.0, 1.0, 1.0], [1.0, 2.0, 3.0]), DataError, "constant"),
 ]
 

@@ -416,5 +416,5 @@ def test_errors_name_the_problem(f16):
     prob = game_problem(white_speyer(), ["f1", "f2"])
     with pytest.raises(DesignError, match="Hurwitz"):
         game_riccati(prob, np.zeros((3, 2)), "f1")
-    with pytest.raises(DesignError, match="3 x 2"):
+    with pytest.raises(ParameterError, match="3 x 2"):
         game_cost(prob, np.zeros((2, 3)))

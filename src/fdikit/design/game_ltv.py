@@ -34,6 +34,7 @@ import numpy as np
 import scipy.linalg
 from scipy.integrate import solve_ivp
 
+from fdikit import validate
 from fdikit.design.game_setup import weight
 from fdikit.design.ltv import LTVModel, MatrixFunction, invariant_generators, ltv_projector
 from fdikit.errors import DataError, DesignError, ModelError, ParameterError
@@ -199,8 +200,12 @@ def _complements(model: LTVModel, targets: Sequence[str], nuisance: Sequence[str
     return {k: tuple(j for j in targets if j != k) + tuple(nuisance) for k in targets}
 
 
+#: Methods of :func:`scipy.integrate.solve_ivp`.
+_IVP_METHODS = ("RK23", "RK45", "DOP853", "Radau", "BDF", "LSODA")
+
+
 def _grid(t) -> np.ndarray:
-    t = np.asarray(t, dtype=float).ravel()
+    t = validate.as_array("the time grid t", t, finite=False).ravel()
     if t.size < 2 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
         raise ParameterError("the time grid t must be finite, strictly increasing, with t0 and t1 (≥ 2 points)")
     return t
@@ -222,7 +227,8 @@ def _riccati(model: LTVModel, target: str, comp: tuple[str, ...], t: np.ndarray,
     Given ``L(t)``: (3.32), ``K0 = A − LC``, ``R = F̂MF̂ᵀ/γ + LVLᵀ``, ``S = −CᵀĤQĤC``.
     The exact Jacobian is ``I⊗K + K⊗I`` with ``K = K0 − P S``.
     """
-    if not (isinstance(gamma, int | float) and math.isfinite(gamma) and gamma > 0):
+    gamma = validate.number("gamma", gamma, finite=False)
+    if not (math.isfinite(gamma) and gamma > 0):
         raise ParameterError(f"gamma must be a positive attenuation bound (small = strong blocking), got {gamma!r}")
     A0, C0 = model.matrix("A", t[0]), model.matrix("C", t[0])
     p, n = C0.shape
@@ -357,6 +363,7 @@ def ltv_game_filter(model: LTVModel, target: str, nuisance: Sequence[str], t, *,
     >>> np.round(np.sort_complex(d.poles()), 2)
     array([-316.27+0.j  ,   -3.53-1.79j,   -3.53+1.79j])
     """
+    validate.choice("integration method", method, _IVP_METHODS)
     comp = _complements(model, [target], nuisance)[target]
     t = _grid(t)
     for s in (t[0], t[len(t) // 2], t[-1]):

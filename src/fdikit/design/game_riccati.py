@@ -252,7 +252,7 @@ def _gain(problem: GameProblem, L) -> np.ndarray:
     m = problem.model
     L = np.asarray(L, dtype=float)
     if L.shape != (m.n, m.p):
-        raise DesignError(f"the gain L must be n x p = {m.n} x {m.p}, got shape {L.shape}")
+        raise ParameterError(f"the gain L must be n x p = {m.n} x {m.p}, got shape {L.shape}")
     if not np.all(np.isfinite(L)):
         raise DesignError("the gain L has non-finite entries")
     return L
@@ -292,7 +292,7 @@ def game_riccati(
     _continuous(problem.model)
     L = _gain(problem, L)
     if target not in problem.targets:
-        raise DesignError(f"{target!r} is not a target of the problem; targets are {problem.names}")
+        raise ParameterError(f"{target!r} is not a target of the problem; targets are {problem.names}")
     poles = scipy.linalg.eigvals(problem.model.A - L @ problem.model.C)
     if np.any(poles.real >= 0):
         raise DesignError(

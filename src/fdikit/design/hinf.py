@@ -396,6 +396,7 @@ def enhancement_direction(design: HinfDesign, fault: str) -> Enhancement:
     largest λ of ``(C̄X_0mC̄ᵀ) q = λ (C̄X_0ωC̄ᵀ) q`` (c.26).  The sign of ``q`` is fixed so that
     its largest entry is positive.
     """
+    validate.instance("design", design, HinfDesign, "pass the result of hinf_detection_filter(...)")
     fam = design.family
     if fault not in fam.spaces:
         raise ModelError(f"no fault {fault!r} in the design; faults are {list(fam.names)}")

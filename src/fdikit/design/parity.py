@@ -23,8 +23,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fdikit import validate
 from fdikit.design.lpv import LPVModel, StackedMatrices, _check_s, lpv_stacked_matrices, stacked_matrices
-from fdikit.errors import DataError, DesignError, ModelError
+from fdikit.errors import DataError, DesignError, ModelError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.residuals import ResidualGenerator, Residuals
 from fdikit.trace import Trace
@@ -148,11 +149,11 @@ class ParityDesign:
 
 
 def _as_w2(W2, q: int) -> np.ndarray:
-    W2 = np.eye(q) if W2 is None else np.asarray(W2, dtype=float)
+    W2 = np.eye(q) if W2 is None else validate.as_array("W2", W2, finite=False)
     if W2.ndim == 1:
         W2 = W2[:, None]
     if W2.ndim != 2 or W2.shape[0] != q or not np.all(np.isfinite(W2)):
-        raise ModelError(f"W2 must be a finite vector or matrix with q = {q} rows, got shape {W2.shape}")
+        raise ParameterError(f"W2 must be a finite vector or matrix with q = {q} rows, got shape {W2.shape}")
     if np.linalg.norm(W2) == 0:
         raise DesignError("W2 = 0 gives the trivial residual r = 0; choose a non-zero W2 (Varrier 2014, (28))")
     return W2

@@ -128,6 +128,8 @@ def unknown_input_matrix(
         For a fault whose output direction is not in the range of ``C``, or a disturbance
         with ``Dd ≠ 0``.
     """
+    validate.instance("model", model, FaultModel)
+    rtol = validate.non_negative("rtol", rtol)
     if isinstance(faults, str):
         faults = [faults]
     idx = model.index("f", list(faults))

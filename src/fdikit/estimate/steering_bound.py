@@ -39,6 +39,7 @@ import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 from numpy.typing import ArrayLike
 
+from fdikit import validate
 from fdikit.errors import DataError
 from fdikit.estimate.steering import FaultMap, SteeringFaultEstimate, fault_map_coefficients
 from fdikit.lti import dlsim_blocked
@@ -246,12 +247,14 @@ def isolation_error_bound(
     >>> bool(np.all(b.theta[est.valid] <= b.bound[est.valid]))
     True
     """
-    r = np.asarray(residual, dtype=float)
-    E = np.asarray(setpoint, dtype=float)
+    validate.instance("estimate", estimate, SteeringFaultEstimate, "pass the result of isolate_steering_faults(...)")
+    r = validate.as_array("residual", residual, error=DataError, finite=False)
+    E = validate.as_array("setpoint", setpoint, error=DataError, finite=False)
     N = len(estimate)
     if r.shape != (N,) or E.shape != (N,):
         raise DataError(
-            f"residual {r.shape} and setpoint {E.shape} must be the ({N},) arrays the estimate was computed from"
+            f"residual {r.shape} and setpoint {E.shape} must be the ({N},) arrays (samples) the estimate was "
+            "computed from"
         )
     fa = np.broadcast_to(np.asarray(f_a, dtype=float), (N,)).astype(float)
     fm = np.broadcast_to(np.asarray(f_m, dtype=float), (N,)).astype(float)

@@ -237,6 +237,9 @@ def path_runs(
     size = validate.number("size", size)
     noise_fraction = validate.non_negative("noise_fraction", noise_fraction)
     dt = validate.positive("dt", dt)
+    if onset >= duration:
+        raise ParameterError(f"onset = {onset} s is not before the end of the run (duration = {duration} s); "
+                             "every fault would act after the run")
     plant = path_fault_model(14).discretize(dt)
     gen = bank.generator.discretize(dt)
     noise = noise_fraction * np.array([bank.nominal[sensor_fault_name(o)] for o in plant.outputs])

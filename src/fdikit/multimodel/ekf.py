@@ -185,7 +185,7 @@ class ExtendedKalmanFilter:
 
     def __init__(self, model: NonlinearGaussianModel, x0, P0) -> None:
         if not isinstance(model, NonlinearGaussianModel):
-            raise ModelError(f"model must be a NonlinearGaussianModel, got {type(model).__name__}")
+            raise ParameterError(f"model must be a NonlinearGaussianModel, got {type(model).__name__}")
         self.model = model
         self.x = _as_vector("x0", x0, model.n, error=ParameterError, finite=True)
         self.P = _check_psd("P0", _as_matrix("P0", P0, model.n, model.n, error=ParameterError), error=ParameterError)

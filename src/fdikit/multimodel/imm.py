@@ -256,8 +256,11 @@ class IMMStepper:
 
     def step(self, u, y) -> IMMStep:
         """One Table 2.1 cycle with ``u_k, y_k`` (see the module docstring for the sample convention)."""
-        u = np.asarray(u, dtype=float).reshape(self._m)
-        y = np.asarray(y, dtype=float).reshape(self._p)
+        u = validate.as_array("u", np.zeros(0) if u is None else u, error=DataError, finite=False)
+        y = validate.as_array("y", y, error=DataError, finite=False)
+        if u.size != self._m or y.size != self._p:
+            raise DataError(f"u_k must have {self._m} entries and y_k {self._p}, got {u.size} and {y.size}")
+        u, y = u.reshape(self._m), y.reshape(self._p)
         if not np.all(np.isfinite(u)):
             raise DataError("input u_k contains NaN/inf; the IMM cannot predict without the input")
         x, P, xm, ll, ok = self._cycle(u, y, keep=True)
