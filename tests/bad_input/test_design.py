@@ -25,11 +25,13 @@ from fdikit.design import (
     kalman,
     lpv_parity_residuals,
     ltv_game_filter,
+    minimal_degree,
     observer,
     observer_generator,
     parity_design,
     resolve_faults,
     restricted_diagonal,
+    scheduled_parity_filter,
     single_fault_game_filter,
     solve_game_are,
     stacked_matrices,
@@ -162,6 +164,9 @@ CASES = [
     case("solve-game-are-shape", lambda: solve_game_are(np.eye(2), np.eye(3), np.eye(2)), ParameterError, "R",
          "2 x 2"),
     case("detection-gain-unknown", lambda: detection_gain_family(_m(), ["zz"]), ModelError, "zz"),
+    # dae_parity.py and scheduled.py (fixes pending in those modules)
+    case("minimal-degree-not-dae", lambda: minimal_degree("dae"), ParameterError, "dae", "DAEModel"),
+    case("scheduled-family-none", lambda: scheduled_parity_filter(None, 20.0), ParameterError, "family"),
     # ------------------------------------------------------------------ estimate
     case("steering-n-zero", lambda: isolate_steering_faults(_r, _r, 0), ParameterError, "n", "positive"),
     case("steering-n-float", lambda: isolate_steering_faults(_r, _r, 2.5), ParameterError, "n", "integer"),

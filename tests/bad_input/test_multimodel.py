@@ -21,6 +21,7 @@ from fdikit.multimodel import (
     dual_convex_filter,
     extended_kalman_filter,
     kalman_filter,
+    limit_value_model_set,
     od_model_set,
     table_4_7_logic,
 )
@@ -158,6 +159,11 @@ CASES = [
     case("cp-models-nan", lambda: cp_model_set(np.full((10, 3), np.nan)), ModelError, "models", "NaN"),
     case("cp-n-vertices", lambda: cp_model_set(np.random.default_rng(0).normal(size=(10, 3)), rank=2,
                                                n_vertices=1), DesignError, "n_vertices", "3"),
+    # model_set.py (fixes pending in that module)
+    case("od-rank-zero", lambda: od_model_set(np.random.default_rng(0).normal(size=(10, 3)), rank=0),
+         ParameterError, "rank", "positive"),
+    case("limit-value-matrices", lambda: limit_value_model_set(lambda **k: None, {"a": 1.0}, {"a": 2.0}),
+         ParameterError, "matrices"),
     case("od-min-gap", lambda: od_model_set(np.random.default_rng(0).normal(size=(10, 3)), min_gap=0.0),
          ParameterError, "min_gap", "positive"),
 ]

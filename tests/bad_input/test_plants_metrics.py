@@ -11,6 +11,7 @@ from fdikit.errors import DataError, ParameterError
 from fdikit.metrics import confusion_matrix, score, summarize, vaf
 from fdikit.monitors import path_bank, path_fault_model, path_runs
 from fdikit.plants import (
+    SingleTrackParameters,
     b747_longitudinal,
     b747_model_set,
     f16xl_gust,
@@ -21,6 +22,9 @@ from fdikit.plants import (
     path_vehicle_14,
     rho_from_speed,
     rounding_intervals,
+    single_track,
+    single_track_lpv,
+    understeer_gradient,
     varrier_lateral,
     varrier_lateral_lpv,
     varrier_uncertainty,
@@ -86,6 +90,13 @@ CASES = [
     case("rho-from-speed-string", lambda: rho_from_speed("fast"), ParameterError, "speed", "number"),
     case("get-plant-kw-type", lambda: get_plant("msd", k1="soft"), ParameterError, "k1", "number"),
     case("tracking-dt-string", lambda: tracking_A("1s"), ParameterError, "dt", "number"),
+    # single_track.py (fixes pending in that module)
+    case("single-track-params-type", lambda: single_track(20.0, params="x"), ParameterError, "params",
+         "SingleTrackParameters"),
+    case("single-track-lpv-dt-zero", lambda: single_track_lpv(dt=0.0), ParameterError, "dt", "positive"),
+    case("understeer-params-type", lambda: understeer_gradient("x"), ParameterError, "params",
+         "SingleTrackParameters"),
+    case("single-track-parameters-string", lambda: SingleTrackParameters(m="heavy"), ParameterError, "m", "number"),
     # ------------------------------------------------------------------ PATH monitor
     case("path-fault-model-13", lambda: path_fault_model(13), ParameterError, "n_states", "13"),
     case("path-bank-dt-negative", lambda: path_bank(dt=-0.01), ParameterError, "dt", "positive"),
