@@ -1,9 +1,10 @@
 """The a_y-sensor fault scenario of Varrier, Koenig & Martinez 2014, §5.4–5.5 (research note §5 items 14–15).
 
 Item 14 is asserted: the fault is +0.5 m/s² on a_y over [150 s, 158 s) only, the residuals are
-normalised to mean one over the faulty time and ϖ is computed exactly as defined.  Item 15 (ϖ_LPVu
-vs ϖ_LPV against the paper's 1.39 and 4.04) is reported, not asserted: the MIPS data are not
-available and the value depends on the simulated uncertainty class.
+normalised to mean one over the faulty time and ϖ is computed exactly as defined.  Item 15: the paper's
+values ϖ_LPV = 1.39, ϖ_LPVu = 4.04 (§5.5) are **not reproduced** (the MIPS data are not available and
+ϖ depends on the simulated uncertainty class); what is reproduced and asserted is the paper's
+conclusion that the U-LPV residual separates the fault better than the LPV one.
 """
 
 from __future__ import annotations
@@ -81,15 +82,30 @@ def test_window_masks_normalisation_and_score():
         varrier_trace(fault_window=(158.0, 150.0))
 
 
-def test_lpv_and_ulpv_scores_are_reported():
-    """Item 15 reported (printed, not compared with 1.39 / 4.04); asserted: every residual is finite,
-    normalised to mean one over the fault, and the U-LPV designs are built with κ < κ_max."""
-    tr = varrier_trace()
+ULPV = ("ulpv_lmi", "ulpv_adjugate", "ulpv_theorem1", "ulpv_constant")
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_ulpv_separates_the_fault_and_lpv_does_not_paper_values_not_reproduced(seed):
+    """§5.5: ϖ_LPV = 1.39 and ϖ_LPVu = 4.04 in the paper — not reproduced: here ϖ_LPV = 0.89 and
+    ϖ_LPVu = 1.23 (LMI), 1.23 (adjugate), 1.36 (pointwise Theorem 1), 1.12 (constant fault) for seed 0.
+
+    Reproduced, and asserted for seeds 0–4: the paper's conclusion that the U-LPV residual rejects the
+    unmodelled dynamics better — every U-LPV variant scores higher than the LPV residual.  The margin is
+    the meaning of ϖ: ϖ > 1 means one threshold separates every faulty sample from every healthy one, and
+    each U-LPV variant is above 1 while the LPV residual is below (its healthy peaks exceed its faulty
+    minimum, the "large amplitudes" the paper reports for LPV).  Over seeds 0–19 ϖ_LPV lies in 0.25–0.91
+    and the U-LPV variants in 1.06–1.62 (the smallest is 6 % above 1); the SDP of the LMI design moves
+    ϖ by ~1e-3 between BLAS kernels, far inside these margins.  Also checked: every residual is
+    normalised to mean one over the fault and the U-LPV design has κ < κ_max.
+    """
+    tr = varrier_trace(seed=seed)
     cmp = varrier_comparison(tr)
     faulty, _ = fault_window_masks(tr, 3)
-    assert set(cmp.varpi) == {"lpv", "ulpv_lmi", "ulpv_adjugate", "ulpv_theorem1", "ulpv_constant"}
+    assert set(cmp.varpi) == {"lpv", *ULPV}
     for name, res in cmp.residuals.items():
         assert np.isfinite(cmp.varpi[name]) and cmp.varpi[name] > 0
         assert res.r[faulty, 0].mean() == pytest.approx(1.0, rel=1e-9)
     assert cmp.design.kappa < cmp.design.kappa_max
-    print("varpi (paper: LPV 1.39, U-LPV 4.04):", {k: round(v, 3) for k, v in cmp.varpi.items()})
+    assert cmp.varpi["lpv"] < 1.0, cmp.varpi
+    assert min(cmp.varpi[name] for name in ULPV) > 1.0, cmp.varpi
