@@ -442,6 +442,11 @@ def scheduled_parity_filter(
     >>> gen.degree, gen.window, gen.residuals
     (2, 3, ('r_steering_actuator',))
     """
+    if not callable(family):
+        raise ParameterError(
+            f"family must be a callable ρ -> discrete FaultModel (e.g. plants.single_track.single_track_lpv()), "
+            f"got {type(family).__name__}"
+        )
     model = family(reference)
     if not isinstance(model, FaultModel) or not model.is_discrete:
         raise ModelError(f"family({reference}) must return a discrete FaultModel, got {model!r}")
