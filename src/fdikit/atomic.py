@@ -56,7 +56,9 @@ def atomic_path(path: str | os.PathLike, *, suffix: str = "") -> Iterator[Path]:
     Raises
     ------
     DataError
-        When ``path`` is an existing folder or its folder cannot be created.
+        When ``path`` is an existing folder, its folder cannot be created, or the temporary file
+        cannot be created, synced or renamed (the previous file is then unchanged).  Exceptions
+        raised by the caller's own writing propagate unchanged (the temporary file is removed).
     """
     path = Path(path)
     if path.is_dir():
@@ -65,14 +67,20 @@ def atomic_path(path: str | os.PathLike, *, suffix: str = "") -> Iterator[Path]:
         path.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise DataError(f"cannot create the folder of {path}: {exc.strerror or exc}") from exc
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix + ".tmp", dir=path.parent)
+    try:
+        fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix + ".tmp", dir=path.parent)
+    except OSError as exc:
+        raise DataError(f"cannot write {path}: {exc.strerror or exc} (is its folder writable?)") from exc
     os.close(fd)
     tmp = Path(tmp_name)
     try:
         yield tmp
-        with open(tmp, "rb+") as fh:
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
+        try:
+            with open(tmp, "rb+") as fh:
+                os.fsync(fh.fileno())
+            os.replace(tmp, path)
+        except OSError as exc:
+            raise DataError(f"cannot write {path}: {exc.strerror or exc}; the previous file is unchanged") from exc
     except BaseException:
         with contextlib.suppress(OSError):
             tmp.unlink()
