@@ -163,7 +163,7 @@ def test_pivoted_qr_bad_arguments():
     with pytest.raises(ParameterError, match="priority"):
         pivoted_qr(np.eye(2), priority=["a", "b"])
     with pytest.raises(ParameterError, match="rank"):
-        od_model_set(np.eye(3), rank=-1)
+        od_model_set(np.eye(3), rank=0)
 
 
 def test_od_rejects_too_many_models_and_bad_input():

@@ -43,7 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fdikit import linalg
-from fdikit.errors import DesignError, ModelError
+from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.residuals import ResidualGenerator
 
@@ -280,7 +280,11 @@ def minimal_degree(dae: DAEModel, fault: str | None = None, max_degree: int | No
     ------
     DesignError
         If no degree up to ``max_degree`` works: the fault is not detectable (2.5).
+    ParameterError
+        If ``dae`` is not a :class:`DAEModel`.
     """
+    if not isinstance(dae, DAEModel):
+        raise ParameterError(f"dae must be a DAEModel (build one with dae_form(model)), got {type(dae).__name__}")
     j = dae.fault_index(fault)
     top = len(dae.unknowns) * (len(dae.H) - 1) if max_degree is None else int(max_degree)
     for d in range(top + 1):

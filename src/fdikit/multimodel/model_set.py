@@ -313,7 +313,7 @@ def od_model_set(models, rank: int | None = None, min_gap: float = 10.0, *, tie_
     DesignError
         If ``N_r + 1`` exceeds the number of models.
     ParameterError
-        On a non-positive ``min_gap``, a negative or non-integer ``rank``, a bad ``tie_tol`` or ``priority``.
+        On a non-positive ``min_gap``, a ``rank`` that is not a positive integer, a bad ``tie_tol`` or ``priority``.
 
     Examples
     --------
@@ -325,8 +325,8 @@ def od_model_set(models, rank: int | None = None, min_gap: float = 10.0, *, tie_
     M = _as_model_matrix(models)
     if not isinstance(min_gap, (int, float, np.floating, np.integer)) or not min_gap > 0 or not np.isfinite(min_gap):
         raise ParameterError(f"min_gap must be a positive number (a ratio of successive |diag R|), got {min_gap!r}")
-    if rank is not None and (isinstance(rank, bool) or not isinstance(rank, (int, np.integer)) or rank < 0):
-        raise ParameterError(f"rank must be a non-negative integer N_r (the set has N_r + 1 models), got {rank!r}")
+    if rank is not None and (isinstance(rank, bool) or not isinstance(rank, (int, np.integer)) or rank < 1):
+        raise ParameterError(f"rank must be a positive integer N_r (the set has N_r + 1 models), got {rank!r}")
     piv, diag_r = pivoted_qr(M, tie_tol, priority)
     sv = np.linalg.svd(M, compute_uv=False)
     n_r = gap_rank(diag_r, min_gap) if rank is None else int(rank)
@@ -395,14 +395,25 @@ def limit_value_model_set(matrices: Callable[..., Sequence], upper: Mapping[str,
     ------
     DesignError
         If ``upper`` and ``lower`` name different parameters.
+    ParameterError
+        If ``matrices`` is not callable or does not return 3 or 4 numeric arrays.
     """
     if set(upper) != set(lower) or not upper:
         raise DesignError(f"upper and lower limits must name the same parameters, got {sorted(upper)} and "
                           f"{sorted(lower)}")
     names = tuple(upper)
+    if not callable(matrices):
+        raise ParameterError(f"matrices must be a callable params -> (A, B, C[, D]), got {type(matrices).__name__}")
 
     def quad(params) -> list[np.ndarray]:
-        mats = [np.atleast_2d(np.asarray(M, float)) for M in matrices(**params)]
+        out = matrices(**params)
+        try:
+            mats = [np.atleast_2d(np.asarray(M, float)) for M in out]
+        except (TypeError, ValueError):
+            raise ParameterError(f"matrices(**{params}) must return (A, B, C) or (A, B, C, D) numeric arrays, "
+                                 f"got {type(out).__name__}") from None
+        if len(mats) not in (3, 4):
+            raise ParameterError(f"matrices(**{params}) must return (A, B, C) or (A, B, C, D), got {len(mats)} arrays")
         if len(mats) == 3:
             mats.append(np.zeros((mats[2].shape[0], mats[1].shape[1])))
         return mats
