@@ -445,14 +445,11 @@ class Trace:
             names=[name for name, _ in columns] + ["fault"],
             metadata={_META_KEY: info, _DIGEST_KEY: _digest(info, columns, *_encode_labels(labels, pa, pc)).encode()},
         )
-        try:
-            with atomic_path(path, suffix=".parquet") as tmp:
-                try:
-                    pq.write_table(table, tmp, write_page_checksum=True)
-                except (OSError, pa.ArrowException) as exc:
-                    raise DataError(f"cannot write trace file {path}: {exc}") from exc
-        except OSError as exc:
-            raise DataError(f"cannot write trace file {path}: {exc.strerror or exc}") from exc
+        with atomic_path(path, suffix=".parquet") as tmp:  # its own failures are DataErrors naming the file
+            try:
+                pq.write_table(table, tmp, write_page_checksum=True)
+            except (OSError, pa.ArrowException) as exc:
+                raise DataError(f"cannot write trace file {path}: {exc}") from exc
         return path
 
     @classmethod
