@@ -15,7 +15,7 @@ from fdikit.design.scheduled import (
     lpv_rank_test,
     scheduled_parity_filter,
 )
-from fdikit.errors import DataError, DesignError, ModelError
+from fdikit.errors import DataError, DesignError, ModelError, ParameterError
 from fdikit.faults import Bias, FaultScenario, Noise, ScaleFactor
 from fdikit.metrics import vaf
 from fdikit.plants.single_track import single_track, single_track_lpv
@@ -45,9 +45,9 @@ def test_family_is_the_sampled_single_track():
         np.testing.assert_allclose(m.A, ref.A, rtol=0, atol=1e-15)
         np.testing.assert_allclose(m.B, ref.B, rtol=0, atol=1e-15)
     assert single_track_lpv(steering_fault=False)(V70).faults == ()
-    with pytest.raises(ModelError, match="dt"):
+    with pytest.raises(ParameterError, match="dt"):
         single_track_lpv(dt=0.0)
-    with pytest.raises(ModelError, match="speed"):
+    with pytest.raises(ParameterError, match="speed"):
         FAMILY(-1.0)
 
 

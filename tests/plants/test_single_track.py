@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from fdikit.errors import ModelError
+from fdikit.errors import ParameterError
 from fdikit.plants import PRIUS_2010, SingleTrackParameters, single_track, understeer_gradient
 
 KMH = 1 / 3.6
@@ -149,14 +149,14 @@ def test_steady_cornering_is_consistent_with_understeer_gradient():
 
 @pytest.mark.parametrize("speed", [0.0, -10.0, math.nan, math.inf, "fast", None])
 def test_bad_speed_raises(speed):
-    with pytest.raises(ModelError, match="speed"):
+    with pytest.raises(ParameterError, match="speed"):
         single_track(speed)
 
 
 def test_bad_parameters_raise():
-    with pytest.raises(ModelError, match="negative"):
+    with pytest.raises(ParameterError, match="negative"):
         SingleTrackParameters(C_f=1.17e5)
-    with pytest.raises(ModelError, match="m must be a positive"):
+    with pytest.raises(ParameterError, match="m must be a positive"):
         SingleTrackParameters(m=0.0)
-    with pytest.raises(ModelError, match="dt"):
+    with pytest.raises(ParameterError, match="dt"):
         single_track(20.0, dt=-0.01)

@@ -40,7 +40,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fdikit.errors import ModelError
+from fdikit import validate
+from fdikit.errors import ParameterError
 from fdikit.model import FaultModel, actuator_fault_name
 
 __all__ = [
@@ -91,14 +92,16 @@ class SingleTrackParameters:
     g: float = 9.81
 
     def __post_init__(self) -> None:
+        for name in ("l_f", "l_r", "m", "I_z", "g", "C_f", "C_r"):
+            object.__setattr__(self, name, validate.number(f"SingleTrackParameters.{name}", getattr(self, name)))
         for name in ("l_f", "l_r", "m", "I_z", "g"):
             value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0):
-                raise ModelError(f"SingleTrackParameters.{name} must be a positive finite number, got {value!r}")
+            if not value > 0:
+                raise ParameterError(f"SingleTrackParameters.{name} must be a positive finite number, got {value!r}")
         for name in ("C_f", "C_r"):
             value = getattr(self, name)
-            if not (math.isfinite(value) and value < 0):
-                raise ModelError(
+            if not value < 0:
+                raise ParameterError(
                     f"SingleTrackParameters.{name} must be negative (thesis convention F_y = -C alpha), got {value!r}; "
                     f"pass -{abs(value)!r} for a physical stiffness of {abs(value)!r} N/rad"
                 )
@@ -120,6 +123,8 @@ def understeer_gradient(params: SingleTrackParameters = PRIUS_2010) -> float:
     is understeer (stable at every speed; no critical speed).  For :data:`PRIUS_2010`
     ``K_u = 0.003526`` rad/(m/s²) (research note §5.1; not printed in the thesis).
     """
+    if not isinstance(params, SingleTrackParameters):
+        raise ParameterError(f"params must be a SingleTrackParameters, got {type(params).__name__}")
     m_f = params.m * params.l_r / params.wheelbase
     m_r = params.m * params.l_f / params.wheelbase
     return m_f / -params.C_f - m_r / -params.C_r
@@ -148,7 +153,7 @@ def single_track(speed: float, params: SingleTrackParameters = PRIUS_2010, dt: f
 
     Raises
     ------
-    ModelError
+    ParameterError
         If ``speed`` is not a positive finite number (the model has ``1/V_x`` terms).
 
     Examples
@@ -162,7 +167,7 @@ def single_track(speed: float, params: SingleTrackParameters = PRIUS_2010, dt: f
     """
     v = _speed(speed)
     if not isinstance(params, SingleTrackParameters):
-        raise ModelError(f"params must be a SingleTrackParameters, got {type(params).__name__}")
+        raise ParameterError(f"params must be a SingleTrackParameters, got {type(params).__name__}")
     A, Bu, Bd, C = _continuous_matrices(v, params)
     model = FaultModel(
         A, C, Bu=Bu, Bd=Bd, states=STATES, outputs=OUTPUTS, controls=CONTROLS, disturbances=DISTURBANCES
@@ -171,13 +176,13 @@ def single_track(speed: float, params: SingleTrackParameters = PRIUS_2010, dt: f
 
 
 def _speed(speed) -> float:
-    """``speed`` as a positive finite float (m/s), or a ModelError saying how to fix it."""
+    """``speed`` as a positive finite float (m/s), or a ParameterError saying how to fix it."""
     try:
         v = float(speed)
     except (TypeError, ValueError):
-        raise ModelError(f"speed must be a number in m/s, got {speed!r}") from None
+        raise ParameterError(f"speed must be a number in m/s, got {speed!r}") from None
     if not (math.isfinite(v) and v > 0):
-        raise ModelError(
+        raise ParameterError(
             f"speed must be a positive finite longitudinal speed in m/s, got {speed!r}; "
             "the single-track model divides by V_x (use e.g. 70 / 3.6 for 70 km/h)"
         )
@@ -283,13 +288,10 @@ class SingleTrackLPV:
 
     def __post_init__(self) -> None:
         if not isinstance(self.params, SingleTrackParameters):
-            raise ModelError(f"params must be a SingleTrackParameters, got {type(self.params).__name__}")
-        try:
-            dt = float(self.dt)
-        except (TypeError, ValueError):
-            raise ModelError(f"dt must be a sample time in s, got {self.dt!r}") from None
-        if not (math.isfinite(dt) and dt > 0):
-            raise ModelError(f"dt must be a positive sample time in s (the thesis uses 0.01), got {self.dt!r}")
+            raise ParameterError(f"params must be a SingleTrackParameters, got {type(self.params).__name__}")
+        dt = validate.number("dt (sample time in s)", self.dt)
+        if not dt > 0:
+            raise ParameterError(f"dt must be a positive sample time in s (the thesis uses 0.01), got {self.dt!r}")
         object.__setattr__(self, "dt", dt)
 
     def matrices(self, speed: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -305,7 +307,7 @@ class SingleTrackLPV:
         """
         v = np.atleast_1d(np.asarray(speed, dtype=float))
         if v.ndim != 1 or not np.all(np.isfinite(v) & (v > 0)):
-            raise ModelError("speeds must be a 1-D array of positive finite longitudinal speeds in m/s")
+            raise ParameterError("speeds must be a 1-D array of positive finite longitudinal speeds in m/s")
         A, Bu, Bd, C = _zoh(v, self.params, self.dt)
         return A, np.concatenate([Bu, Bd], axis=-1), C, np.zeros(C.shape[:-1] + (3,))
 
