@@ -23,8 +23,9 @@ from scipy.stats import binom
 from fdikit.decision import ThresholdEvaluator
 from fdikit.design import kalman
 from fdikit.faults import Bias, FaultScenario
+from fdikit.gaps import GapRule as _GapRule
+from fdikit.gaps import Recovery as _Recovery
 from fdikit.plants import path_vehicle_12
-from fdikit.residuals import _GapRule, _Recovery
 from fdikit.simulate import simulate
 from fdikit.trace import Trace
 

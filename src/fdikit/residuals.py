@@ -12,9 +12,9 @@ vectorised recursion between gaps); ``online()`` returns a :class:`ResidualStepp
 for invalid (NaN/inf) samples: the filter is propagated with the model and the inputs
 through the gap and the samples after it are marked *recovering* (not valid for
 decisions) until the gap transient has decayed below the noise (:class:`ResidualStepper`
-gives the rule and its derivation).  ``internal_form(model)`` is Varga's internal form ``R``: the
-interconnection of the plant model and the filter, from ``(u, d, f, w)`` to ``r``,
-so decoupling is a number, not a plot.
+gives the rule; :mod:`fdikit.gaps` implements it and gives its derivation).
+``internal_form(model)`` is Varga's internal form ``R``: the interconnection of the plant
+model and the filter, from ``(u, d, f, w)`` to ``r``, so decoupling is a number, not a plot.
 """
 
 from __future__ import annotations
@@ -26,6 +26,7 @@ import numpy as np
 import scipy.linalg
 
 from fdikit.errors import DataError, ModelError, ParameterError
+from fdikit.gaps import GapRule, Recovery
 from fdikit.lti import dlsim_blocked
 from fdikit.model import GROUPS, FaultModel
 from fdikit.trace import Trace
@@ -214,14 +215,14 @@ class ResidualGenerator:
         """Residuals of a whole trace, vectorised between gaps; identical to ``online().run(trace)``.
 
         A sample with a NaN/inf in a signal the generator reads is *invalid*: its residuals are NaN
-        and the filter is propagated through it by the gap rule of :class:`ResidualStepper` (model
-        prediction of the missing measurements, last value of a missing control).  The samples after
-        a gap are *recovering* (finite residuals, ``valid`` False, ``recovering`` True) until the gap
-        transient has decayed below ``recovery_tol`` noise standard deviations.  Stretches of valid
-        samples are processed by the blocked recursion of :func:`fdikit.lti.dlsim_blocked`; only the
-        invalid samples and the recovery bookkeeping are stepped one by one (by superposition: the
-        response to the usable inputs and the response to the gap rule's state corrections are each
-        one blocked solve over the whole trace).
+        and the filter is propagated through it by the gap rule of :class:`ResidualStepper` and
+        :mod:`fdikit.gaps` (model prediction of the missing measurements, last value of a missing
+        control).  The samples after a gap are *recovering* (finite residuals, ``valid`` False,
+        ``recovering`` True) until the gap transient has decayed below ``recovery_tol`` noise
+        standard deviations.  Stretches of valid samples are processed by the blocked recursion of
+        :func:`fdikit.lti.dlsim_blocked`; only the invalid samples and the recovery bookkeeping are
+        stepped one by one (by superposition: the response to the usable inputs and the response to
+        the gap rule's state corrections are each one blocked solve over the whole trace).
 
         Parameters
         ----------
@@ -258,9 +259,9 @@ class ResidualGenerator:
         meta = {"trace": dict(trace.meta)}
         if ok.all():
             r, _, _ = dlsim_blocked(g.A, g.B, g.C, g.D, v, x0)
-            _GapRule(g, residual_cov, recovery_tol)  # validates the options alike on clean data
+            GapRule(g, residual_cov, recovery_tol)  # validates the options alike on clean data
             return Residuals(trace.t, r, self.residuals, self.isolates, meta=meta)
-        rule = _GapRule(g, residual_cov, recovery_tol)
+        rule = GapRule(g, residual_cov, recovery_tol)
         N, n = v.shape[0], g.n
         # Superposition: x = X0 + c, X0 the response to the usable inputs (bad entries 0) from rest, c the
         # response to x0 and to the state corrections E the gap rule applies on invalid samples.  Only the
@@ -270,7 +271,7 @@ class ResidualGenerator:
         E = np.zeros((N, n))
         valid = np.zeros(N, bool)
         recovering = np.zeros(N, bool)
-        rec = _Recovery(rule)
+        rec = Recovery(rule)
         last = np.zeros(v.shape[1])
         c, kc = x0.copy(), 0
         bad_idx = np.flatnonzero(~ok)
@@ -297,7 +298,7 @@ class ResidualGenerator:
         return Residuals(trace.t, r, self.residuals, self.isolates, valid, meta=meta, recovering=recovering)
 
     @staticmethod
-    def _flags(rec: _Recovery, valid: np.ndarray, recovering: np.ndarray, start: int, stop: int) -> None:
+    def _flags(rec: Recovery, valid: np.ndarray, recovering: np.ndarray, start: int, stop: int) -> None:
         """Flags of the valid samples ``start … stop − 1`` (recovering while the gap transient lasts)."""
         i = start
         while i < stop and rec.active:
@@ -408,179 +409,12 @@ def _state0(g: ResidualGenerator, x0) -> np.ndarray:
     return x.copy()
 
 
-class _GapRule:
-    """The gap rule of one discrete generator (shared by ``run`` and the stepper, so both agree).
-
-    The filter ``z+ = A z + B_u u + B_y y``, ``r = C z + D_u u + D_y y`` is split into its
-    independent parts (connected components of the states and residuals through ``A`` and ``C``;
-    a stacked bank gives one per filter).  On a sample where the outputs ``b`` are invalid, each
-    part ``c`` is fed ``y_b = −(D_{y,cb})⁺ (C_c z_c + D_{u,c} u + D_{y,c,good} y_good) + Π_c y_b,last``:
-    the least-squares choice that makes the part's residuals closest to zero (exactly zero when
-    ``D_{y,cb}`` has full column rank, as for an observer ``r = y − ŷ``, where it is the predicted
-    output: open-loop model propagation), and in the directions the part's feedthrough does not
-    see (``Π_c = I − D⁺D``) the last valid value.  An invalid control is held at its last valid
-    value (0 before any).  The deviation ``δ`` of the filter state from the one the true samples
-    would have given obeys, with ``e`` the fault-free residual,
-
-        δ+ = (A − B_b D⁺ C) δ − B_b D⁺ e     (invalid sample),      δ+ = A δ     (valid sample),
-
-    and the residual transient is ``C δ``.  :class:`_Recovery` propagates ``P = Cov δ`` with
-    ``Cov e = residual_cov`` and keeps the samples after a gap "recovering" while
-    ``diag(C P Cᵀ) > tol² diag(residual_cov)``.  Parts fed a held value (not predicted) add an
-    error the filter matrices cannot bound; for them the recovery lasts at least
-    ``ceil(log tol / log ρ(A))`` samples (the filter forgetting its state by the factor ``tol``).
-    """
-
-    def __init__(self, g: ResidualGenerator, residual_cov, tol) -> None:
-        if isinstance(tol, bool) or not isinstance(tol, (int, float, np.integer, np.floating)):
-            raise ParameterError(f"recovery_tol must be a number in (0, 1], got {tol!r}")
-        if not (np.isfinite(tol) and 0 < tol <= 1):
-            raise ParameterError(f"recovery_tol must be in (0, 1] (a fraction of the noise std), got {tol!r}")
-        q = len(g.residuals)
-        if residual_cov is None:
-            S = np.eye(q)
-        else:
-            try:
-                S = np.atleast_2d(np.asarray(residual_cov, dtype=float))
-            except (TypeError, ValueError) as exc:
-                raise ParameterError(f"residual_cov must be a {q}x{q} covariance matrix, got {residual_cov!r}") from exc
-            if S.shape == (1, q) and q > 1:
-                S = np.diag(S[0])
-            if S.shape != (q, q) or not np.all(np.isfinite(S)) or not np.allclose(S, S.T, rtol=1e-10, atol=0):
-                raise ParameterError(f"residual_cov must be a finite symmetric {q}x{q} matrix (residuals "
-                                     f"{list(g.residuals)}), got shape {S.shape}")
-            if q and not np.all(np.diag(S) > 0):
-                raise ParameterError("residual_cov must have a positive diagonal (every residual has noise)")
-        self.g, self.S, self.tol = g, S, float(tol)
-        self.limit = self.tol**2 * np.diag(S)
-        self.mu = len(g.controls)
-        n = g.n
-        rho = float(np.max(np.abs(np.linalg.eigvals(g.A)))) if n else 0.0
-        self.rho = rho
-        self.settle = 0 if n == 0 else (1 if rho == 0 else (
-            int(np.ceil(np.log(self.tol) / np.log(rho))) if rho < 1 else -1))
-        self.parts = _components(g.A, g.C)
-        self._AT = g.A.T.copy()
-        self._cache: dict[bytes, tuple] = {}
-
-    def pattern(self, ok_ch: np.ndarray) -> tuple:
-        """Per pattern of valid channels: per part (states, rows, M⁺, Π), the δ-matrices (T, Q) and "held"."""
-        key = ok_ch.tobytes()
-        hit = self._cache.get(key)
-        if hit is not None:
-            return hit
-        g, mu = self.g, self.mu
-        bad_y = np.flatnonzero(~ok_ch[mu:])
-        bad_u = np.flatnonzero(~ok_ch[:mu])
-        good_y = np.flatnonzero(ok_ch[mu:])
-        n, q = g.n, len(g.residuals)
-        T = g.A.copy()
-        G = np.zeros((n, q))
-        held = bool(bad_u.size and np.any(g.B[:, bad_u] != 0))
-        parts = []
-        for states, rows in self.parts:
-            Bb = g.B[np.ix_(states, mu + bad_y)]
-            M = g.D[np.ix_(rows, mu + bad_y)]
-            Mp = np.linalg.pinv(M, rcond=1e-10) if M.size else np.zeros((bad_y.size, rows.size))
-            Pi = np.eye(bad_y.size) - Mp @ M
-            if states.size and np.any(np.abs(Bb @ Pi) > 1e-12 * max(1.0, np.abs(Bb).max(initial=0))):
-                held = True
-            K = Bb @ Mp
-            if states.size and rows.size:
-                T[np.ix_(states, states)] -= K @ g.C[np.ix_(rows, states)]
-                G[np.ix_(states, rows)] = -K
-            parts.append((states, rows, Mp, Pi))
-        hit = (bad_y, bad_u, good_y, parts, T, G @ self.S @ G.T, held)
-        self._cache[key] = hit
-        return hit
-
-    def propagate(self, z: np.ndarray, v: np.ndarray, ok_ch: np.ndarray, last: np.ndarray) -> np.ndarray:
-        """The filter state after an invalid sample ``v`` (entries with ``ok_ch`` False are unusable)."""
-        g, mu = self.g, self.mu
-        bad_y, bad_u, good_y, parts, _, _, _ = self.pattern(ok_ch)
-        w = np.where(ok_ch, v, last)  # controls: last valid value; outputs: replaced per part below
-        znew = np.empty_like(z)
-        for states, rows, Mp, Pi in parts:
-            wc = w.copy()
-            if bad_y.size:
-                known = g.C[np.ix_(rows, states)] @ z[states] + g.D[rows, :mu] @ w[:mu] \
-                    + g.D[np.ix_(rows, mu + good_y)] @ w[mu + good_y]
-                wc[mu + bad_y] = -(Mp @ known) + Pi @ last[mu + bad_y]
-            znew[states] = g.A[np.ix_(states, states)] @ z[states] + g.B[states] @ wc
-        return znew
-
-
-def _components(A: np.ndarray, C: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
-    """Independent parts of a filter: (states, residual rows) connected through A and C."""
-    n, q = A.shape[0], C.shape[0]
-    parent = list(range(n + q))
-
-    def find(i: int) -> int:
-        while parent[i] != i:
-            parent[i] = parent[parent[i]]
-            i = parent[i]
-        return i
-
-    def join(i: int, j: int) -> None:
-        parent[find(i)] = find(j)
-
-    for i, j in zip(*np.nonzero(A)):
-        join(int(i), int(j))
-    for k, j in zip(*np.nonzero(C)):
-        join(n + int(k), int(j))
-    groups: dict[int, list[int]] = {}
-    for i in range(n + q):
-        groups.setdefault(find(i), []).append(i)
-    out = []
-    for members in groups.values():
-        states = np.array([i for i in members if i < n], dtype=int)
-        rows = np.array([i - n for i in members if i >= n], dtype=int)
-        out.append((states, rows))
-    return out
-
-
-class _Recovery:
-    """Which samples after a gap are still recovering (the bookkeeping of :class:`_GapRule`)."""
-
-    def __init__(self, rule: _GapRule) -> None:
-        self.rule = rule
-        self.P: np.ndarray | None = None
-        self.hold = 0
-
-    @property
-    def active(self) -> bool:
-        return self.P is not None or self.hold != 0
-
-    def invalid_sample(self, ok_ch: np.ndarray) -> None:
-        rule = self.rule
-        _, _, _, _, T, Q, held = rule.pattern(ok_ch)
-        P = np.zeros_like(T) if self.P is None else self.P
-        self.P = T @ P @ T.T + Q
-        if held:
-            self.hold = rule.settle
-
-    def valid_sample(self) -> bool:
-        """Advance over a valid sample; True when it may be used for decisions."""
-        rule = self.rule
-        recovering = False
-        if self.P is not None:
-            d = np.einsum("ij,jk,ik->i", rule.g.C, self.P, rule.g.C)
-            if np.any(d > rule.limit):
-                recovering = True
-                self.P = rule.g.A @ self.P @ rule._AT
-            else:
-                self.P = None
-        if self.hold != 0:
-            recovering = True
-            self.hold -= 1 if self.hold > 0 else 0
-        return not recovering
-
-
 class ResidualStepper:
     """Online residual generation, one sample at a time, through gaps of invalid samples.
 
     ``step(u, y)`` returns the residual vector of the current sample.  The gap rule (the same
-    in :meth:`ResidualGenerator.run`, which gives the same residuals and flags):
+    in :meth:`ResidualGenerator.run`, which gives the same residuals and flags; implemented and
+    derived in :mod:`fdikit.gaps`):
 
     * **invalid sample** (a NaN/inf in a signal the generator reads): the residuals are NaN,
       ``last_valid`` is False, ``invalid`` counts it, and the filter is propagated with the model
@@ -611,7 +445,7 @@ class ResidualStepper:
                  residual_cov=None, recovery_tol: float = 0.1) -> None:
         g = generator
         self.generator = g
-        self._rule = _GapRule(g, residual_cov, recovery_tol)
+        self._rule = GapRule(g, residual_cov, recovery_tol)
         self._x0 = _state0(g, x0)
         self._AB = np.hstack([g.A, g.B])
         self._CD = np.hstack([g.C, g.D])
@@ -624,7 +458,7 @@ class ResidualStepper:
         self.last_valid = True
         self.last_recovering = False
         self._last = np.zeros(self._AB.shape[1] - self.generator.n)
-        self._rec = _Recovery(self._rule)
+        self._rec = Recovery(self._rule)
 
     def _vector(self, values, names: tuple[str, ...], what: str) -> np.ndarray:
         if values is None or isinstance(values, (str, bytes)):
@@ -698,6 +532,7 @@ class ResidualStepper:
             recovering[k] = self.last_recovering
         return Residuals(trace.t, r, g.residuals, g.isolates, valid, meta={"trace": dict(trace.meta)},
                          recovering=recovering)
+
 
 def stack_generators(generators: Iterable[ResidualGenerator]) -> ResidualGenerator:
     """One generator from several: block-diagonal filter states, concatenated residuals.
