@@ -366,8 +366,8 @@ class FaultModel:
 
         if self.is_discrete:
             raise ModelError(f"model is already discrete (dt={self.dt}); discretize a continuous model")
-        dt = validate.positive("dt (the sample time)", dt, error=validate.ModelArgumentError)
-        validate.choice("discretization method", method, _DISCRETIZE_METHODS, error=validate.ModelArgumentError)
+        dt = validate.positive("dt (the sample time)", dt, error=ParameterError)
+        validate.choice("discretization method", method, _DISCRETIZE_METHODS, error=ParameterError)
         Ad, Bd, Cd, Dd, _ = scipy.signal.cont2discrete((self.A, self.B, self.C, self.D), dt, method=method)
         return self._with_matrices(Ad, Bd, Cd, Dd, dt)
 

@@ -24,10 +24,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from fdikit.errors import ModelError, ParameterError
+from fdikit.errors import ParameterError
 
 __all__ = [
-    "ModelArgumentError",
     "as_array",
     "as_matrix",
     "as_square",
@@ -42,15 +41,6 @@ __all__ = [
     "choice",
     "instance",
 ]
-
-
-class ModelArgumentError(ParameterError, ModelError):
-    """A bad argument of a model method (e.g. the ``dt`` of :meth:`FaultModel.discretize`).
-
-    A :class:`~fdikit.errors.ParameterError` (the class for bad arguments); also a
-    :class:`~fdikit.errors.ModelError`, which these methods raised before, so existing
-    ``except ModelError`` code keeps working.
-    """
 
 
 def _show(value) -> str:

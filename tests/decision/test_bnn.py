@@ -21,7 +21,7 @@ from fdikit.decision.bnn import (
     robbins_monro_steps,
 )
 from fdikit.decision.gaussian_ml import GaussianMlEvaluator
-from fdikit.errors import DataError, ModelError
+from fdikit.errors import DataError, ParameterError
 from fdikit.residuals import Residuals
 
 FAULTS = ("f1", "f2", "f3")
@@ -258,9 +258,9 @@ def test_robbins_monro_gains_satisfy_the_conditions(a):
         lower = np.log(m + 1) if a == 1 else ((m + 1) ** (1 - a) - 1) / (1 - a)
         assert s[m - 1] >= rho0 * lower
     for bad in (0.5, 0.3, 1.2):
-        with pytest.raises(ModelError, match=r"\(0.5, 1\]"):
+        with pytest.raises(ParameterError, match=r"\(0.5, 1\]"):
             robbins_monro_steps(rho0, 10, bad)
-    with pytest.raises(ModelError, match="positive"):
+    with pytest.raises(ParameterError, match="positive"):
         robbins_monro_steps(0.0, 10, a)
 
 
@@ -411,7 +411,7 @@ def test_inputs_are_scaled_group_magnitudes():
 
 def test_bad_input():
     r = _res(np.zeros((5, 3)))
-    with pytest.raises(ModelError, match="not trained"):
+    with pytest.raises(ParameterError, match="not trained"):
         BnnEvaluator().run(r)
     with pytest.raises(DataError, match="no training data"):
         BnnEvaluator().fit({})
@@ -419,7 +419,7 @@ def test_bad_input():
         BnnEvaluator().fit({"none": r})
     with pytest.raises(DataError, match="no training samples"):
         BnnEvaluator(hypotheses=("f9",)).fit({"f1": r})
-    with pytest.raises(ModelError, match="labels"):
+    with pytest.raises(ParameterError, match="labels"):
         BnnEvaluator().fit([r])
     with pytest.raises(DataError, match="2 label entries for 1"):
         BnnEvaluator().fit([r], ["f1", "f2"])
@@ -431,21 +431,21 @@ def test_bad_input():
         BnnEvaluator(columns=("zz",)).fit({"f1": r})
     with pytest.raises(DataError, match="scale"):
         BnnEvaluator().fit({"f1": r})  # all-zero magnitudes: no nominal scale
-    with pytest.raises(ModelError, match="2 scale values for 3 inputs"):
+    with pytest.raises(ParameterError, match="2 scale values for 3 inputs"):
         BnnEvaluator(scale=[1.0, 2.0]).fit({"f1": r})
-    with pytest.raises(ModelError, match="inputs"):
+    with pytest.raises(ParameterError, match="inputs"):
         BnnEvaluator(inputs="abs")
-    with pytest.raises(ModelError, match="threshold"):
+    with pytest.raises(ParameterError, match="threshold"):
         BnnEvaluator(threshold=1.0)
-    with pytest.raises(ModelError, match="feedback"):
+    with pytest.raises(ParameterError, match="feedback"):
         BnnEvaluator(feedback="full")
-    with pytest.raises(ModelError, match="update"):
+    with pytest.raises(ParameterError, match="update"):
         BnnEvaluator(update="sr1")
-    with pytest.raises(ModelError, match="exponent"):
+    with pytest.raises(ParameterError, match="exponent"):
         BnnEvaluator(rm_exponent=0.5)
-    with pytest.raises(ModelError, match="feedback matrix"):
+    with pytest.raises(ParameterError, match="feedback matrix"):
         BnnNetwork((3, 3, 2), feedback=np.eye(3))
-    with pytest.raises(ModelError, match="weight vector"):
+    with pytest.raises(ParameterError, match="weight vector"):
         BnnNetwork((3, 3)).forward(np.zeros(5), np.zeros((4, 3)))
     with pytest.raises(DataError, match="network input"):
         BnnNetwork((3, 3)).forward(np.zeros(12), np.zeros((4, 2)))
@@ -527,9 +527,9 @@ def test_gaussian_ml_priors_fit_and_online():
         GaussianMlEvaluator().fit({"none": data["none"]})
     with pytest.raises(DataError, match="singular"):
         GaussianMlEvaluator.from_moments({"a": [0, 0], "b": [1, 1]}, np.ones((2, 2)))
-    with pytest.raises(ModelError, match="priors lack"):
+    with pytest.raises(ParameterError, match="priors lack"):
         GaussianMlEvaluator(priors={"none": 1.0}, inputs="raw").fit(data)
-    with pytest.raises(ModelError, match="no class model"):
+    with pytest.raises(ParameterError, match="no class model"):
         GaussianMlEvaluator().run(r)
 
 

@@ -13,7 +13,7 @@ from scipy.stats import norm
 
 from fdikit.decision.cusum import CusumEvaluator, cusum_arl, cusum_design
 from fdikit.diagnosis import UNKNOWN_FAULT
-from fdikit.errors import DataError, ModelError
+from fdikit.errors import DataError, ParameterError
 from fdikit.residuals import Residuals
 
 
@@ -242,9 +242,9 @@ def test_isolation_through_ties():
 
 def test_bad_input():
     r = Residuals(np.arange(50) * 1.0, np.random.default_rng(0).standard_normal((50, 2)), ("a", "b"), ())
-    with pytest.raises(ModelError, match="no drift/threshold"):
+    with pytest.raises(ParameterError, match="no drift/threshold"):
         CusumEvaluator().run(r)
-    with pytest.raises(ModelError, match="no drift/threshold"):
+    with pytest.raises(ParameterError, match="no drift/threshold"):
         CusumEvaluator(drift=0.5).step([0.0, 0.0])
     with pytest.raises(DataError, match="3 threshold values for 2 residuals"):
         CusumEvaluator(0.5, [4, 4, 4]).run(r)
@@ -256,23 +256,23 @@ def test_bad_input():
     with pytest.raises(DataError, match="2 threshold values for 3 residuals"):
         ev.step([0.0, 0.0, 0.0])
     for kw in ({"drift": 0.0}, {"drift": -1.0}, {"threshold": 0.0}, {"sigma": -1.0}):
-        with pytest.raises(ModelError, match="must be positive"):
+        with pytest.raises(ParameterError, match="must be positive"):
             CusumEvaluator(**kw)
-    with pytest.raises(ModelError, match="restart"):
+    with pytest.raises(ParameterError, match="restart"):
         CusumEvaluator(restart="sometimes")
-    with pytest.raises(ModelError, match="hold"):
+    with pytest.raises(ParameterError, match="hold"):
         CusumEvaluator(hold=-1)
-    with pytest.raises(ModelError, match="needs a target"):
+    with pytest.raises(ParameterError, match="needs a target"):
         CusumEvaluator().fit(r, shift=1.0)
-    with pytest.raises(ModelError, match="shift="):
+    with pytest.raises(ParameterError, match="shift="):
         CusumEvaluator().fit(r, arl0=100.0)
     with pytest.raises(DataError, match="at least 10"):
         CusumEvaluator().fit(r.slice(stop=5.0))
     with pytest.raises(DataError, match="constant"):
         CusumEvaluator().fit(Residuals(np.arange(50) * 1.0, np.zeros((50, 1)), ("a",), ()))
-    with pytest.raises(ModelError, match="positive"):
+    with pytest.raises(ParameterError, match="positive"):
         cusum_design(100.0, 0.0)
-    with pytest.raises(ModelError, match="not above"):
+    with pytest.raises(ParameterError, match="not above"):
         cusum_design(1.02, 1.0)
-    with pytest.raises(ModelError, match="threshold must be positive"):
+    with pytest.raises(ParameterError, match="threshold must be positive"):
         cusum_arl(0.5, -1.0)

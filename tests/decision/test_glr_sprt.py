@@ -10,7 +10,7 @@ from scipy.stats import chi2, multivariate_normal, norm
 
 from fdikit.decision.glr import GlrEvaluator, glr_threshold, residual_blocks
 from fdikit.decision.sprt import SprtEvaluator, sprt_asn, sprt_thresholds
-from fdikit.errors import DataError, ModelError
+from fdikit.errors import DataError, ParameterError
 from fdikit.residuals import Residuals
 
 SIGMA = np.array([[1.0, 0.6, 0.2], [0.6, 2.0, -0.5], [0.2, -0.5, 0.5]])
@@ -163,11 +163,11 @@ def test_glr_blocks_and_isolation():
 
 def test_glr_bad_input():
     r = Residuals(np.arange(50) * 1.0, np.random.default_rng(0).standard_normal((50, 2)), ("a", "b"), ())
-    with pytest.raises(ModelError, match="no threshold"):
+    with pytest.raises(ParameterError, match="no threshold"):
         GlrEvaluator().run(r)
-    with pytest.raises(ModelError, match="window"):
+    with pytest.raises(ParameterError, match="window"):
         GlrEvaluator(window=0)
-    with pytest.raises(ModelError, match="positive"):
+    with pytest.raises(ParameterError, match="positive"):
         GlrEvaluator(threshold=-1.0)
     with pytest.raises(DataError, match="3 thresholds for 2 blocks"):
         GlrEvaluator(threshold=[1, 2, 3]).run(r)
@@ -184,13 +184,13 @@ def test_glr_bad_input():
         ev.step([0.0])
     with pytest.raises(DataError, match="at least 10"):
         GlrEvaluator().fit(r.slice(stop=5.0))
-    with pytest.raises(ModelError, match="one label per residual"):
+    with pytest.raises(ParameterError, match="one label per residual"):
         GlrEvaluator(threshold=5.0, blocks="pairs").run(r)
-    with pytest.raises(ModelError, match="3 block labels for 2"):
+    with pytest.raises(ParameterError, match="3 block labels for 2"):
         GlrEvaluator(threshold=5.0, blocks=["x", "y", "z"]).run(r)
-    with pytest.raises(ModelError, match=r"\(0, 1\)"):
+    with pytest.raises(ParameterError, match=r"\(0, 1\)"):
         glr_threshold(0.0, 10)
-    with pytest.raises(ModelError, match="one filter"):
+    with pytest.raises(ParameterError, match="one filter"):
         GlrEvaluator(threshold=5.0, blocks="all", groups=("g1", "g2")).run(r)
 
 
@@ -301,17 +301,17 @@ def test_sprt_restart_semantics():
 def test_sprt_bad_input():
     r = Residuals(np.arange(50) * 1.0, np.random.default_rng(0).standard_normal((50, 2)), ("a", "b"), ())
     for a, b in [(0.0, 0.1), (0.1, 1.0), (0.6, 0.5), (-0.1, 0.1)]:
-        with pytest.raises(ModelError, match="alpha"):
+        with pytest.raises(ParameterError, match="alpha"):
             SprtEvaluator(1.0, a, b)
-    with pytest.raises(ModelError, match="zero shift"):
+    with pytest.raises(ParameterError, match="zero shift"):
         SprtEvaluator([1.0, 0.0], blocks="each").run(r)
     with pytest.raises(DataError, match="3 shift values for 2"):
         SprtEvaluator([1.0, 1.0, 1.0]).run(r)
-    with pytest.raises(ModelError, match="hold"):
+    with pytest.raises(ParameterError, match="hold"):
         SprtEvaluator(1.0, hold=1.5)
-    with pytest.raises(ModelError, match="positive variances"):
+    with pytest.raises(ParameterError, match="positive variances"):
         SprtEvaluator(1.0, cov=[1.0, -1.0])
-    with pytest.raises(ModelError, match="finite"):
+    with pytest.raises(ParameterError, match="finite"):
         SprtEvaluator([np.nan])
     ev = SprtEvaluator(1.0).fit(r)
     with pytest.raises(DataError, match="fitted on 2"):
@@ -322,5 +322,5 @@ def test_sprt_bad_input():
         ev.step([0.0, 0.0])
     with pytest.raises(DataError, match="at least 10"):
         SprtEvaluator(1.0).fit(r.slice(stop=3.0))
-    with pytest.raises(ModelError, match="divergence"):
+    with pytest.raises(ParameterError, match="divergence"):
         sprt_asn(0.01, 0.01, 0.0)

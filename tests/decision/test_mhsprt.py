@@ -17,7 +17,7 @@ from fdikit.decision.mhsprt import (
     shiryayev_dp,
     shiryayev_threshold,
 )
-from fdikit.errors import DataError, ModelError
+from fdikit.errors import DataError, ParameterError
 from fdikit.residuals import Residuals
 
 EPS = np.finfo(float).eps
@@ -301,9 +301,9 @@ def test_uniform_mean_nondiagonal_fallback():
     """Non-diagonal Λ: 'erf' refuses; 'mixture' (seeded Sobol points in the box) is a proper density (integrates to
     1), reproducible for a seed, and within 1 % of the exact box convolution."""
     lam = np.array([[0.25, 0.15], [0.15, 0.25]])
-    with pytest.raises(ModelError, match="diagonal"):
+    with pytest.raises(ParameterError, match="diagonal"):
         UniformMeanDensity([0, 0], [1, 2], lam)
-    with pytest.raises(ModelError, match="rng"):
+    with pytest.raises(ParameterError, match="rng"):
         UniformMeanDensity([0, 0], [1, 2], lam, method="mixture")
     f = UniformMeanDensity([0, 0], [1, 2], lam, method="mixture", rng=7)
     g = UniformMeanDensity([0, 0], [1, 2], lam, method="mixture", rng=7)
@@ -362,11 +362,11 @@ def test_threshold_helper():
     """R-SPRT-6: F_T = 1 − α; from costs, the bound F_T ≤ (Q − C)/(Q + S)."""
     assert shiryayev_threshold(0.05) == pytest.approx(0.95)
     assert shiryayev_threshold(false_alarm_cost=10.0, delay_cost=0.5, measurement_cost=1.0) == pytest.approx(9 / 10.5)
-    with pytest.raises(ModelError):
+    with pytest.raises(ParameterError):
         shiryayev_threshold(0.05, false_alarm_cost=1.0, delay_cost=1.0)
-    with pytest.raises(ModelError):
+    with pytest.raises(ParameterError):
         shiryayev_threshold(false_alarm_cost=1.0, delay_cost=0.1, measurement_cost=2.0)  # violates (7.10b)
-    with pytest.raises(ModelError):
+    with pytest.raises(ParameterError):
         shiryayev_threshold(1.5)
 
 
@@ -538,31 +538,31 @@ def test_bad_input_is_refused():
                       (dict(threshold=0.0), r"\(0, 1\]"), (dict(threshold=1.2), r"\(0, 1\]"),
                       (dict(p={"f": 1e-3}), "missing"), (dict(pi=[0.1, 0.2, 0.3]), "3 entries"),
                       (dict(form="printed"), "form")]:
-        with pytest.raises(ModelError, match=match):
+        with pytest.raises(ParameterError, match=match):
             MhsprtEvaluator(ok, **kw)
-    with pytest.raises(ModelError, match="'none'"):
+    with pytest.raises(ParameterError, match="'none'"):
         MhsprtEvaluator({"f": g1, "g": g0})
-    with pytest.raises(ModelError, match="at least one fault"):
+    with pytest.raises(ParameterError, match="at least one fault"):
         MhsprtEvaluator({"none": g0})
-    with pytest.raises(ModelError, match="dimensions"):
+    with pytest.raises(ParameterError, match="dimensions"):
         MhsprtEvaluator({"none": g0, "f": GaussianDensity([0, 0], np.eye(2))})
-    with pytest.raises(ModelError, match="logpdf"):
+    with pytest.raises(ParameterError, match="logpdf"):
         MhsprtEvaluator({"none": g0, "f": object()})
-    with pytest.raises(ModelError, match="no densities"):
+    with pytest.raises(ParameterError, match="no densities"):
         MhsprtEvaluator().step([0.0])
     with pytest.raises(DataError, match="components"):
         MhsprtEvaluator(ok).run(_res(np.zeros((5, 2))))
-    with pytest.raises(ModelError, match="singular"):
+    with pytest.raises(ParameterError, match="singular"):
         GaussianDensity([0, 0], [[1.0, 1.0], [1.0, 1.0]])
-    with pytest.raises(ModelError, match="zero or negative variance"):
+    with pytest.raises(ParameterError, match="zero or negative variance"):
         GaussianDensity([0, 0], [[1.0, 0.0], [0.0, 0.0]])
-    with pytest.raises(ModelError, match="symmetric"):
+    with pytest.raises(ParameterError, match="symmetric"):
         GaussianDensity([0, 0], [[1.0, 0.5], [0.0, 1.0]])
     reg = GaussianDensity([0, 0], [[1.0, 1.0], [1.0, 1.0]], regularization=1e-6)  # ridge on the correlations
     np.testing.assert_allclose(reg.cov, [[1 + 1e-6, 1.0], [1.0, 1 + 1e-6]])
-    with pytest.raises(ModelError, match="low <= high"):
+    with pytest.raises(ParameterError, match="low <= high"):
         UniformMeanDensity(1.0, 0.0, 1.0)
-    with pytest.raises(ModelError, match="positive semi-definite"):
+    with pytest.raises(ParameterError, match="positive semi-definite"):
         gaussian_mean_density(0.0, 1.0, -1.0)
     rng = np.random.default_rng(0)
     sing = _res(np.column_stack([rng.standard_normal(50), np.ones(50)]))

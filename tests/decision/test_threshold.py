@@ -8,7 +8,7 @@ from fdikit import FaultModel
 from fdikit.decision import ThresholdEvaluator, alpha_from_rate
 from fdikit.design import kalman
 from fdikit.diagnosis import UNKNOWN_FAULT, isolate
-from fdikit.errors import DataError, ModelError
+from fdikit.errors import DataError, ParameterError
 from fdikit.residuals import Residuals
 from fdikit.simulate import simulate
 
@@ -107,18 +107,18 @@ def test_isolation_logic():
 
 def test_bad_input():
     r = Residuals(np.arange(5) * 1.0, np.zeros((5, 2)), ("a", "b"), ())
-    with pytest.raises(ModelError, match="no thresholds"):
+    with pytest.raises(ParameterError, match="no thresholds"):
         ThresholdEvaluator().run(r)
     with pytest.raises(DataError, match="3 thresholds for 2"):
         ThresholdEvaluator(thresholds=[1, 1, 1]).run(r)
-    with pytest.raises(ModelError, match="exactly one"):
+    with pytest.raises(ParameterError, match="exactly one"):
         ThresholdEvaluator().fit(r)
     with pytest.raises(DataError, match="at least 10"):
         ThresholdEvaluator().fit(r, false_alarm_prob=0.01)
     const = Residuals(np.arange(50) * 1.0, np.zeros((50, 1)), ("a",), ())
     with pytest.raises(DataError, match="constant"):
         ThresholdEvaluator().fit(const, false_alarm_prob=0.01)
-    with pytest.raises(ModelError, match="persistence"):
+    with pytest.raises(ParameterError, match="persistence"):
         ThresholdEvaluator(persistence=(3, 2))
-    with pytest.raises(ModelError, match="positive"):
+    with pytest.raises(ParameterError, match="positive"):
         ThresholdEvaluator(thresholds=[-1.0])

@@ -6,7 +6,7 @@ import scipy.signal
 
 from fdikit.decision import CusumEvaluator, ThresholdEvaluator
 from fdikit.decision.whiten import Whitened, yule_walker
-from fdikit.errors import DataError, ModelError
+from fdikit.errors import DataError, ParameterError
 from fdikit.residuals import Residuals
 
 
@@ -66,9 +66,9 @@ def test_batch_equals_online_with_bad_samples():
 
 
 def test_bad_input():
-    with pytest.raises(ModelError, match="order"):
+    with pytest.raises(ParameterError, match="order"):
         Whitened(ThresholdEvaluator(), order=0)
-    with pytest.raises(ModelError, match="not fitted"):
+    with pytest.raises(ParameterError, match="not fitted"):
         Whitened(ThresholdEvaluator()).run(_res(np.zeros((10, 1))))
     with pytest.raises(DataError, match="more than"):
         yule_walker(np.ones(5), 3)

@@ -15,7 +15,7 @@ Names: an evaluator remembers the residual names it was fitted on; ``run`` refus
 names differ (:class:`~fdikit.errors.DataError` naming the missing and the extra residuals, or the
 positions of reordered ones: use ``residuals.select(evaluator.names)``), and so does ``step`` when
 given ``names=`` (or a mapping ``{name: value}``).  Bad arguments raise
-:class:`~fdikit.decision.common.EvaluatorArgumentError`, a :class:`~fdikit.errors.ParameterError`.
+:class:`~fdikit.errors.ParameterError`.
 """
 
 from fdikit.decision.bnn import BnnEvaluator

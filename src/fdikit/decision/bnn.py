@@ -67,11 +67,11 @@ import numpy as np
 from scipy.special import expit
 
 from fdikit.decision.bnn_network import BnnNetwork
-from fdikit.decision.common import EvaluatorArgumentError, checked_residuals, step_vector
+from fdikit.decision.common import checked_residuals, step_vector
 from fdikit.decision.labelled_runs import _as_runs, _decisions, _Inputs, _targets
 from fdikit.decision.quasi_newton import QuasiNewtonResult, quasi_newton, robbins_monro_steps
 from fdikit.diagnosis import Diagnosis, StepDecision
-from fdikit.errors import DataError
+from fdikit.errors import DataError, ParameterError
 from fdikit.faults import NO_FAULT
 from fdikit.residuals import Residuals
 
@@ -192,22 +192,22 @@ class BnnEvaluator:
         rng: np.random.Generator | int | None = 0,
     ) -> None:
         if inputs not in ("magnitude", "raw"):
-            raise EvaluatorArgumentError(f"unknown inputs mode {inputs!r}; use 'magnitude' or 'raw'")
+            raise ParameterError(f"unknown inputs mode {inputs!r}; use 'magnitude' or 'raw'")
         if not 0 < threshold < 1:
-            raise EvaluatorArgumentError(f"the posterior threshold must be in (0, 1), got {threshold}")
+            raise ParameterError(f"the posterior threshold must be in (0, 1), got {threshold}")
         if isinstance(feedback, str) and feedback not in ("tied", "pad", "learned"):
-            raise EvaluatorArgumentError(f"unknown feedback {feedback!r}; use 'tied', 'pad', 'learned' or a matrix")
+            raise ParameterError(f"unknown feedback {feedback!r}; use 'tied', 'pad', 'learned' or a matrix")
         if hidden is not None and any(int(h) < 1 for h in hidden):
-            raise EvaluatorArgumentError(f"hidden widths must be positive integers, got {hidden}")
+            raise ParameterError(f"hidden widths must be positive integers, got {hidden}")
         if min(rm_window, rm_batch) < 1 or min(rm_steps, max_iter) < 0:
-            raise EvaluatorArgumentError("rm_window and rm_batch must be >= 1, max_iter and rm_steps >= 0")
+            raise ParameterError("rm_window and rm_batch must be >= 1, max_iter and rm_steps >= 0")
         robbins_monro_steps(1.0 if rho0 is None else rho0, 1, rm_exponent)  # validates
         self._hypotheses = None if hypotheses is None else tuple(hypotheses)
         self.hypotheses: tuple[str, ...] | None = self._hypotheses
         self.inputs, self.columns, self.scale = inputs, None if columns is None else tuple(columns), scale
         self.hidden = None if hidden is None else tuple(int(h) for h in hidden)
         if update not in ("dfp", "bfgs"):
-            raise EvaluatorArgumentError(f"unknown quasi-Newton update {update!r}; use 'dfp' or 'bfgs'")
+            raise ParameterError(f"unknown quasi-Newton update {update!r}; use 'dfp' or 'bfgs'")
         self.feedback, self.threshold, self.update = feedback, float(threshold), update
         self.max_iter, self.rm_steps = int(max_iter), int(rm_steps)
         self.rm_window, self.rm_batch = int(rm_window), int(rm_batch)
@@ -309,7 +309,7 @@ class BnnEvaluator:
             return np.ones(len(spec.keys))
         if isinstance(self.scale, str):
             if self.scale != "nominal":
-                raise EvaluatorArgumentError(f"unknown scale {self.scale!r}; use 'nominal', None, a number or an array")
+                raise ParameterError(f"unknown scale {self.scale!r}; use 'nominal', None, a number or an array")
             s = np.ones(len(spec.keys))
             X = np.abs(np.concatenate(feats))
             lab = np.concatenate([lb for _, lb in runs])
@@ -320,7 +320,7 @@ class BnnEvaluator:
         else:
             s = np.asarray(self.scale, dtype=float).ravel()
             if s.size not in (1, len(spec.keys)):
-                raise EvaluatorArgumentError(f"{s.size} scale values for {len(spec.keys)} inputs {list(spec.keys)}")
+                raise ParameterError(f"{s.size} scale values for {len(spec.keys)} inputs {list(spec.keys)}")
             s = np.broadcast_to(s, (len(spec.keys),)).copy()
         if not np.all(np.isfinite(s) & (s > 0)):
             bad = [k for k, v in zip(spec.keys, s) if not (np.isfinite(v) and v > 0)]
@@ -339,7 +339,7 @@ class BnnEvaluator:
     # ------------------------------------------------------------------ running
     def _ready(self) -> tuple[BnnNetwork, _Inputs]:
         if self.network is None or self._inputs is None:
-            raise EvaluatorArgumentError("the network is not trained; call fit() with labelled residuals first")
+            raise ParameterError("the network is not trained; call fit() with labelled residuals first")
         return self.network, self._inputs
 
     def run(self, residuals: Residuals) -> Diagnosis:

@@ -12,8 +12,7 @@ from collections.abc import Sequence
 import numpy as np
 from scipy.special import expit
 
-from fdikit.decision.common import EvaluatorArgumentError
-from fdikit.errors import DataError
+from fdikit.errors import DataError, ParameterError
 
 __all__ = ["BnnNetwork"]
 
@@ -29,13 +28,13 @@ class BnnNetwork:
     def __init__(self, widths: Sequence[int], feedback=None, learn_feedback: bool = False) -> None:
         widths = tuple(int(n) for n in widths)
         if len(widths) < 2 or min(widths) < 1:
-            raise EvaluatorArgumentError(
+            raise ParameterError(
                 f"a network needs at least an input and an output layer of positive width, got {widths}"
             )
         self.widths = widths
         F = np.eye(widths[0], widths[-1]) if feedback is None else np.asarray(feedback, dtype=float)
         if F.shape != (widths[0], widths[-1]) or not np.all(np.isfinite(F)):
-            raise EvaluatorArgumentError(
+            raise ParameterError(
                 f"the feedback matrix must be finite with shape {(widths[0], widths[-1])}, got {F.shape}"
             )
         self.feedback, self.learn_feedback = F, bool(learn_feedback)
@@ -49,7 +48,7 @@ class BnnNetwork:
         """``([W², …, W^q], [θ², …, θ^q], F)`` from the flat vector."""
         w = np.asarray(w, dtype=float)
         if w.shape != (self.n_params,):
-            raise EvaluatorArgumentError(f"weight vector has shape {w.shape}, the network needs ({self.n_params},)")
+            raise ParameterError(f"weight vector has shape {w.shape}, the network needs ({self.n_params},)")
         Ws, ths, k = [], [], 0
         for a, b in self._shapes:
             Ws.append(w[k : k + a * b].reshape(a, b))

@@ -6,20 +6,11 @@ from __future__ import annotations
 import numpy as np
 
 from fdikit.diagnosis import isolate
-from fdikit.errors import DataError, ModelError, ParameterError
+from fdikit.errors import DataError
 from fdikit.residuals import Residuals
 
-__all__ = ["EvaluatorArgumentError", "is_count", "k_of_n", "held", "isolate_cached", "checked_names",
+__all__ = ["is_count", "k_of_n", "held", "isolate_cached", "checked_names",
            "check_fitted_names", "checked_residuals", "step_vector"]
-
-
-class EvaluatorArgumentError(ParameterError, ModelError):
-    """A bad evaluator argument or an evaluator used before it is set up.
-
-    A :class:`~fdikit.errors.ParameterError` (the class for bad arguments); also a
-    :class:`~fdikit.errors.ModelError`, which the evaluators raised for these before, so existing
-    ``except ModelError`` code keeps working.
-    """
 
 
 def is_count(value, minimum: int) -> bool:

@@ -51,7 +51,6 @@ import numpy as np
 from scipy.optimize import brentq
 
 from fdikit.decision.common import (
-    EvaluatorArgumentError,
     checked_residuals,
     held,
     is_count,
@@ -60,7 +59,7 @@ from fdikit.decision.common import (
     step_vector,
 )
 from fdikit.diagnosis import Diagnosis, StepDecision, isolate
-from fdikit.errors import DataError
+from fdikit.errors import DataError, ParameterError
 from fdikit.residuals import Residuals
 
 __all__ = ["CusumEvaluator", "cusum_arl", "cusum_design", "SIEGMUND_CORRECTION"]
@@ -114,9 +113,9 @@ def cusum_arl(drift, threshold, shift=0.0, two_sided: bool = True):
     """
     nu, h = np.asarray(drift, dtype=float), np.asarray(threshold, dtype=float)
     if not np.all(nu >= 0):
-        raise EvaluatorArgumentError(f"CUSUM drift must be >= 0, got {drift}")
+        raise ParameterError(f"CUSUM drift must be >= 0, got {drift}")
     if not np.all(h > 0):
-        raise EvaluatorArgumentError(f"CUSUM threshold must be positive, got {threshold}")
+        raise ParameterError(f"CUSUM threshold must be positive, got {threshold}")
     delta = np.asarray(shift, dtype=float)
     b = h + SIEGMUND_CORRECTION
     up = _arl_one_sided(delta - nu, b)
@@ -133,7 +132,7 @@ def _threshold_for(arl0: float, nu: float, two_sided: bool) -> float:
     """The ``h`` whose Siegmund ARL0 equals ``arl0`` for drift ``nu``."""
     at_zero = float(_arl_one_sided(-nu, SIEGMUND_CORRECTION)) / (2.0 if two_sided else 1.0)
     if not arl0 > at_zero:
-        raise EvaluatorArgumentError(
+        raise ParameterError(
             f"target ARL0={arl0:g} is not above {at_zero:.3g} samples, the run length of h=0 with drift {nu:g}; "
             "ask for a longer mean time between false alarms"
         )
@@ -145,7 +144,7 @@ def _threshold_for(arl0: float, nu: float, two_sided: bool) -> float:
     while f(hi) < 0:
         hi *= 2.0
         if hi > 1e6:
-            raise EvaluatorArgumentError(f"no CUSUM threshold below 1e6 reaches ARL0={arl0:g} with drift {nu:g}")
+            raise ParameterError(f"no CUSUM threshold below 1e6 reaches ARL0={arl0:g} with drift {nu:g}")
     return float(brentq(f, 1e-12, hi, xtol=1e-13, rtol=4 * np.finfo(float).eps))
 
 
@@ -177,9 +176,9 @@ def cusum_design(arl0: float, shift: float, two_sided: bool = True) -> tuple[flo
     (0.5, 5.063)
     """
     if not np.isfinite(shift) or not shift > 0:
-        raise EvaluatorArgumentError(f"fault size (shift) must be positive, in units of sigma; got {shift}")
+        raise ParameterError(f"fault size (shift) must be positive, in units of sigma; got {shift}")
     if not np.isfinite(arl0) or not arl0 > 1:
-        raise EvaluatorArgumentError(f"target ARL0 must be a number of samples > 1, got {arl0}")
+        raise ParameterError(f"target ARL0 must be a number of samples > 1, got {arl0}")
     nu = 0.5 * float(shift)
     return nu, _threshold_for(float(arl0), nu, two_sided)
 
@@ -189,11 +188,11 @@ def _param(name: str, value, positive: bool = True):
         return None
     arr = np.atleast_1d(np.asarray(value, dtype=float))
     if arr.ndim != 1:
-        raise EvaluatorArgumentError(f"{name} must be a scalar or one value per residual, got shape {arr.shape}")
+        raise ParameterError(f"{name} must be a scalar or one value per residual, got shape {arr.shape}")
     if positive and not np.all(arr > 0):
-        raise EvaluatorArgumentError(f"{name} must be positive, got {arr}")
+        raise ParameterError(f"{name} must be positive, got {arr}")
     if not np.all(np.isfinite(arr)):
-        raise EvaluatorArgumentError(f"{name} must be finite, got {arr}")
+        raise ParameterError(f"{name} must be finite, got {arr}")
     return arr
 
 
@@ -329,9 +328,9 @@ class CusumEvaluator:
         self.mean = _param("mean", mean, positive=False)
         self.sigma = _param("sigma", sigma)
         if restart not in _RESTARTS:
-            raise EvaluatorArgumentError(f"restart must be one of {_RESTARTS}, got {restart!r}")
+            raise ParameterError(f"restart must be one of {_RESTARTS}, got {restart!r}")
         if not is_count(hold, 0):
-            raise EvaluatorArgumentError(f"hold must be a non-negative number of samples, got {hold}")
+            raise ParameterError(f"hold must be a non-negative number of samples, got {hold}")
         self.two_sided = bool(two_sided)
         self.restart = restart
         self.hold = int(hold)
@@ -377,17 +376,17 @@ class CusumEvaluator:
             bad = [residuals.names[i] for i in np.flatnonzero(~(sigma > 0))]
             raise DataError(f"residual(s) {bad} are constant on the fault-free data; cannot standardise them")
         if arl0 is not None and mean_time_between_false_alarms is not None:
-            raise EvaluatorArgumentError("give at most one of arl0 and mean_time_between_false_alarms")
+            raise ParameterError("give at most one of arl0 and mean_time_between_false_alarms")
         if mean_time_between_false_alarms is not None:
             dt = float(np.median(np.diff(residuals.t)))
             if not mean_time_between_false_alarms > 0 or not dt > 0:
-                raise EvaluatorArgumentError(
+                raise ParameterError(
                     f"need a positive mean time between false alarms and sample time, "
                     f"got {mean_time_between_false_alarms} s and dt={dt}"
                 )
             arl0 = mean_time_between_false_alarms / dt
         if shift is not None and arl0 is None:
-            raise EvaluatorArgumentError(
+            raise ParameterError(
                 "a fault size (shift=) needs a target arl0= or mean_time_between_false_alarms="
             )
         if arl0 is not None:
@@ -397,7 +396,7 @@ class CusumEvaluator:
             elif self.drift is not None:
                 nu = _widen("drift", self.drift, q, 0.5)
             else:
-                raise EvaluatorArgumentError(
+                raise ParameterError(
                     "to design the threshold from arl0, give shift= (the fault size) or a drift"
                 )
             h = np.array([_threshold_for(float(arl0) * q, float(v), self.two_sided) for v in nu])
@@ -411,7 +410,7 @@ class CusumEvaluator:
 
     def _ready(self, q: int, residuals: Residuals | None = None):
         if self.drift is None or self.threshold is None:
-            raise EvaluatorArgumentError(
+            raise ParameterError(
                 "the CUSUM has no drift/threshold; pass drift= and threshold= or call "
                 "fit(fault_free, arl0=..., shift=...)"
             )

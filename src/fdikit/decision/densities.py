@@ -13,8 +13,7 @@ import numpy as np
 import scipy.linalg
 from scipy.special import log_ndtr, logsumexp, ndtr
 
-from fdikit.decision.common import EvaluatorArgumentError
-from fdikit.errors import DataError
+from fdikit.errors import DataError, ParameterError
 
 __all__ = ["GaussianDensity", "UniformMeanDensity", "gaussian_mean_density"]
 
@@ -23,9 +22,9 @@ _LOG2PI = np.log(2.0 * np.pi)
 def _vec(value, name: str, n: int | None = None) -> np.ndarray:
     v = np.atleast_1d(np.asarray(value, dtype=float)).ravel()
     if n is not None and v.size != n:
-        raise EvaluatorArgumentError(f"{name} has {v.size} entries, need {n}")
+        raise ParameterError(f"{name} has {v.size} entries, need {n}")
     if not np.all(np.isfinite(v)):
-        raise EvaluatorArgumentError(f"{name} has non-finite entries: {v}")
+        raise ParameterError(f"{name} has non-finite entries: {v}")
     return v
 
 
@@ -34,25 +33,25 @@ def _cov(value, n: int, name: str = "covariance", regularization: float = 0.0, d
     c = np.asarray(value, dtype=float)
     c = c * np.eye(n) if c.ndim == 0 else np.diag(c) if c.ndim == 1 else c
     if c.shape != (n, n) or not np.all(np.isfinite(c)):
-        raise EvaluatorArgumentError(f"{name} must be a finite ({n}, {n}) matrix, got shape {c.shape}")
+        raise ParameterError(f"{name} must be a finite ({n}, {n}) matrix, got shape {c.shape}")
     scale = np.abs(c).max(initial=0.0)
     if np.abs(c - c.T).max(initial=0.0) > 1e-8 * scale:
-        raise EvaluatorArgumentError(f"{name} is not symmetric (max |Λ − Λᵀ| = {np.abs(c - c.T).max():.3g})")
+        raise ParameterError(f"{name} is not symmetric (max |Λ − Λᵀ| = {np.abs(c - c.T).max():.3g})")
     c = 0.5 * (c + c.T)
     if regularization:
         if not regularization > 0:
-            raise EvaluatorArgumentError(f"regularization must be positive, got {regularization}")
+            raise ParameterError(f"regularization must be positive, got {regularization}")
         c = c + regularization * np.diag(np.diag(c))
     if not definite:
         return c
     d = np.diag(c)
     if not np.all(d > 0):
-        raise EvaluatorArgumentError(
+        raise ParameterError(
             f"{name} has zero or negative variance in component(s) {np.flatnonzero(~(d > 0)).tolist()}; "
                          "drop constant residual components, or pass regularization=ε (adds ε·diag(Λ))")
     ev = np.linalg.eigvalsh(c / np.sqrt(np.outer(d, d)))  # of the correlation matrix: scale-free conditioning
     if not ev[0] > 1e3 * n * np.finfo(float).eps:
-        raise EvaluatorArgumentError(
+        raise ParameterError(
             f"{name} is singular (smallest correlation eigenvalue {ev[0]:.3g}: components are linearly dependent); "
             "remove duplicated residual components, or pass regularization=ε (adds ε·diag(Λ))"
         )
@@ -86,8 +85,8 @@ def _rows(x, n: int) -> np.ndarray:
 class GaussianDensity:
     """``N(mean, cov)``; ``cov`` may be a variance (scalar), variances (vector) or a matrix.
 
-    A singular covariance is refused (:class:`ModelError`) unless ``regularization=ε`` adds ``ε·diag(Λ)``
-    (shrinks the correlations by ``1/(1 + ε)``; a component of zero variance is refused either way).
+    A singular covariance is refused (:class:`~fdikit.errors.ParameterError`) unless ``regularization=ε``
+    adds ``ε·diag(Λ)`` (shrinks the correlations by ``1/(1 + ε)``; a component of zero variance is refused either way).
     """
 
     mean: np.ndarray
@@ -134,7 +133,7 @@ def gaussian_mean_density(center, cov, mean_cov, regularization: float = 0.0) ->
     lam = _cov(cov, n, "cov", definite=False)
     s = _cov(mean_cov, n, "mean_cov", definite=False)
     if np.linalg.eigvalsh(s)[0] < -1e-12 * np.abs(s).max(initial=0.0):
-        raise EvaluatorArgumentError("mean_cov must be positive semi-definite")
+        raise ParameterError("mean_cov must be positive semi-definite")
     return GaussianDensity(center, lam + s, regularization)
 
 
@@ -181,7 +180,7 @@ class UniformMeanDensity:
         low = _vec(self.low, "low")
         high = _vec(self.high, "high", low.size)
         if np.any(high < low):
-            raise EvaluatorArgumentError(f"the box needs low <= high, got low={low}, high={high}")
+            raise ParameterError(f"the box needs low <= high, got low={low}, high={high}")
         cov = _cov(self.cov, low.size, regularization=self.regularization)
         set_ = object.__setattr__
         set_(self, "low", low)
@@ -190,7 +189,7 @@ class UniformMeanDensity:
         if self.method == "erf":
             off = cov - np.diag(np.diag(cov))
             if np.abs(off).max(initial=0.0) > 0:
-                raise EvaluatorArgumentError(
+                raise ParameterError(
                     "the erf form of Prop. 7.5 needs a diagonal covariance (the box does not factor otherwise); "
                     "use method='mixture' with a seeded rng, or keep only the variances"
                 )
@@ -199,7 +198,7 @@ class UniformMeanDensity:
             set_(self, "_point", (high - low) <= 1e-8 * sig)
         elif self.method == "mixture":
             if self.rng is None:
-                raise EvaluatorArgumentError(
+                raise ParameterError(
                     "method='mixture' draws points in the box: pass rng= (a seed or a Generator)"
                 )
             from scipy.stats import qmc
@@ -210,7 +209,7 @@ class UniformMeanDensity:
             set_(self, "_g", g)
             set_(self, "_zm", _whiten(low + u * (high - low), g._W))
         else:
-            raise EvaluatorArgumentError(f"unknown method {self.method!r}; use 'erf' or 'mixture'")
+            raise ParameterError(f"unknown method {self.method!r}; use 'erf' or 'mixture'")
 
     @property
     def dim(self) -> int:

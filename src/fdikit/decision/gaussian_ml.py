@@ -18,10 +18,10 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 from scipy.special import logsumexp
 
-from fdikit.decision.common import EvaluatorArgumentError, checked_residuals, step_vector
+from fdikit.decision.common import checked_residuals, step_vector
 from fdikit.decision.labelled_runs import _as_runs, _Inputs
 from fdikit.diagnosis import Diagnosis, StepDecision
-from fdikit.errors import DataError
+from fdikit.errors import DataError, ParameterError
 from fdikit.faults import NO_FAULT
 from fdikit.residuals import Residuals
 
@@ -44,7 +44,7 @@ class GaussianMlEvaluator:
 
     def __init__(self, priors=None, *, inputs: str = "magnitude", columns: Sequence[str] | None = None) -> None:
         if inputs not in ("magnitude", "raw"):
-            raise EvaluatorArgumentError(f"unknown inputs mode {inputs!r}; use 'magnitude' or 'raw'")
+            raise ParameterError(f"unknown inputs mode {inputs!r}; use 'magnitude' or 'raw'")
         self.priors, self.inputs, self.columns = priors, inputs, None if columns is None else tuple(columns)
         self.classes: tuple[str, ...] = ()
         self.means: np.ndarray | None = None
@@ -91,7 +91,7 @@ class GaussianMlEvaluator:
     def _set(self, classes, M, S, counts) -> None:
         n = M.shape[1]
         if S.shape != (n, n) or not np.all(np.isfinite(S)) or not np.all(np.isfinite(M)):
-            raise EvaluatorArgumentError(f"covariance must be a finite {n}x{n} matrix and the means finite")
+            raise ParameterError(f"covariance must be a finite {n}x{n} matrix and the means finite")
         S = 0.5 * (S + S.T)
         ev = np.linalg.eigvalsh(S)
         if not ev[0] > 1e-12 * max(ev[-1], 0.0):
@@ -101,15 +101,15 @@ class GaussianMlEvaluator:
             pi = np.full(len(classes), 1.0 / len(classes))
         elif isinstance(self.priors, str):
             if self.priors != "empirical" or counts is None:
-                raise EvaluatorArgumentError(f"priors={self.priors!r}: use None, a mapping, or 'empirical' with fit()")
+                raise ParameterError(f"priors={self.priors!r}: use None, a mapping, or 'empirical' with fit()")
             pi = counts / counts.sum()
         else:
             missing = [c for c in classes if c not in self.priors]
             if missing:
-                raise EvaluatorArgumentError(f"priors lack the classes {missing}")
+                raise ParameterError(f"priors lack the classes {missing}")
             pi = np.array([float(self.priors[c]) for c in classes])
             if not np.all(pi > 0):
-                raise EvaluatorArgumentError(f"priors must be positive, got {pi}")
+                raise ParameterError(f"priors must be positive, got {pi}")
             pi = pi / pi.sum()
         self.classes, self.means, self.covariance, self.prior = tuple(classes), M, S, pi
         Li = np.linalg.solve(S, M.T).T  # rows Λ⁻¹ m_i
@@ -145,7 +145,7 @@ class GaussianMlEvaluator:
 
     def _ready(self) -> _Inputs:
         if self.means is None or self._inputs is None:
-            raise EvaluatorArgumentError("the classifier has no class model; call fit() or use from_moments()")
+            raise ParameterError("the classifier has no class model; call fit() or use from_moments()")
         return self._inputs
 
     def run(self, residuals: Residuals) -> Diagnosis:

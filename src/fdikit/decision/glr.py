@@ -41,7 +41,6 @@ import scipy.linalg
 from scipy.stats import chi2
 
 from fdikit.decision.common import (
-    EvaluatorArgumentError,
     checked_names,
     checked_residuals,
     held,
@@ -50,7 +49,7 @@ from fdikit.decision.common import (
     step_vector,
 )
 from fdikit.diagnosis import Diagnosis, StepDecision, isolate
-from fdikit.errors import DataError
+from fdikit.errors import DataError, ParameterError
 from fdikit.residuals import Residuals
 
 __all__ = ["BlockLayout", "GlrEvaluator", "as_covariance", "fit_moments", "glr_threshold", "residual_blocks"]
@@ -68,11 +67,11 @@ def glr_threshold(false_alarm_prob: float, window: int, dof: int = 1) -> float:
     9.095
     """
     if not 0 < false_alarm_prob < 1:
-        raise EvaluatorArgumentError(f"false-alarm probability must be in (0, 1), got {false_alarm_prob}")
+        raise ParameterError(f"false-alarm probability must be in (0, 1), got {false_alarm_prob}")
     if not is_count(window, 1):
-        raise EvaluatorArgumentError(f"window must be a positive number of samples, got {window}")
+        raise ParameterError(f"window must be a positive number of samples, got {window}")
     if not is_count(dof, 1):
-        raise EvaluatorArgumentError(f"dof (the block dimension) must be a positive integer, got {dof}")
+        raise ParameterError(f"dof (the block dimension) must be a positive integer, got {dof}")
     return float(chi2.isf(false_alarm_prob / window, dof) / 2.0)
 
 
@@ -104,13 +103,13 @@ def residual_blocks(
         elif blocks == "all":
             labels = ["all"] * q
         else:
-            raise EvaluatorArgumentError(
+            raise ParameterError(
                 f"blocks must be 'isolates', 'each', 'all' or one label per residual, got {blocks!r}"
             )
     else:
         labels = [str(b) for b in blocks]
         if len(labels) != q:
-            raise EvaluatorArgumentError(f"{len(labels)} block labels for {q} residuals")
+            raise ParameterError(f"{len(labels)} block labels for {q} residuals")
     out: dict[str, list[int]] = {}
     for i, lab in enumerate(labels):
         out.setdefault(str(lab), []).append(i)
@@ -176,7 +175,7 @@ class BlockLayout:
             if groups is not None:
                 gs = {groups[i] for i in ix}
                 if len(gs) != 1:
-                    raise EvaluatorArgumentError(
+                    raise ParameterError(
                         f"block {name!r} mixes residuals of the filters {sorted(gs)}; a block must "
                                      "lie within one filter of the bank")
                 grp.append(gs.pop())
@@ -218,11 +217,11 @@ def _check_cov(cov) -> np.ndarray | None:
         return None
     c = np.asarray(cov, dtype=float)
     if not np.all(np.isfinite(c)):
-        raise EvaluatorArgumentError("the covariance has non-finite entries")
+        raise ParameterError("the covariance has non-finite entries")
     if c.ndim <= 1 and not np.all(c > 0):
-        raise EvaluatorArgumentError(f"variances must be positive, got {c}")
+        raise ParameterError(f"variances must be positive, got {c}")
     if c.ndim == 2 and (c.shape[0] != c.shape[1] or not np.allclose(c, c.T, rtol=1e-10, atol=0)):
-        raise EvaluatorArgumentError(f"the covariance must be a symmetric square matrix, got shape {c.shape}")
+        raise ParameterError(f"the covariance must be a symmetric square matrix, got shape {c.shape}")
     return c
 
 
@@ -282,15 +281,15 @@ class GlrEvaluator:
         groups=None,
     ) -> None:
         if not is_count(window, 1):
-            raise EvaluatorArgumentError(f"window must be a positive number of samples, got {window}")
+            raise ParameterError(f"window must be a positive number of samples, got {window}")
         self.window = int(window)
         self.threshold = None if threshold is None else np.atleast_1d(np.asarray(threshold, dtype=float))
         if self.threshold is not None and not np.all(self.threshold > 0):
-            raise EvaluatorArgumentError(f"GLR threshold must be positive, got {self.threshold}")
+            raise ParameterError(f"GLR threshold must be positive, got {self.threshold}")
         self.mean = None if mean is None else np.atleast_1d(np.asarray(mean, dtype=float))
         self.cov = _check_cov(cov)
         if not (isinstance(blocks, str) or isinstance(blocks, Sequence)):
-            raise EvaluatorArgumentError(
+            raise ParameterError(
                 f"blocks must be 'isolates', 'each', 'all' or one label per residual, got {blocks!r}"
             )
         self.blocks = blocks if isinstance(blocks, str) else tuple(blocks)
@@ -311,12 +310,12 @@ class GlrEvaluator:
         docstring).  Without a target the threshold given to the constructor is kept.
         """
         if false_alarm_prob is not None and false_alarms_per_hour is not None:
-            raise EvaluatorArgumentError("give at most one of false_alarm_prob and false_alarms_per_hour")
+            raise ParameterError("give at most one of false_alarm_prob and false_alarms_per_hour")
         mean, cov = fit_moments(residuals)
         if false_alarms_per_hour is not None:
             dt = float(np.median(np.diff(residuals.t)))
             if not false_alarms_per_hour > 0 or not dt > 0:
-                raise EvaluatorArgumentError(
+                raise ParameterError(
                     f"need a positive rate and sample time, got {false_alarms_per_hour}/h and dt={dt}"
                 )
             false_alarm_prob = min(0.5, false_alarms_per_hour * dt / 3600.0)
@@ -324,7 +323,7 @@ class GlrEvaluator:
         layout = BlockLayout(self.blocks, residuals.names, iso, self.groups, cov)
         if false_alarm_prob is not None:
             if not 0 < false_alarm_prob < 1:
-                raise EvaluatorArgumentError(f"false-alarm probability must be in (0, 1), got {false_alarm_prob}")
+                raise ParameterError(f"false-alarm probability must be in (0, 1), got {false_alarm_prob}")
             G = len(layout.blocks)
             self.threshold = np.array([glr_threshold(false_alarm_prob / G, self.window, int(p)) for p in layout.dims])
             self.alpha = float(false_alarm_prob)
@@ -337,7 +336,7 @@ class GlrEvaluator:
     def _ready(self, q: int, residuals: Residuals | None = None):
         names = checked_names(q, residuals, self.names)
         if self.threshold is None:
-            raise EvaluatorArgumentError(
+            raise ParameterError(
                 "the GLR has no threshold; pass threshold= (see glr_threshold) or call "
                 "fit(fault_free, false_alarm_prob=...)"
             )

@@ -13,9 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fdikit.decision.common import EvaluatorArgumentError
 from fdikit.diagnosis import Diagnosis
-from fdikit.errors import DataError
+from fdikit.errors import DataError, ParameterError
 from fdikit.faults import NO_FAULT
 from fdikit.residuals import Residuals
 
@@ -33,7 +32,7 @@ class _Inputs:
     @classmethod
     def build(cls, names, isolates, mode: str, columns) -> _Inputs:
         if mode not in ("magnitude", "raw"):
-            raise EvaluatorArgumentError(f"unknown inputs mode {mode!r}; use 'magnitude' or 'raw'")
+            raise ParameterError(f"unknown inputs mode {mode!r}; use 'magnitude' or 'raw'")
         names = tuple(names)
         if columns is None:
             idx = list(range(len(names)))
@@ -67,7 +66,7 @@ def _as_runs(data, labels) -> list[tuple[Residuals, np.ndarray]]:
     runs: list[tuple[Residuals, np.ndarray]] = []
     if isinstance(data, Mapping):
         if labels is not None:
-            raise EvaluatorArgumentError(
+            raise ParameterError(
                 "give labels only with a sequence of Residuals; a mapping's keys are the labels"
             )
         for key, value in data.items():
@@ -79,7 +78,7 @@ def _as_runs(data, labels) -> list[tuple[Residuals, np.ndarray]]:
     else:
         items = [data] if isinstance(data, Residuals) else list(data)
         if labels is None:
-            raise EvaluatorArgumentError("a sequence of Residuals needs per-run labels (a str or one label per sample)")
+            raise ParameterError("a sequence of Residuals needs per-run labels (a str or one label per sample)")
         labels = [labels] if isinstance(labels, str) or isinstance(data, Residuals) else list(labels)
         if len(labels) != len(items):
             raise DataError(f"{len(labels)} label entries for {len(items)} runs")

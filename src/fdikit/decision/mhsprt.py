@@ -30,7 +30,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from fdikit.decision.common import EvaluatorArgumentError, checked_residuals, step_vector
+from fdikit.decision.common import checked_residuals, step_vector
 from fdikit.decision.densities import (
     GaussianDensity,
     UniformMeanDensity,
@@ -38,7 +38,7 @@ from fdikit.decision.densities import (
 )
 from fdikit.decision.shiryayev import ShiryayevDP, shiryayev_dp, shiryayev_threshold
 from fdikit.diagnosis import UNKNOWN_FAULT, Diagnosis, StepDecision
-from fdikit.errors import DataError, ModelError
+from fdikit.errors import DataError, ParameterError
 from fdikit.faults import NO_FAULT
 from fdikit.residuals import Residuals
 
@@ -64,7 +64,7 @@ def magnitude_blocks(residuals: Residuals, groups: Sequence[str] | None = None) 
     Euclidean magnitude is one measurement component; an untied residual is a block of its own.
     """
     if groups is not None and len(groups) != len(residuals.names):
-        raise EvaluatorArgumentError(f"{len(groups)} groups for {len(residuals.names)} residuals")
+        raise ParameterError(f"{len(groups)} groups for {len(residuals.names)} residuals")
     labels = []
     for k, (name, iso) in enumerate(zip(residuals.names, residuals.isolates)):
         base = iso if iso is not None else re.sub(r"\[\d+\]$", "", name)
@@ -76,16 +76,16 @@ def _per_fault(value, faults: tuple[str, ...], name: str) -> np.ndarray:
     if isinstance(value, Mapping):
         missing, extra = set(faults) - set(value), set(value) - set(faults)
         if missing or extra:
-            raise EvaluatorArgumentError(f"{name} must name exactly the faults {faults}; missing {sorted(missing)}, "
+            raise ParameterError(f"{name} must name exactly the faults {faults}; missing {sorted(missing)}, "
                              f"unknown {sorted(extra)}")
         v = np.array([float(value[f]) for f in faults])
     else:
         v = np.broadcast_to(np.asarray(value, dtype=float), (len(faults),)).copy() if np.ndim(value) == 0 else \
             np.asarray(value, dtype=float).ravel()
         if v.size != len(faults):
-            raise EvaluatorArgumentError(f"{name} has {v.size} entries for {len(faults)} faults {faults}")
+            raise ParameterError(f"{name} has {v.size} entries for {len(faults)} faults {faults}")
     if not np.all(np.isfinite(v)):
-        raise EvaluatorArgumentError(f"{name} has non-finite entries: {v}")
+        raise ParameterError(f"{name} has non-finite entries: {v}")
     return v
 
 
@@ -140,7 +140,7 @@ class MhsprtEvaluator:
     def __init__(self, densities: Mapping | None = None, *, p=1e-4, pi=1e-3, threshold=0.95,
                  form: str = "corrected", blocks: Sequence[str] | None = None) -> None:
         if form not in ("corrected", "literal"):
-            raise EvaluatorArgumentError(f"unknown form {form!r}; use 'corrected' or 'literal'")
+            raise ParameterError(f"unknown form {form!r}; use 'corrected' or 'literal'")
         self.form, self.p, self.pi, self.threshold = form, p, pi, threshold
         self.blocks = None if blocks is None else tuple(blocks)
         self.names: tuple[str, ...] | None = None
@@ -153,16 +153,16 @@ class MhsprtEvaluator:
     def _set_densities(self, densities: dict) -> None:
         densities = {str(k): v for k, v in densities.items()}
         if NO_FAULT not in densities:
-            raise EvaluatorArgumentError(
+            raise ParameterError(
                 f"densities need the fault-free hypothesis {NO_FAULT!r}; got {list(densities)}"
             )
         if len(densities) < 2:
-            raise EvaluatorArgumentError("need at least one fault hypothesis besides 'none'")
+            raise ParameterError("need at least one fault hypothesis besides 'none'")
         dims = {k: getattr(d, "dim", None) for k, d in densities.items()}
         if None in dims.values() or not all(callable(getattr(d, "logpdf", None)) for d in densities.values()):
-            raise EvaluatorArgumentError("each density needs a 'dim' and a 'logpdf(x)'; see GaussianDensity")
+            raise ParameterError("each density needs a 'dim' and a 'logpdf(x)'; see GaussianDensity")
         if len(set(dims.values())) != 1:
-            raise EvaluatorArgumentError(f"densities of different dimensions: {dims}")
+            raise ParameterError(f"densities of different dimensions: {dims}")
         self.densities = {NO_FAULT: densities[NO_FAULT], **{k: v for k, v in densities.items() if k != NO_FAULT}}
 
     @property
@@ -192,11 +192,11 @@ class MhsprtEvaluator:
         pi = _per_fault(self.pi, faults, "pi")
         ft = _per_fault(self.threshold, faults, "threshold")
         if np.any(p < 0) or not p.sum() < 1:
-            raise EvaluatorArgumentError(f"switch probabilities p must be >= 0 with sum < 1, got {p} (sum {p.sum():g})")
+            raise ParameterError(f"switch probabilities p must be >= 0 with sum < 1, got {p} (sum {p.sum():g})")
         if np.any(pi < 0) or not pi.sum() <= 1:
-            raise EvaluatorArgumentError(f"initial probabilities pi must be >= 0 with sum <= 1 (Prop. 7.2), got {pi}")
+            raise ParameterError(f"initial probabilities pi must be >= 0 with sum <= 1 (Prop. 7.2), got {pi}")
         if not np.all((ft > 0) & (ft <= 1)):
-            raise EvaluatorArgumentError(f"thresholds F_T must be in (0, 1], got {ft}")
+            raise ParameterError(f"thresholds F_T must be in (0, 1], got {ft}")
         self._p, self._ft = p, ft
         with np.errstate(divide="ignore"):
             self._log_p = np.concatenate([[-np.inf], np.log(p)])
@@ -228,7 +228,7 @@ class MhsprtEvaluator:
         (a singular fitted covariance is refused with :class:`DataError` otherwise).
         """
         if mean not in ("fixed", "gaussian", "uniform"):
-            raise EvaluatorArgumentError(f"unknown mean model {mean!r}; use 'fixed', 'gaussian' or 'uniform'")
+            raise ParameterError(f"unknown mean model {mean!r}; use 'fixed', 'gaussian' or 'uniform'")
         if NO_FAULT not in data or len(data) < 2:
             raise DataError(f"fit needs fault-free residuals under {NO_FAULT!r} and at least one fault; "
                             f"got {list(data)}")
@@ -270,7 +270,7 @@ class MhsprtEvaluator:
                 else:
                     dens[hyp] = UniformMeanDensity(mu.min(axis=0), mu.max(axis=0), lam, uniform_method, n_points,
                                                    rng, regularization)
-            except ModelError as exc:
+            except ParameterError as exc:
                 raise DataError(f"hypothesis {hyp!r}: {exc}") from exc
         self._set_densities(dens)
         self.names = names
@@ -317,7 +317,7 @@ class MhsprtEvaluator:
 
     def _need(self) -> None:
         if self.densities is None:
-            raise EvaluatorArgumentError("the evaluator has no densities; pass densities= or call fit() on residuals")
+            raise ParameterError("the evaluator has no densities; pass densities= or call fit() on residuals")
 
     # ------------------------------------------------------------------ batch
     def run(self, residuals: Residuals) -> Diagnosis:

@@ -16,8 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import line_search as _wolfe_search
 
-from fdikit.decision.common import EvaluatorArgumentError
-from fdikit.errors import DataError
+from fdikit.errors import DataError, ParameterError
 
 __all__ = ["QuasiNewtonResult", "quasi_newton", "robbins_monro_steps"]
 
@@ -111,7 +110,7 @@ def quasi_newton(
     line_search : ``(fun, x, d, f, g) -> (alpha, f_new, g_new)`` or None on failure, instead.
     """
     if update not in ("dfp", "bfgs"):
-        raise EvaluatorArgumentError(f"unknown quasi-Newton update {update!r}; use 'dfp' or 'bfgs'")
+        raise ParameterError(f"unknown quasi-Newton update {update!r}; use 'dfp' or 'bfgs'")
     c2 = (0.1 if update == "dfp" else 0.9) if c2 is None else float(c2)
     x = np.array(x0, dtype=float).ravel()
     f, g = fun(x)
@@ -172,9 +171,9 @@ def robbins_monro_steps(rho0: float, n: int, a: float = 0.75) -> np.ndarray:
     ``ρ_k > 0``; ``Σρ_k = ∞`` needs ``a ≤ 1`` and ``Σρ_k² = ρ_0² ζ(2a) < ∞`` needs ``a > 1/2``.
     """
     if not rho0 > 0:
-        raise EvaluatorArgumentError(f"the Robbins-Monro gain rho0 must be positive, got {rho0}")
+        raise ParameterError(f"the Robbins-Monro gain rho0 must be positive, got {rho0}")
     if not 0.5 < a <= 1:
-        raise EvaluatorArgumentError(
+        raise ParameterError(
             f"the Robbins-Monro exponent must be in (0.5, 1] (sum rho = inf, sum rho^2 < inf), got {a}"
         )
     return rho0 / np.arange(1, int(n) + 1, dtype=float) ** a

@@ -7,8 +7,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import expit
 
-from fdikit.decision.common import EvaluatorArgumentError
 from fdikit.decision.densities import GaussianDensity, UniformMeanDensity
+from fdikit.errors import ParameterError
 
 __all__ = ["ShiryayevDP", "shiryayev_dp", "shiryayev_threshold"]
 
@@ -29,14 +29,14 @@ def shiryayev_threshold(
       The exact value needs the expected cost-to-go ``A(F_T)``; :func:`shiryayev_dp` computes it for ``m = 1``.
     """
     if (false_alarm_prob is None) == (false_alarm_cost is None):
-        raise EvaluatorArgumentError("give either false_alarm_prob, or false_alarm_cost and delay_cost")
+        raise ParameterError("give either false_alarm_prob, or false_alarm_cost and delay_cost")
     if false_alarm_prob is not None:
         if not 0 < false_alarm_prob < 1:
-            raise EvaluatorArgumentError(f"false-alarm probability must be in (0, 1), got {false_alarm_prob}")
+            raise ParameterError(f"false-alarm probability must be in (0, 1), got {false_alarm_prob}")
         return 1.0 - float(false_alarm_prob)
     Q, S, C = float(false_alarm_cost), float(delay_cost if delay_cost is not None else np.nan), float(measurement_cost)
     if not (S >= 0 and C >= 0 and Q > C):
-        raise EvaluatorArgumentError(
+        raise ParameterError(
             f"need delay_cost >= 0, measurement_cost >= 0 and false_alarm_cost > measurement_cost "
                          f"(7.10b), got Q={Q}, S={S}, C={C}")
     return (Q - C) / (Q + S)
@@ -71,7 +71,7 @@ def _support(d) -> tuple[float, float]:
     if isinstance(d, UniformMeanDensity):
         s = np.sqrt(d.cov[0, 0])
         return d.low[0] - 12 * s, d.high[0] + 12 * s
-    raise EvaluatorArgumentError("pass x_range=(lo, hi) for densities other than GaussianDensity/UniformMeanDensity")
+    raise ParameterError("pass x_range=(lo, hi) for densities other than GaussianDensity/UniformMeanDensity")
 
 
 def shiryayev_dp(
@@ -88,12 +88,12 @@ def shiryayev_dp(
     bound; for ``m > 1`` the state is ``m``-dimensional and no grid is offered.
     """
     if not 0 <= p < 1:
-        raise EvaluatorArgumentError(f"p must be in [0, 1), got {p}")
+        raise ParameterError(f"p must be in [0, 1), got {p}")
     bound = shiryayev_threshold(false_alarm_cost=false_alarm_cost, delay_cost=delay_cost,
                                 measurement_cost=measurement_cost)
     Q, S, C = float(false_alarm_cost), float(delay_cost), float(measurement_cost)
     if getattr(f0, "dim", 1) != 1 or getattr(f1, "dim", 1) != 1:
-        raise EvaluatorArgumentError("shiryayev_dp handles scalar measurements only")
+        raise ParameterError("shiryayev_dp handles scalar measurements only")
     if x_range is None:
         (a0, b0), (a1, b1) = _support(f0), _support(f1)
         x_range = (min(a0, a1), max(b0, b1))

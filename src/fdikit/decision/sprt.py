@@ -43,7 +43,6 @@ from collections.abc import Sequence
 import numpy as np
 
 from fdikit.decision.common import (
-    EvaluatorArgumentError,
     checked_names,
     checked_residuals,
     held,
@@ -54,7 +53,7 @@ from fdikit.decision.common import (
 )
 from fdikit.decision.glr import BlockLayout, as_covariance, fit_moments
 from fdikit.diagnosis import Diagnosis, StepDecision, isolate
-from fdikit.errors import DataError
+from fdikit.errors import DataError, ParameterError
 from fdikit.residuals import Residuals
 
 __all__ = ["SprtEvaluator", "sprt_asn", "sprt_thresholds"]
@@ -69,7 +68,7 @@ def sprt_thresholds(alpha: float, beta: float) -> tuple[float, float]:
     [4.5951, -4.5951]
     """
     if not (0 < alpha < 1 and 0 < beta < 1 and alpha + beta < 1):
-        raise EvaluatorArgumentError(f"need 0 < alpha, beta < 1 and alpha + beta < 1, got alpha={alpha}, beta={beta}")
+        raise ParameterError(f"need 0 < alpha, beta < 1 and alpha + beta < 1, got alpha={alpha}, beta={beta}")
     return float(np.log((1 - beta) / alpha)), float(np.log(beta / (1 - alpha)))
 
 
@@ -81,13 +80,13 @@ def sprt_asn(alpha: float, beta: float, divergence: float, hypothesis: int = 1) 
     somewhat larger (by about ``0.583·√(2D)/D`` samples for Gaussian data).
     """
     if not divergence > 0:
-        raise EvaluatorArgumentError(f"the divergence must be positive, got {divergence}")
+        raise ParameterError(f"the divergence must be positive, got {divergence}")
     A, B = sprt_thresholds(alpha, beta)
     if hypothesis == 1:
         return ((1 - beta) * A + beta * B) / divergence
     if hypothesis == 0:
         return ((1 - alpha) * B + alpha * A) / (-divergence)
-    raise EvaluatorArgumentError(f"hypothesis must be 0 or 1, got {hypothesis}")
+    raise ParameterError(f"hypothesis must be 0 or 1, got {hypothesis}")
 
 
 def _advance(L: np.ndarray, done: np.ndarray, lam: np.ndarray, A: np.ndarray, B: np.ndarray, restart: bool):
@@ -178,18 +177,18 @@ class SprtEvaluator:
     ) -> None:
         self.shift = np.atleast_1d(np.asarray(shift, dtype=float))
         if self.shift.ndim != 1 or not np.all(np.isfinite(self.shift)):
-            raise EvaluatorArgumentError(f"shift must be finite, one value or one per residual; got {shift}")
+            raise ParameterError(f"shift must be finite, one value or one per residual; got {shift}")
         self.A, self.B = sprt_thresholds(alpha, beta)
         self.alpha, self.beta = float(alpha), float(beta)
         self.mean = None if mean is None else np.atleast_1d(np.asarray(mean, dtype=float))
         self.cov = None if cov is None else np.asarray(cov, dtype=float)
         if self.cov is not None and (not np.all(np.isfinite(self.cov)) or (self.cov.ndim < 2 and
                                                                             not np.all(self.cov > 0))):
-            raise EvaluatorArgumentError(f"cov must be finite with positive variances, got {cov}")
+            raise ParameterError(f"cov must be finite with positive variances, got {cov}")
         if not is_count(hold, 0):
-            raise EvaluatorArgumentError(f"hold must be a non-negative number of samples, got {hold}")
+            raise ParameterError(f"hold must be a non-negative number of samples, got {hold}")
         if not (isinstance(blocks, str) or isinstance(blocks, Sequence)):
-            raise EvaluatorArgumentError(
+            raise ParameterError(
                 f"blocks must be 'isolates', 'each', 'all' or one label per residual, got {blocks!r}"
             )
         self.blocks = blocks if isinstance(blocks, str) else tuple(blocks)
@@ -230,7 +229,7 @@ class SprtEvaluator:
         for g, (name, ix) in enumerate(layout.blocks):
             d = delta[list(ix)]
             if not np.any(d != 0):
-                raise EvaluatorArgumentError(
+                raise ParameterError(
                     f"block {name!r} has a zero shift; the SPRT needs a non-zero change δ to test"
                 )
             W = layout.whiten[g, : len(ix), : len(ix)]

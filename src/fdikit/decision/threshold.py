@@ -26,9 +26,9 @@ from collections import deque
 import numpy as np
 from scipy.stats import norm
 
-from fdikit.decision.common import EvaluatorArgumentError, checked_residuals, held, isolate_cached, k_of_n, step_vector
+from fdikit.decision.common import checked_residuals, held, isolate_cached, k_of_n, step_vector
 from fdikit.diagnosis import Diagnosis, StepDecision, isolate
-from fdikit.errors import DataError
+from fdikit.errors import DataError, ParameterError
 from fdikit.residuals import Residuals
 
 __all__ = ["ThresholdEvaluator", "alpha_from_rate"]
@@ -37,7 +37,7 @@ __all__ = ["ThresholdEvaluator", "alpha_from_rate"]
 def alpha_from_rate(false_alarms_per_hour: float, dt: float) -> float:
     """Per-sample false-alarm probability for a target number of false alarms per hour."""
     if not false_alarms_per_hour > 0 or not dt > 0:
-        raise EvaluatorArgumentError(f"need a positive rate and sample time, got {false_alarms_per_hour}/h and dt={dt}")
+        raise ParameterError(f"need a positive rate and sample time, got {false_alarms_per_hour}/h and dt={dt}")
     return min(1.0, false_alarms_per_hour * dt / 3600.0)
 
 
@@ -77,11 +77,11 @@ class ThresholdEvaluator:
     ) -> None:
         k, n = persistence
         if not (1 <= k <= n):
-            raise EvaluatorArgumentError(f"persistence (k, n) needs 1 <= k <= n, got {persistence}")
+            raise ParameterError(f"persistence (k, n) needs 1 <= k <= n, got {persistence}")
         self.persistence = (int(k), int(n))
         self.thresholds = None if thresholds is None else np.atleast_1d(np.asarray(thresholds, dtype=float))
         if self.thresholds is not None and not np.all(self.thresholds > 0):
-            raise EvaluatorArgumentError(f"thresholds must be positive, got {self.thresholds}")
+            raise ParameterError(f"thresholds must be positive, got {self.thresholds}")
         self.center = None if center is None else np.atleast_1d(np.asarray(center, dtype=float))
         self.isolates = None if isolates is None else tuple(isolates)
         self.groups = None if groups is None else tuple(groups)
@@ -99,7 +99,7 @@ class ThresholdEvaluator:
     ) -> ThresholdEvaluator:
         """Calibrate centres and thresholds on fault-free residuals; returns ``self``."""
         if (false_alarm_prob is None) == (false_alarms_per_hour is None):
-            raise EvaluatorArgumentError("give exactly one of false_alarm_prob and false_alarms_per_hour")
+            raise ParameterError("give exactly one of false_alarm_prob and false_alarms_per_hour")
         residuals = checked_residuals(residuals, None)
         r = residuals.r[residuals.valid]
         r = r[np.all(np.isfinite(r), axis=1)]
@@ -112,7 +112,7 @@ class ThresholdEvaluator:
         else:
             alpha = float(false_alarm_prob)
         if not 0 < alpha < 1:
-            raise EvaluatorArgumentError(f"false-alarm probability must be in (0, 1), got {alpha}")
+            raise ParameterError(f"false-alarm probability must be in (0, 1), got {alpha}")
         a_i = alpha / q
         center = r.mean(axis=0)
         if method == "gaussian":
@@ -126,7 +126,7 @@ class ThresholdEvaluator:
                 )
             tau = np.quantile(np.abs(r - center), 1 - a_i, axis=0)
         else:
-            raise EvaluatorArgumentError(f"unknown calibration method {method!r}; use 'gaussian' or 'empirical'")
+            raise ParameterError(f"unknown calibration method {method!r}; use 'gaussian' or 'empirical'")
         if not np.all(tau > 0):
             bad = [residuals.names[i] for i in np.flatnonzero(~(tau > 0))]
             raise DataError(f"residual(s) {bad} are constant on the fault-free data; cannot set a threshold")
@@ -139,7 +139,7 @@ class ThresholdEvaluator:
 
     def _ready(self, q: int, residuals: Residuals | None = None) -> tuple[np.ndarray, np.ndarray, tuple]:
         if self.thresholds is None:
-            raise EvaluatorArgumentError(
+            raise ParameterError(
                 "the evaluator has no thresholds; pass thresholds= or call fit() on fault-free residuals"
             )
         tau = np.broadcast_to(self.thresholds, (q,)) if self.thresholds.size in (1, q) else None

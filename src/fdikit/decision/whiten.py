@@ -18,9 +18,9 @@ import numpy as np
 import scipy.linalg
 import scipy.signal
 
-from fdikit.decision.common import EvaluatorArgumentError, is_count
+from fdikit.decision.common import is_count
 from fdikit.diagnosis import Diagnosis, StepDecision
-from fdikit.errors import DataError
+from fdikit.errors import DataError, ParameterError
 from fdikit.residuals import Residuals
 
 __all__ = ["Whitened", "yule_walker"]
@@ -50,7 +50,7 @@ class Whitened:
 
     def __init__(self, evaluator, order: int = 5) -> None:
         if not is_count(order, 1):
-            raise EvaluatorArgumentError(f"order must be a positive integer, got {order}")
+            raise ParameterError(f"order must be a positive integer, got {order}")
         self.evaluator, self.order = evaluator, int(order)
         self.coef: np.ndarray | None = None
         self.center: np.ndarray | None = None
@@ -69,7 +69,7 @@ class Whitened:
     def whiten(self, residuals: Residuals) -> Residuals:
         """The innovations ``e`` of ``residuals`` (NaN, invalid, on bad samples)."""
         if self.coef is None:
-            raise EvaluatorArgumentError("the whitener is not fitted; call fit() on fault-free residuals")
+            raise ParameterError("the whitener is not fitted; call fit() on fault-free residuals")
         if residuals.r.shape[1] != self.coef.shape[0]:
             raise DataError(f"{residuals.r.shape[1]} residuals, the whitener was fitted on {self.coef.shape[0]}")
         valid = residuals.valid & np.all(np.isfinite(residuals.r), axis=1)
@@ -94,7 +94,7 @@ class Whitened:
     def step(self, r) -> StepDecision:
         """One sample: the innovation from the last ``p`` valid samples, then the wrapped ``step``."""
         if self.coef is None:
-            raise EvaluatorArgumentError("the whitener is not fitted; call fit() on fault-free residuals")
+            raise ParameterError("the whitener is not fitted; call fit() on fault-free residuals")
         r = np.asarray(r, dtype=float).ravel()
         if not np.all(np.isfinite(r)):
             return self.evaluator.step(r)  # the wrapped evaluator holds its decision
