@@ -31,7 +31,7 @@ from fdikit.lti import dlsim_blocked
 from fdikit.model import GROUPS, FaultModel
 from fdikit.trace import Trace
 
-__all__ = ["ResidualGenerator", "ResidualStepper", "Residuals", "stack_generators"]
+__all__ = ["ResidualGenerator", "ResidualStepper", "Residuals", "stack_generators", "check_signals"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -202,7 +202,7 @@ class ResidualGenerator:
         """
         if not isinstance(trace, Trace):
             raise DataError(f"trace must be a fdikit.trace.Trace, got {type(trace).__name__}")
-        _check_signals(trace, self.controls, self.outputs)
+        check_signals(trace, self.controls, self.outputs)
 
     def inputs_from(self, trace: Trace) -> np.ndarray:
         """The (N, m + p) block ``[u, y]`` this generator reads, taken from a trace by name."""
@@ -370,8 +370,22 @@ class ResidualGenerator:
                           inputs=list(self.controls) + list(self.outputs), outputs=list(self.residuals))
 
 
-def _check_signals(trace: Trace, controls: Sequence[str], outputs: Sequence[str]) -> None:
-    """:class:`DataError` naming the controls/outputs a trace lacks (and where a misplaced one is)."""
+def check_signals(trace: Trace, controls: Sequence[str], outputs: Sequence[str]) -> None:
+    """Refuse a trace that lacks signals a generator reads.
+
+    Parameters
+    ----------
+    trace : Trace
+        The trace to read.
+    controls, outputs : sequence of str
+        The signal names the generator reads.
+
+    Raises
+    ------
+    DataError
+        Naming each missing control/output, where a misplaced one was found instead (an output
+        recorded as a control or the reverse), and the trace's signals the generator does not read.
+    """
     problems = []
     for kind, want, have, other, other_kind in (
         ("control", controls, trace.controls, trace.outputs, "output"),

@@ -49,7 +49,7 @@ from fdikit.design.dae_parity import time_varying_bar as _bar
 from fdikit.errors import DataError, DesignError, ModelError, ParameterError
 from fdikit.linalg import rank
 from fdikit.model import FaultModel
-from fdikit.residuals import Residuals, _check_signals
+from fdikit.residuals import Residuals, check_signals
 from fdikit.trace import Trace
 
 __all__ = [
@@ -260,7 +260,7 @@ class ScheduledResidualGenerator:
             raise DataError(f"trace must be a fdikit.trace.Trace, got {type(trace).__name__}")
         if len(trace) > 1 and not np.isclose(trace.dt, self.dt, rtol=1e-6):
             raise DataError(f"data sampled at dt={trace.dt:g} but the filter runs at dt={self.dt:g}; resample")
-        _check_signals(trace, self.controls, self.outputs)
+        check_signals(trace, self.controls, self.outputs)
         rho = self._schedule_of(trace, schedule)
         n_dec = self.recovery_length(recovery_tol)
         z = np.hstack([trace.columns("y", self.outputs), trace.columns("u", self.controls)])
@@ -380,7 +380,7 @@ class ScheduledStepper:
             raise DataError(f"trace must be a fdikit.trace.Trace, got {type(trace).__name__}")
         if len(trace) > 1 and not np.isclose(trace.dt, g.dt, rtol=1e-6):
             raise DataError(f"data sampled at dt={trace.dt:g} but the filter runs at dt={g.dt:g}; resample")
-        _check_signals(trace, g.controls, g.outputs)
+        check_signals(trace, g.controls, g.outputs)
         rho = g._schedule_of(trace, schedule)
         U, Y = trace.columns("u", g.controls), trace.columns("y", g.outputs)
         r = np.empty(len(trace))
