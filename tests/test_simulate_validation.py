@@ -38,13 +38,9 @@ from fdikit.faults import (
 )
 from fdikit.lti import dlsim_blocked
 from fdikit.model import FaultModel
-from fdikit.simulate import (
-    NonlinearPlant,
-    _available_memory,
-    _simulation_bytes,
-    simulate,
-    simulate_scheduled,
-)
+from fdikit.simulate import NonlinearPlant, simulate, simulate_scheduled
+from fdikit.simulate_checks import _available_memory
+from fdikit.simulate_checks import simulation_bytes as _simulation_bytes
 
 LN_MAX = math.log(np.finfo(float).max)  # 709.78: e^x overflows for x above this
 
@@ -257,7 +253,7 @@ def test_huge_duration_is_refused_at_once_with_the_size():
 
 def test_memory_estimate_against_a_small_budget(monkeypatch):
     """With 1 MiB available, 100 samples run and 100 000 are refused with the bytes they need."""
-    import fdikit.simulate as sim
+    import fdikit.simulate_checks as sim
 
     monkeypatch.setattr(sim, "_available_memory", lambda: (2.0**20, "test budget"))
     simulate(plant(), duration=99 * DT, dt=DT)
