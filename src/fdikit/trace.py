@@ -5,50 +5,28 @@ generators and evaluators consume.  It exports to pandas and saves to Parquet.
 
 File format and integrity
 -------------------------
-:meth:`Trace.save` writes one Parquet file with the float64 columns ``t``, ``u:<name>``,
-``y:<name>``, ``x:<name>``, ``d:<name>`` and the string column ``fault``; the signal names
-and ``meta`` are JSON in the schema metadata key ``fdikit``, and ``fdikit.sha256`` holds a
-SHA-256 digest over that JSON and every column's values.  The round trip with
-:meth:`Trace.load` is exact: floats bit for bit (NaN payloads and signed zeros included),
-labels and names as the same Unicode strings, ``meta`` as the same JSON values.
-
-Three layers protect a saved trace:
-
-* the file is written atomically (:func:`fdikit.atomic.atomic_path`: a temporary file in the
-  same folder, ``fsync``, rename), so a crash or an error leaves the previous file or the new
-  one, never a truncated mix;
-* every Parquet page carries a CRC-32 checksum that is verified on load (pyarrow ≥ 15);
-* the content digest covers what the page checksums do not: page headers and the footer
-  metadata (names, ``meta``), so a damaged file is refused even where a damaged byte would
-  still decode.
-
-Every malformed or damaged file makes :meth:`Trace.load` raise :class:`DataError` naming the
-file and the problem; it never returns a trace that differs from the one saved.
+:meth:`Trace.save` writes one Parquet file with a float64 column per time and signal and a
+string column ``fault``; the names and ``meta`` are JSON in the schema metadata, with a SHA-256
+digest of the content.  The file is written atomically, every page carries a CRC-32 checksum,
+and :meth:`Trace.load` verifies both and the structure of the file: every malformed or damaged
+file makes it raise :class:`DataError` naming the file and the problem; it never returns a
+trace that differs from the one saved.  The round trip is exact.  The format and its checks
+are in :mod:`fdikit.trace_io`.
 """
 
 from __future__ import annotations
 
-import hashlib
-import json
-import os
-from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from fdikit.atomic import atomic_path
-from fdikit.errors import DataError, ParameterError
+from fdikit.errors import DataError
 from fdikit.faults import NO_FAULT
+from fdikit.trace_io import COLUMN_PREFIX, read_trace, write_trace
 
 __all__ = ["Trace"]
-
-_PREFIX = {"u": "u:", "y": "y:", "x": "x:", "d": "d:"}
-_BLOCKS = (("u", "controls"), ("y", "outputs"), ("x", "states"), ("d", "disturbances"))
-_META_KEY = b"fdikit"
-_DIGEST_KEY = b"fdikit.sha256"
-_DIGEST_TAG = b"fdikit-trace-sha256-v1\x00"
 
 
 # ---------------------------------------------------------------------- validation helpers
@@ -93,8 +71,11 @@ def _block(name: str, value, n: int, names: Sequence[str]) -> np.ndarray:
     return arr
 
 
-def _names(attr: str, names) -> tuple[str, ...]:
-    """Signal names of one block: non-empty UTF-8 strings, unique within the block."""
+def check_names(attr: str, names) -> tuple[str, ...]:
+    """Signal names of one block: non-empty UTF-8 strings, unique within the block.
+
+    Also checks the names read from a file (:mod:`fdikit.trace_io`).
+    """
     if isinstance(names, str | bytes):
         raise DataError(
             f"trace {attr} must be a sequence of names, got the single string {names!r}; write [{names!r}] "
@@ -203,59 +184,11 @@ def _json_value(v, where: str, depth: int = 0):
     )
 
 
-def _json_meta(meta) -> dict:
+def json_meta(meta) -> dict:
+    """``meta`` as plain JSON values; also re-checks it when a trace is saved (:mod:`fdikit.trace_io`)."""
     if not isinstance(meta, Mapping):
         raise DataError(f"trace meta must be a dict (JSON object), got {type(meta).__name__}")
     return _json_value(meta, "meta")
-
-
-def _as_path(path) -> Path:
-    if not isinstance(path, str | os.PathLike):
-        raise ParameterError(f"path must be a file name (str or pathlib.Path), got {type(path).__name__}")
-    try:
-        return Path(path)
-    except TypeError as exc:  # a PathLike whose __fspath__ returns bytes
-        raise ParameterError(f"path must be a file name (str or pathlib.Path): {exc}") from None
-
-
-def _digest(info: bytes, columns: Sequence[tuple[str, np.ndarray]], labels: Sequence[str], codes) -> str:
-    """SHA-256 over the fdikit metadata bytes, the float64 columns (little-endian) and the fault labels.
-
-    The labels enter as their distinct values in order of first appearance (UTF-8, each with its
-    length) and the per-sample index into them, which is what :func:`pyarrow.compute.dictionary_encode`
-    gives for the same label sequence on save and on load.
-    """
-    h = hashlib.sha256(_DIGEST_TAG)
-    h.update(len(info).to_bytes(8, "little"))
-    h.update(info)
-    for name, col in columns:
-        raw = name.encode("utf-8")
-        h.update(len(raw).to_bytes(8, "little"))
-        h.update(raw)
-        h.update(len(col).to_bytes(8, "little"))
-        h.update(np.ascontiguousarray(col, dtype="<f8"))
-    h.update(len(labels).to_bytes(8, "little"))
-    for label in labels:
-        raw = label.encode("utf-8")
-        h.update(len(raw).to_bytes(8, "little"))
-        h.update(raw)
-    h.update(np.ascontiguousarray(codes, dtype="<i8"))
-    return h.hexdigest()
-
-
-def _encode_labels(arr, pa, pc) -> tuple[list[str], np.ndarray]:
-    """Distinct labels (first-appearance order) and the per-sample codes of a pyarrow string array."""
-    enc = pc.dictionary_encode(arr)
-    return enc.dictionary.to_pylist(), enc.indices.to_numpy(zero_copy_only=False)
-
-
-def _read_error(path: Path, exc: BaseException) -> str:
-    msg = " ".join(str(exc).split())
-    if "CRC" in msg or "checksum" in msg.lower():
-        return (f"trace file {path} is corrupted: a Parquet page checksum does not match its data ({msg}); "
-                "restore the file from a copy or re-create it")
-    return (f"cannot read trace file {path}: it is not a Parquet file, or it is truncated or corrupted "
-            f"({type(exc).__name__}: {msg})")
 
 
 @dataclass(frozen=True, eq=False)
@@ -309,13 +242,13 @@ class Trace:
         set_ = object.__setattr__
         set_(self, "t", t)
         for attr in ("controls", "outputs", "states", "disturbances"):
-            set_(self, attr, _names(attr, getattr(self, attr)))
+            set_(self, attr, check_names(attr, getattr(self, attr)))
         set_(self, "u", _block("u", self.u, n, self.controls))
         set_(self, "y", _block("y", self.y, n, self.outputs))
         set_(self, "x", _block("x", np.zeros((n, 0)) if self.x is None else self.x, n, self.states))
         set_(self, "d", _block("d", np.zeros((n, 0)) if self.d is None else self.d, n, self.disturbances))
         set_(self, "fault", _fault(self.fault, n))
-        set_(self, "meta", _json_meta(self.meta))
+        set_(self, "meta", json_meta(self.meta))
 
     # ------------------------------------------------------------------ access
     def __len__(self) -> int:
@@ -377,21 +310,9 @@ class Trace:
         for kind, names in (("u", self.controls), ("y", self.outputs), ("x", self.states), ("d", self.disturbances)):
             block = getattr(self, kind)
             for j, nm in enumerate(names):
-                data[_PREFIX[kind] + nm] = block[:, j]
+                data[COLUMN_PREFIX[kind] + nm] = block[:, j]
         data["fault"] = self.fault
         return pd.DataFrame(data, index=pd.Index(self.t, name="t"))
-
-    def _float_columns(self) -> list[tuple[str, np.ndarray]]:
-        cols = [("t", self.t)]
-        for kind, attr in _BLOCKS:
-            block = getattr(self, kind)
-            cols += [(_PREFIX[kind] + nm, block[:, j]) for j, nm in enumerate(getattr(self, attr))]
-        return [(name, np.ascontiguousarray(col, dtype=np.float64)) for name, col in cols]
-
-    def _info_bytes(self) -> bytes:
-        info = {attr: list(getattr(self, attr)) for _, attr in _BLOCKS}
-        info["meta"] = _json_meta(self.meta)  # again: meta is a mutable dict
-        return json.dumps(info, ensure_ascii=True, allow_nan=True).encode("ascii")
 
     def save(self, path: str | Path) -> Path:
         """Write the trace to a Parquet file, atomically; the round trip with :meth:`load` is exact.
@@ -421,36 +342,7 @@ class Trace:
         Every page is written with a CRC-32 checksum and the schema metadata holds a SHA-256
         digest of the content (see the module docstring).
         """
-        import pyarrow as pa
-        import pyarrow.compute as pc
-        import pyarrow.parquet as pq
-
-        path = _as_path(path)
-        info = self._info_bytes()
-        columns = self._float_columns()
-        try:
-            labels = pa.array(self.fault.tolist(), type=pa.string())  # (from the numpy array, a NUL would cut a label)
-        except (UnicodeError, pa.ArrowException):
-            for k, label in enumerate(self.fault.tolist()):
-                try:
-                    label.encode("utf-8")
-                except UnicodeEncodeError:
-                    raise DataError(
-                        f"cannot save the trace to {path}: fault label at sample {k} ({label!r}) is not valid UTF-8 "
-                        "text (it holds a lone surrogate)"
-                    ) from None
-            raise
-        table = pa.Table.from_arrays(
-            [pa.array(col, type=pa.float64()) for _, col in columns] + [labels],
-            names=[name for name, _ in columns] + ["fault"],
-            metadata={_META_KEY: info, _DIGEST_KEY: _digest(info, columns, *_encode_labels(labels, pa, pc)).encode()},
-        )
-        with atomic_path(path, suffix=".parquet") as tmp:  # its own failures are DataErrors naming the file
-            try:
-                pq.write_table(table, tmp, write_page_checksum=True)
-            except (OSError, pa.ArrowException) as exc:
-                raise DataError(f"cannot write trace file {path}: {exc}") from exc
-        return path
+        return write_trace(self, path)
 
     @classmethod
     def load(cls, path: str | Path, *, verify: bool = True) -> Trace:
@@ -481,147 +373,7 @@ class Trace:
             null or empty label, a digest that does not match ...); the message names the file
             and the problem.
         """
-        import pyarrow as pa
-        import pyarrow.compute as pc
-        import pyarrow.parquet as pq
-
-        path = _as_path(path)
-        if not isinstance(verify, bool):
-            raise ParameterError(f"verify must be True or False, got {verify!r}")
-        try:
-            if path.is_dir():
-                raise DataError(f"cannot read trace file {path}: it is a folder; give the .parquet file in it")
-            if not path.exists():
-                raise DataError(f"no trace file at {path}")
-            if not path.is_file():
-                raise DataError(f"cannot read trace file {path}: it is not a regular file (a pipe or a device?)")
-            with open(path, "rb"):
-                pass
-            size = path.stat().st_size
-        except (OSError, ValueError) as exc:
-            raise DataError(f"cannot read trace file {path}: {getattr(exc, 'strerror', None) or exc}") from None
-        if size == 0:
-            raise DataError(f"trace file {path} is empty (0 bytes): it was never written completely; re-create it")
-        try:
-            table = pq.ParquetFile(path, page_checksum_verification=True).read()
-        except Exception as exc:  # noqa: BLE001 - whatever a damaged file makes pyarrow raise
-            raise DataError(_read_error(path, exc)) from exc
-
-        md = table.schema.metadata or {}
-        raw = md.get(_META_KEY)
-        if raw is None:
-            raise DataError(f"{path} is a Parquet file but not an fdikit trace (no 'fdikit' schema metadata)")
-        names = cls._names_from_info(path, raw)
-        meta = names.pop("meta")
-
-        # ---- columns: exactly t, the listed signals and fault; float64 signals, string labels, no nulls
-        present = table.schema.names
-        dup = sorted(nm for nm, c in Counter(present).items() if c > 1)
-        if dup:
-            raise DataError(f"{path} has duplicate columns {dup}; a trace file holds each signal once")
-        expected = ["t"] + [_PREFIX[k] + nm for k, attr in _BLOCKS for nm in names[attr]] + ["fault"]
-        missing = [c for c in expected if c not in set(present)]
-        if missing:
-            raise DataError(f"{path} is missing the column(s) {missing} that its fdikit metadata lists")
-        unexpected = [c for c in present if c not in set(expected)]
-        if unexpected:
-            raise DataError(f"{path} has unexpected column(s) {unexpected} that its fdikit metadata does not list")
-        for c in expected[:-1]:
-            if table.schema.field(c).type != pa.float64():
-                raise DataError(f"{path}: column {c!r} has type {table.schema.field(c).type}; trace signals must be "
-                                "float64 (double)")
-        cls._check_label_column(path, table.column("fault"), pa, pc)
-
-        # ---- integrity: the content digest must be there (unless verify=False) and match
-        stored = md.get(_DIGEST_KEY)
-        if stored is None and verify:
-            raise DataError(
-                f"{path} has no content digest ('fdikit.sha256' metadata): it was not written by Trace.save, "
-                "or its metadata is damaged. Trace.load(path, verify=False) reads it without that check"
-            )
-        arrays: dict[str, np.ndarray] = {}
-        for c in expected[:-1]:
-            col = table.column(c)
-            if col.null_count and stored is not None:
-                first = int(np.flatnonzero(pc.is_null(col).to_numpy(zero_copy_only=False))[0])
-                raise DataError(
-                    f"trace file {path} is corrupted: column {c!r} has {col.null_count} null value(s), the first at "
-                    f"sample {first}; Trace.save writes NaN, never null"
-                )
-            # nulls (only in files without a digest: fdikit before the digest stored NaN as null) read as NaN
-            arrays[c] = np.asarray(col.to_numpy(), dtype=float)
-        fault, labels, codes = cls._labels_from(path, table.column("fault"), pa, pc)
-        if stored is not None and stored != _digest(raw, list(arrays.items()), labels, codes).encode("ascii"):
-            raise DataError(
-                f"trace file {path} is corrupted: its content digest (SHA-256 over the metadata and every column) "
-                "does not match the stored one, so the file changed after it was written; restore it from a copy"
-            )
-
-        n = len(fault)
-        blocks = {}
-        for kind, attr in _BLOCKS:
-            cols = [arrays[_PREFIX[kind] + nm] for nm in names[attr]]
-            blocks[kind] = np.column_stack(cols) if cols else np.zeros((n, 0))
-        try:
-            return cls(t=np.array(arrays["t"]), u=blocks["u"], y=blocks["y"], x=blocks["x"], d=blocks["d"], fault=fault,
-                       meta=meta, **names)
-        except DataError as exc:
-            raise DataError(f"trace file {path}: {exc}") from None
-
-    @staticmethod
-    def _names_from_info(path: Path, raw: bytes) -> dict:
-        """The signal names and meta from the 'fdikit' metadata, checked."""
-        try:
-            info = json.loads(raw.decode("utf-8"))
-        except UnicodeDecodeError:
-            raise DataError(f"{path}: its 'fdikit' metadata is not UTF-8 text; the file is damaged") from None
-        except ValueError as exc:
-            raise DataError(f"{path}: its 'fdikit' metadata is not valid JSON ({exc}); the file is damaged") from None
-        if not isinstance(info, dict):
-            raise DataError(f"{path}: its 'fdikit' metadata must be a JSON object, got {type(info).__name__}")
-        out = {}
-        for _, attr in _BLOCKS:
-            if attr not in info:
-                raise DataError(f"{path}: the {attr!r} list is missing from its 'fdikit' metadata")
-            try:
-                out[attr] = _names(attr, info[attr])
-            except DataError as exc:
-                raise DataError(f"{path}: {exc}") from None
-        if "meta" not in info:
-            raise DataError(f"{path}: the 'meta' dict is missing from its 'fdikit' metadata")
-        if not isinstance(info["meta"], dict):
-            raise DataError(f"{path}: 'meta' in its 'fdikit' metadata is a {type(info['meta']).__name__}, not a dict")
-        out["meta"] = info["meta"]
-        return out
-
-    @staticmethod
-    def _check_label_column(path: Path, col, pa, pc) -> None:
-        """The 'fault' column must hold strings and no null."""
-        typ = col.type
-        value_type = typ.value_type if pa.types.is_dictionary(typ) else typ
-        is_text = pa.types.is_string(value_type) or pa.types.is_large_string(value_type) or (
-            hasattr(pa.types, "is_string_view") and pa.types.is_string_view(value_type))
-        if not is_text:
-            raise DataError(f"{path}: column 'fault' has type {typ}; fault labels must be strings")
-        if col.null_count:
-            first = int(np.flatnonzero(pc.is_null(col).to_numpy(zero_copy_only=False))[0])
-            raise DataError(
-                f"{path}: column 'fault' has a null label at sample {first} ({col.null_count} nulls in all); "
-                f"every sample needs a label ({NO_FAULT!r} where healthy)"
-            )
-
-    @staticmethod
-    def _labels_from(path: Path, col, pa, pc) -> tuple[np.ndarray, list[str], np.ndarray]:
-        """The (checked) 'fault' column as a numpy str array, with its distinct labels and codes."""
-        arr = col.combine_chunks()
-        if pa.types.is_dictionary(arr.type):
-            arr = arr.cast(arr.type.value_type)
-        labels, codes = _encode_labels(arr, pa, pc)
-        bad = [s for s in labels if s.endswith("\x00")]
-        if bad:
-            raise DataError(f"{path}: the label {bad[0]!r} in column 'fault' ends with a NUL character")
-        fault = np.asarray(labels, dtype=str)[codes] if labels else np.full(0, NO_FAULT)
-        return fault, labels, codes
+        return read_trace(path, verify=verify, cls=cls)
 
     def __repr__(self) -> str:
         span = f"{self.t[0]:g}..{self.t[-1]:g} s" if len(self) else "empty"
