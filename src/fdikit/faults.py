@@ -28,7 +28,6 @@ Examples
 from __future__ import annotations
 
 import math
-import numbers
 import re
 from abc import ABC, abstractmethod
 from collections.abc import Iterable, Sequence
@@ -37,6 +36,7 @@ from typing import ClassVar, Literal
 
 import numpy as np
 
+from fdikit import validate
 from fdikit.errors import DataError, ParameterError
 from fdikit.model import actuator_fault_name, sensor_fault_name
 
@@ -62,12 +62,7 @@ NO_FAULT = "none"
 
 def _real(owner: str, name: str, value, *, finite: bool = True, hint: str = "") -> float:
     """``value`` as a float: a real number (not a bool, str or array), finite unless ``finite=False``."""
-    ok = isinstance(value, numbers.Real) and not isinstance(value, bool | np.bool_)
-    if not ok and isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
-        ok = True
-    if not ok:
-        raise ParameterError(f"{owner}: {name} must be a number, got {value!r} ({type(value).__name__})")
-    v = float(value)
+    v = validate.number(f"{owner}: {name}", value, finite=False)
     if finite and not math.isfinite(v):
         raise ParameterError(f"{owner}: {name} must be a finite number, got {v}{hint}")
     return v

@@ -27,8 +27,9 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from fdikit import validate
 from fdikit.errors import DataError, FdiWarning, ParameterError
-from fdikit.faults import FaultScenario, _real
+from fdikit.faults import FaultScenario
 from fdikit.model import FaultModel
 
 __all__ = [
@@ -55,7 +56,7 @@ __all__ = [
 
 def _number(name: str, value) -> float:
     """A finite float from a real number argument (ParameterError otherwise)."""
-    return _real("simulate", name, value)
+    return validate.number(f"simulate: {name}", value)
 
 
 def check_sample_time(dt) -> float:
