@@ -221,7 +221,9 @@ def read_trace(path: str | Path, *, verify: bool = True, cls: type[Trace] | None
         with open(path, "rb"):
             pass
         size = path.stat().st_size
-    except (OSError, ValueError) as exc:
+    except DataError:
+        raise
+    except (OSError, ValueError) as exc:  # unreadable (permissions), or a path the OS refuses (NUL byte)
         raise DataError(f"cannot read trace file {path}: {getattr(exc, 'strerror', None) or exc}") from None
     if size == 0:
         raise DataError(f"trace file {path} is empty (0 bytes): it was never written completely; re-create it")
