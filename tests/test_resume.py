@@ -1,10 +1,12 @@
-"""Long commands lose nothing: kill ``compare-evaluators`` and ``multiple-model`` three times, resume, compare.
+"""Long commands lose nothing: kill ``compare-evaluators``, ``multiple-model`` and ``target-tracking`` three
+times each, resume, compare.
 
 Each command runs in a subprocess (``python -m fdikit.cli``) with small arguments.  A reference run goes
 uninterrupted into ``ref/``; the same command into ``run/`` is SIGKILLed three times, each time as soon as
 one more finished result (a part file) than at the previous kill exists — for ``compare-evaluators``
 after (at least) the 1st, 8th and 15th of its 16 test runs, for ``multiple-model`` after its 1st, 2nd and
-3rd of 4 items — and rerun after each kill.  The resumed results must equal the reference byte for byte
+3rd of 4 items, for ``target-tracking`` after its 1st, 2nd and 3rd of 4 chunks of runs — and rerun after
+each kill.  The resumed results must equal the reference byte for byte
 (no file here carries a timing), every part must be kept across the kills (nothing lost), the summary
 must hold each result once (nothing duplicated), and no summary file may appear before the run is
 complete.  The reference runs go in parallel with the killed ones to keep the wall time down.
@@ -32,6 +34,7 @@ from fdikit.resume import MANIFEST, RunStore
 COMPARE = ["compare-evaluators", "--runs-per-fault", "1", "--healthy-runs", "1", "--no-bnn",
            "--evaluators", "threshold,cusum,sprt,mhsprt,gaussian-ml"]
 MULTIPLE = ["multiple-model", "--runs", "1", "--model-sets", "2", "--msd-dt", "0.02"]
+TRACKING = ["target-tracking", "--runs", "4"]  # 4 parts of 1 run
 TIMEOUT = 600.0
 
 
@@ -136,6 +139,15 @@ def test_kill_and_resume_compare_evaluators_and_multiple_model(tmp_path):
     assert {p: p.read_bytes() for p in out.iterdir() if p.is_file()} == before
     print(f"kill points: compare {c_counts} of 16 runs, multiple-model {m_counts} of 4 items; "
           f"{time.perf_counter() - start:.1f} s")
+
+
+def test_kill_and_resume_target_tracking(tmp_path):
+    ref_proc = _start(TRACKING, tmp_path / "ref")
+    counts = _kill_resume_compare(TRACKING, tmp_path / "run", (1, 2, 3), ("summary.md", "rmse.png"))
+    _finish(ref_proc, "reference target-tracking")
+    assert len(set(counts)) == 3 and counts[-1] < 4, counts
+    _same_files(tmp_path / "ref", tmp_path / "run", ("summary.md", "rmse.png"))
+    assert len(_parts(tmp_path / "run")) == 4
 
 
 def test_other_arguments_are_refused_before_any_work(tmp_path):

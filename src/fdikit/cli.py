@@ -9,6 +9,7 @@ Every file is written atomically (:mod:`fdikit.atomic`).
 
 from __future__ import annotations
 
+import io
 import time
 from pathlib import Path
 
@@ -211,19 +212,27 @@ def target_tracking(
     runs: int = typer.Option(100, help="Monte-Carlo runs (Hallouzi 2008 §2.4.2 uses 100)."),
     seed: int = typer.Option(0, help="Seed of the first run."),
     out: Path = typer.Option(Path("out/target_tracking"), help="Folder for summary.md and rmse.png."),
+    fresh: bool = _fresh_option(),
 ) -> None:
-    """Convex-model filters vs the IMM on the maneuvering-target benchmark (Hallouzi 2008, §2.4.2)."""
-    from fdikit.atomic import write_text
-    from fdikit.resume import check_count, check_output_folder, check_seed
+    """Convex-model filters vs the IMM on the maneuvering-target benchmark (Hallouzi 2008, §2.4.2).
+
+    The sums of every chunk of runs (at most 10) are kept in OUT as they complete; a killed run resumes
+    when rerun with the same arguments.
+    """
+    from rich.progress import Progress
+
+    from fdikit.resume import RunStore, check_count, check_seed
     from fdikit.scenarios.target_tracking import plot_target_tracking, target_tracking_monte_carlo
 
     start = time.perf_counter()
     try:
         check_count(runs, "runs")
         check_seed(seed)
-        check_output_folder(out)
-        with console.status(f"target tracking: {runs} Monte-Carlo runs ..."):
-            result = target_tracking_monte_carlo(runs=runs, seed=seed)
+        store = RunStore(out, "target-tracking", {"runs": runs, "seed": seed}, fresh=fresh)
+        with Progress(console=console, transient=True) as bar:
+            task = bar.add_task(f"target tracking: {runs} Monte-Carlo runs", total=runs)
+            result = target_tracking_monte_carlo(runs=runs, seed=seed, store=store,
+                                                 progress=lambda done: bar.update(task, completed=done))
     except (FdiError, OSError) as exc:
         _fail(exc)
     intervals = list(next(iter(result.summary.values())))
@@ -238,8 +247,9 @@ def target_tracking(
         lines.append(f"| {name} | " + " | ".join(cells) + " |")
     console.print(table)
     try:
-        plot_target_tracking(result, out / "rmse.png")
-        write_text(out / "summary.md", "\n".join(lines) + "\n")
+        png = io.BytesIO()
+        plot_target_tracking(result, png)
+        store.publish({"rmse.png": png.getvalue(), "summary.md": "\n".join(lines) + "\n"})
     except (FdiError, OSError) as exc:
         _fail(exc)
     console.print(f"wrote {out / 'summary.md'} and {out / 'rmse.png'} in {time.perf_counter() - start:.0f} s")

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fdikit.errors import ModelError
+from fdikit.errors import ParameterError
 from fdikit.faults import NO_FAULT
 from fdikit.multimodel.convex import dual_convex_filter
 from fdikit.multimodel.convex_ekf import augmented_ekf
@@ -71,7 +71,7 @@ def maneuver_profile(n_samples: int = N_SAMPLES) -> tuple[np.ndarray, np.ndarray
     ([[0.5, 0.5], [0.75, 0.25], [0.75, 0.25], [0.5, 0.5], [0.0, 1.0]], 'left_turn_half')
     """
     if n_samples < 1:
-        raise ModelError(f"n_samples must be positive, got {n_samples}")
+        raise ParameterError(f"n_samples must be positive, got {n_samples}")
     k = np.arange(n_samples)
     mu = np.full((n_samples, 2), 0.5)
     labels = np.full(n_samples, NO_FAULT, dtype=object)
@@ -134,28 +134,17 @@ class TargetTrackingResult:
     seed: int | None
 
 
-def target_tracking_monte_carlo(runs: int = 100, seed: int | None = 0, *, lam: float = 0.9, q_mu: float = 1e-2,
-                                filters=("dual_cmf", "ekf", "imm"), n_samples: int = N_SAMPLES
-                                ) -> TargetTrackingResult:
-    """Monte-Carlo comparison of the dual CMF, the augmented EKF and the IMM (Hallouzi 2008, §2.4.2).
+#: At most this many runs per resumable part of :func:`target_tracking_monte_carlo` (a part holds the sums
+#: of its runs); fewer when that gives less than four parts, so that short runs resume in steps too.
+CHUNK_RUNS = 10
 
-    Parameters
-    ----------
-    runs : number of runs (thesis: 100).  seed : master seed (runs use ``SeedSequence(seed).spawn``).
-    lam : dual-CMF forgetting factor (thesis 0.9).  q_mu : EKF ``Q^μ = q_mu I`` (thesis 1e-2).
-    filters : subset of ``("dual_cmf", "ekf", "imm")``.
-    """
-    filters = tuple(filters)
-    bad = set(filters) - {"dual_cmf", "ekf", "imm"}
-    if bad or not filters:
-        raise ModelError(f"unknown filters {sorted(bad)}; choose from 'dual_cmf', 'ekf', 'imm'")
-    if runs < 1:
-        raise ModelError(f"runs must be at least 1, got {runs}")
+
+def _chunk_sums(children, filters, lam, q_mu, n_samples) -> dict:
+    """Sums over the runs seeded by ``children`` of the squared errors, weights and chatter of each filter."""
     ms = tracking_convex_set(TS)
-    B_true, mu_true, _ = maneuver_profile(n_samples)
+    B_true, _, _ = maneuver_profile(n_samples)
     B_cm = ms.B[:, :, 0]  # (2, 4)
     B_imm = np.stack([tracking_B(nm).ravel() for nm in ("straight", "left_turn", "right_turn")])
-    imm = None
     if "imm" in filters:
         from fdikit.multimodel.imm import IMMFilter
 
@@ -165,7 +154,7 @@ def target_tracking_monte_carlo(runs: int = 100, seed: int | None = 0, *, lam: f
     chat = {f: 0.0 for f in filters}
     lo, hi = INTERVALS["left_half"]
     Lr = np.linalg.cholesky(R_TRACKING)
-    for child in np.random.SeedSequence(seed).spawn(runs):
+    for child in children:
         rng = np.random.default_rng(child)
         tr = target_tracking_trace(rng, n_samples)
         x0 = tr.x[0] + Lr @ rng.standard_normal(4)
@@ -179,8 +168,7 @@ def target_tracking_monte_carlo(runs: int = 100, seed: int | None = 0, *, lam: f
                 xh, mu, Bh = r.x, r.mu, r.mu @ B_cm
                 left = mu[:, 0]
             else:
-                imm = IMMFilter(modes, PI_TRACKING, x0=x0, P0=R_TRACKING)
-                r = imm.run(tr.u, tr.y)
+                r = IMMFilter(modes, PI_TRACKING, x0=x0, P0=R_TRACKING).run(tr.u, tr.y)
                 xh, mu, Bh = r.x, r.mu, r.mu @ B_imm
                 left = 0.5 + 0.5 * (mu[:, 1] - mu[:, 2])
             err = tr.x - xh
@@ -189,6 +177,59 @@ def target_tracking_monte_carlo(runs: int = 100, seed: int | None = 0, *, lam: f
             se[f]["B"] += ((Bh - B_true) ** 2).sum(axis=1)
             wsum[f] += mu
             chat[f] += np.abs(np.diff(left[lo:hi + 1])).mean()
+    return {f: {"pos": se[f]["pos"].tolist(), "vel": se[f]["vel"].tolist(), "B": se[f]["B"].tolist(),
+                "w": wsum[f].tolist(), "chatter": chat[f]} for f in filters}
+
+
+def target_tracking_monte_carlo(runs: int = 100, seed: int | None = 0, *, lam: float = 0.9, q_mu: float = 1e-2,
+                                filters=("dual_cmf", "ekf", "imm"), n_samples: int = N_SAMPLES, store=None,
+                                progress=None) -> TargetTrackingResult:
+    """Monte-Carlo comparison of the dual CMF, the augmented EKF and the IMM (Hallouzi 2008, §2.4.2).
+
+    Parameters
+    ----------
+    runs : number of runs (thesis: 100).  seed : master seed (runs use ``SeedSequence(seed).spawn``).
+    lam : dual-CMF forgetting factor (thesis 0.9).  q_mu : EKF ``Q^μ = q_mu I`` (thesis 1e-2).
+    filters : subset of ``("dual_cmf", "ekf", "imm")``.
+    store : :class:`fdikit.resume.RunStore`, optional
+        Keeps the sums of every chunk of runs (``min(CHUNK_RUNS, max(1, runs // 4))`` runs) as a part as
+        soon as they are complete and reuses the parts already there, so a killed run resumes.  The runs
+        are always summed chunk by chunk in chunk order, so the result is the same bit for bit with or
+        without a store and however often the run was interrupted.
+    progress : callable, optional
+        Called with the number of runs done after each chunk.
+
+    Raises
+    ------
+    ParameterError
+        For unknown filters or fewer than one run.
+    """
+    filters = tuple(filters)
+    bad = set(filters) - {"dual_cmf", "ekf", "imm"}
+    if bad or not filters:
+        raise ParameterError(f"unknown filters {sorted(bad)}; choose from 'dual_cmf', 'ekf', 'imm'")
+    if isinstance(runs, bool) or not isinstance(runs, int | np.integer) or runs < 1:
+        raise ParameterError(f"runs must be an integer of at least 1, got {runs!r}")
+    _, mu_true, _ = maneuver_profile(n_samples)
+    children = np.random.SeedSequence(seed).spawn(runs)
+    se = {f: {q: np.zeros(n_samples) for q in ("pos", "vel", "B")} for f in filters}
+    wsum = {f: np.zeros((n_samples, 3 if f == "imm" else 2)) for f in filters}
+    chat = {f: 0.0 for f in filters}
+    chunk = min(CHUNK_RUNS, max(1, runs // 4))
+    for start in range(0, runs, chunk):
+        key = f"runs-{start:05d}"
+        part = None if store is None else store.load(key)
+        if part is None:
+            part = _chunk_sums(children[start:start + chunk], filters, lam, q_mu, n_samples)
+            if store is not None:
+                part = store.save(key, part)
+        for f in filters:
+            for q in ("pos", "vel", "B"):
+                se[f][q] += np.asarray(part[f][q], dtype=float)
+            wsum[f] += np.asarray(part[f]["w"], dtype=float)
+            chat[f] += float(part[f]["chatter"])
+        if progress is not None:
+            progress(min(start + chunk, runs))
     rmse = {q: {f: np.sqrt(se[f][q] / runs) for f in filters} for q in ("pos", "vel", "B")}
     mean_w = {f: wsum[f] / runs for f in filters}
     cm_w = {f: (np.column_stack([0.5 + 0.5 * (w[:, 1] - w[:, 2]), 0.5 - 0.5 * (w[:, 1] - w[:, 2])])
