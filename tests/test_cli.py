@@ -116,3 +116,15 @@ def test_multiple_model_command(tmp_path):
         assert part in text
     for png in ("target_tracking.png", "b747.png", "msd.png"):
         assert (out / png).stat().st_size > 10_000
+
+
+def test_simulate_reports_a_fault_that_never_acts_as_one_warning_line(tmp_path):
+    from typer.testing import CliRunner
+
+    from fdikit.cli import app
+
+    res = CliRunner().invoke(app, ["simulate", "path12", "-f", "bias:yaw_rate:0.02@50", "--duration", "5",
+                                   "--out", str(tmp_path / "t.parquet")])
+    assert res.exit_code == 0, res.output
+    assert "warning:" in res.output and "never acts" in res.output and "warnings.warn" not in res.output
+    assert (tmp_path / "t.parquet").is_file()

@@ -11,13 +11,14 @@ from __future__ import annotations
 
 import io
 import time
+import warnings
 from pathlib import Path
 
 import typer
 from rich.console import Console
 from rich.table import Table
 
-from fdikit.errors import FdiError, ParameterError
+from fdikit.errors import FdiError, FdiWarning, ParameterError
 
 app = typer.Typer(help="fdikit: model-based fault detection and isolation for vehicles and aircraft.",
                   no_args_is_help=True, add_completion=False)
@@ -104,7 +105,8 @@ def plants() -> None:
 def simulate(
     plant: str = typer.Argument(..., help="Plant name (see `fdikit plants`)."),
     fault: list[str] = typer.Option([], "--fault", "-f",
-                                    help="Fault spec kind:target[:value][@onset[-end]], e.g. bias:yaw_rate:0.02@10."),
+                                    help="Fault spec kind:target[:value][@onset[-end]][#sensor|#actuator], "
+                                         "e.g. bias:yaw_rate:0.02@10."),
     duration: float = typer.Option(30.0, help="Simulated time [s]."),
     dt: float = typer.Option(0.01, help="Sample time [s]."),
     noise: float = typer.Option(0.0, help="Measurement noise std, the same on every output."),
@@ -129,9 +131,12 @@ def simulate(
         model = get_plant(plant, **kw)
         out = check_output_file(out)
         scenario = FaultScenario([parse_fault(s) for s in fault])
-        with console.status(f"simulating {plant} for {duration:g} s ..."):
+        with console.status(f"simulating {plant} for {duration:g} s ..."), warnings.catch_warnings(record=True) as seen:
+            warnings.simplefilter("always", FdiWarning)
             trace = run(model, scenario, duration=duration, dt=dt, measurement_noise=noise or None, rng=seed,
                         meta={"plant_name": plant, "plant_params": kw})
+        for w in seen:  # one line each (a fault that never acts ...), not Python's warning format
+            console.print(f"[yellow]warning:[/yellow] {w.message}")
         path = trace.save(out)
     except (FdiError, OSError) as exc:
         _fail(exc)
