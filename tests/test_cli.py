@@ -119,11 +119,7 @@ def test_multiple_model_command(tmp_path):
 
 
 def test_simulate_reports_a_fault_that_never_acts_as_one_warning_line(tmp_path):
-    from typer.testing import CliRunner
-
-    from fdikit.cli import app
-
-    res = CliRunner().invoke(app, ["simulate", "path12", "-f", "bias:yaw_rate:0.02@50", "--duration", "5",
+    res = runner.invoke(app, ["simulate", "path12", "-f", "bias:yaw_rate:0.02@50", "--duration", "5",
                                    "--out", str(tmp_path / "t.parquet")])
     assert res.exit_code == 0, res.output
     assert "warning:" in res.output and "never acts" in res.output and "warnings.warn" not in res.output
