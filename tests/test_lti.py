@@ -109,3 +109,16 @@ def test_lifted_matrices_definition():
             blk = T[2 * j : 2 * j + 2, i : i + 1]
             ref = P[j - 1 - i] @ B if i < j else np.zeros((2, 1))
             np.testing.assert_allclose(blk, ref, atol=1e-14)
+
+
+def test_non_finite_input_is_refused_not_spread_into_its_block():
+    """A NaN at sample 40 would corrupt samples 32-39 of the lifted block solve: refused instead."""
+    import pytest
+
+    from fdikit.errors import DataError
+    from fdikit.lti import dlsim_blocked
+
+    v = np.ones((64, 1))
+    v[40] = np.nan
+    with pytest.raises(DataError, match="v \\(the input sequence\\)"):
+        dlsim_blocked(np.array([[0.5]]), np.array([[1.0]]), np.array([[1.0]]), np.array([[0.0]]), v)

@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from fdikit import validate
+from fdikit.errors import DataError
 
 __all__ = ["dlsim_blocked", "lifted_matrices"]
 
@@ -53,6 +54,13 @@ def dlsim_blocked(
     Returns
     -------
     y : (N, p) outputs, x : (N, n) states (``x[0] = x0``), x_end : (n,) the state after the last sample.
+
+    Raises
+    ------
+    DataError
+        When ``v`` holds a NaN/inf (it would spread to the earlier samples of its 32-sample block).
+    ParameterError
+        For malformed matrices, a non-finite ``x0`` or a bad ``block``.
     """
     block = validate.integer("block", block, minimum=1)
     A = validate.as_square("A", A)
@@ -61,9 +69,11 @@ def dlsim_blocked(
     m = B.shape[1]
     C = validate.as_matrix("C", C, (None, n))
     D = validate.as_matrix("D", D, (C.shape[0], m))
-    v = validate.as_matrix("v (the input sequence)", v, (None, m), finite=False)
+    # non-finite samples are refused: the lifted solve mixes the samples of a block, so a NaN/inf would also
+    # corrupt the earlier samples of its block (callers with gaps handle them first, as residuals.run does)
+    v = validate.as_matrix("v (the input sequence)", v, (None, m), error=DataError)
     N = v.shape[0]
-    x0 = np.zeros(n) if x0 is None else validate.as_vector("x0", x0, n, finite=False)
+    x0 = np.zeros(n) if x0 is None else validate.as_vector("x0", x0, n)
     if n == 0 or N == 0:
         return v @ D.T, np.zeros((N, n)), x0.copy()
     M = max(1, min(block, N))

@@ -9,7 +9,7 @@ from harness import case, check, ids
 from fdikit import FaultModel
 from fdikit.analysis import default_freqs, fault_to_residual_gain, structure_matrix
 from fdikit.design import kalman
-from fdikit.errors import ModelError, ParameterError
+from fdikit.errors import DataError, ModelError, ParameterError
 from fdikit.fdi_report import fdi_report
 from fdikit.linalg import (
     actuator_fault_map,
@@ -104,7 +104,9 @@ CASES = [
          ModelError, "zz"),
     # ------------------------------------------------------------------ lti
     case("dlsim-v-shape", lambda: dlsim_blocked(np.eye(2), np.ones((2, 1)), np.eye(2), np.zeros((2, 1)),
-                                                np.ones((10, 3))), ParameterError, "v", "columns"),
+                                                np.ones((10, 3))), DataError, "v", "columns"),
+    case("dlsim-v-nan", lambda: dlsim_blocked(np.eye(2), np.ones((2, 1)), np.eye(2), np.zeros((2, 1)),
+                                              np.full((10, 1), np.nan)), DataError, "v", "finite"),
     case("dlsim-block-zero", lambda: dlsim_blocked(np.eye(2), np.ones((2, 1)), np.eye(2), np.zeros((2, 1)),
                                                    np.ones((10, 1)), block=0), ParameterError, "block", "positive"),
     case("dlsim-x0-size", lambda: dlsim_blocked(np.eye(2), np.ones((2, 1)), np.eye(2), np.zeros((2, 1)),
