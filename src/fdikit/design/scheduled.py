@@ -256,12 +256,7 @@ class ScheduledResidualGenerator:
         start of a run that begins with a valid sample the window is padded with zeros as before
         (the start-up transient is not flagged).
         """
-        if not isinstance(trace, Trace):
-            raise DataError(f"trace must be a fdikit.trace.Trace, got {type(trace).__name__}")
-        if len(trace) > 1 and not np.isclose(trace.dt, self.dt, rtol=1e-6):
-            raise DataError(f"data sampled at dt={trace.dt:g} but the filter runs at dt={self.dt:g}; resample")
-        check_signals(trace, self.controls, self.outputs)
-        rho = self._schedule_of(trace, schedule)
+        rho = self.checked_schedule(trace, schedule)
         n_dec = self.recovery_length(recovery_tol)
         z = np.hstack([trace.columns("y", self.outputs), trace.columns("u", self.controls)])
         N = len(trace)
@@ -284,6 +279,21 @@ class ScheduledResidualGenerator:
         meta = {"trace": dict(trace.meta), "schedule": schedule if isinstance(schedule, str) else self.schedule}
         return Residuals(trace.t, r[:, None], self.residuals, self.isolates, valid, meta=meta,
                          recovering=ok & ~valid)
+
+    def checked_schedule(self, trace: Trace, schedule=None) -> np.ndarray:
+        """The schedule of ``trace`` after checking that the filter can read the trace (type, dt, signals).
+
+        Raises
+        ------
+        DataError
+            For a non-trace, another sample time, missing signals or a bad schedule.
+        """
+        if not isinstance(trace, Trace):
+            raise DataError(f"trace must be a fdikit.trace.Trace, got {type(trace).__name__}")
+        if len(trace) > 1 and not np.isclose(trace.dt, self.dt, rtol=1e-6):
+            raise DataError(f"data sampled at dt={trace.dt:g} but the filter runs at dt={self.dt:g}; resample")
+        check_signals(trace, self.controls, self.outputs)
+        return self._schedule_of(trace, schedule)
 
     def _schedule_of(self, trace: Trace, schedule) -> np.ndarray:
         if schedule is None or isinstance(schedule, str):
@@ -376,12 +386,7 @@ class ScheduledStepper:
     def run(self, trace: Trace, schedule: np.ndarray | str | None = None) -> Residuals:
         """Step through a whole trace (what :meth:`ScheduledResidualGenerator.run` vectorises)."""
         g = self.generator
-        if not isinstance(trace, Trace):
-            raise DataError(f"trace must be a fdikit.trace.Trace, got {type(trace).__name__}")
-        if len(trace) > 1 and not np.isclose(trace.dt, g.dt, rtol=1e-6):
-            raise DataError(f"data sampled at dt={trace.dt:g} but the filter runs at dt={g.dt:g}; resample")
-        check_signals(trace, g.controls, g.outputs)
-        rho = g._schedule_of(trace, schedule)
+        rho = g.checked_schedule(trace, schedule)
         U, Y = trace.columns("u", g.controls), trace.columns("y", g.outputs)
         r = np.empty(len(trace))
         valid = np.empty(len(trace), bool)
