@@ -50,7 +50,38 @@ from fdikit.errors import ParameterError
 if TYPE_CHECKING:
     from fdikit.residuals import ResidualGenerator
 
-__all__ = ["GapRule", "Recovery"]
+__all__ = ["GapRule", "Recovery", "gap_options"]
+
+
+def gap_options(g: ResidualGenerator, residual_cov, tol) -> tuple[np.ndarray, float]:
+    """``(Σ, tol)`` of the gap rule after checking them; what :class:`GapRule` and a clean ``run`` both check.
+
+    Raises
+    ------
+    ParameterError
+        For a ``recovery_tol`` outside ``(0, 1]`` or a ``residual_cov`` that is not a finite symmetric
+        ``q x q`` matrix with a positive diagonal.
+    """
+    if isinstance(tol, bool) or not isinstance(tol, (int, float, np.integer, np.floating)):
+        raise ParameterError(f"recovery_tol must be a number in (0, 1], got {tol!r}")
+    if not (np.isfinite(tol) and 0 < tol <= 1):
+        raise ParameterError(f"recovery_tol must be in (0, 1] (a fraction of the noise std), got {tol!r}")
+    q = len(g.residuals)
+    if residual_cov is None:
+        S = np.eye(q)
+    else:
+        try:
+            S = np.atleast_2d(np.asarray(residual_cov, dtype=float))
+        except (TypeError, ValueError) as exc:
+            raise ParameterError(f"residual_cov must be a {q}x{q} covariance matrix, got {residual_cov!r}") from exc
+        if S.shape == (1, q) and q > 1:
+            S = np.diag(S[0])
+        if S.shape != (q, q) or not np.all(np.isfinite(S)) or not np.allclose(S, S.T, rtol=1e-10, atol=0):
+            raise ParameterError(f"residual_cov must be a finite symmetric {q}x{q} matrix (residuals "
+                                 f"{list(g.residuals)}), got shape {S.shape}")
+        if q and not np.all(np.diag(S) > 0):
+            raise ParameterError("residual_cov must have a positive diagonal (every residual has noise)")
+    return S, float(tol)
 
 
 class GapRule:
@@ -62,26 +93,8 @@ class GapRule:
     """
 
     def __init__(self, g: ResidualGenerator, residual_cov, tol) -> None:
-        if isinstance(tol, bool) or not isinstance(tol, (int, float, np.integer, np.floating)):
-            raise ParameterError(f"recovery_tol must be a number in (0, 1], got {tol!r}")
-        if not (np.isfinite(tol) and 0 < tol <= 1):
-            raise ParameterError(f"recovery_tol must be in (0, 1] (a fraction of the noise std), got {tol!r}")
-        q = len(g.residuals)
-        if residual_cov is None:
-            S = np.eye(q)
-        else:
-            try:
-                S = np.atleast_2d(np.asarray(residual_cov, dtype=float))
-            except (TypeError, ValueError) as exc:
-                raise ParameterError(f"residual_cov must be a {q}x{q} covariance matrix, got {residual_cov!r}") from exc
-            if S.shape == (1, q) and q > 1:
-                S = np.diag(S[0])
-            if S.shape != (q, q) or not np.all(np.isfinite(S)) or not np.allclose(S, S.T, rtol=1e-10, atol=0):
-                raise ParameterError(f"residual_cov must be a finite symmetric {q}x{q} matrix (residuals "
-                                     f"{list(g.residuals)}), got shape {S.shape}")
-            if q and not np.all(np.diag(S) > 0):
-                raise ParameterError("residual_cov must have a positive diagonal (every residual has noise)")
-        self.g, self.S, self.tol = g, S, float(tol)
+        S, tol = gap_options(g, residual_cov, tol)
+        self.g, self.S, self.tol = g, S, tol
         self.limit = self.tol**2 * np.diag(S)
         self.mu = len(g.controls)
         n = g.n

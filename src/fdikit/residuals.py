@@ -26,7 +26,7 @@ import numpy as np
 import scipy.linalg
 
 from fdikit.errors import DataError, ModelError, ParameterError
-from fdikit.gaps import GapRule, Recovery
+from fdikit.gaps import GapRule, Recovery, gap_options
 from fdikit.lti import dlsim_blocked
 from fdikit.model import GROUPS, FaultModel
 from fdikit.trace import Trace
@@ -259,7 +259,7 @@ class ResidualGenerator:
         meta = {"trace": dict(trace.meta)}
         if ok.all():
             r, _, _ = dlsim_blocked(g.A, g.B, g.C, g.D, v, x0)
-            GapRule(g, residual_cov, recovery_tol)  # validates the options alike on clean data
+            gap_options(g, residual_cov, recovery_tol)  # the options are checked alike on clean data
             return Residuals(trace.t, r, self.residuals, self.isolates, meta=meta)
         rule = GapRule(g, residual_cov, recovery_tol)
         N, n = v.shape[0], g.n
