@@ -47,19 +47,9 @@ _EPS = np.finfo(float).eps
 
 def _mat(name: str, M) -> np.ndarray:
     """``M`` as a finite real or complex 2-D array (a vector is one row); ParameterError otherwise."""
-    if isinstance(M, str | bytes):
-        raise ParameterError(f"{name} must be a matrix of numbers, got the string {M!r}")
-    try:
-        M = np.asarray(M)
-    except (ValueError, TypeError) as exc:
-        raise ParameterError(f"{name} must be a rectangular matrix of numbers ({exc})") from None
-    if M.dtype.kind not in "biufc":
-        raise ParameterError(f"{name} must be a matrix of numbers, got entries of type {M.dtype}")
-    M = np.atleast_2d(M)
+    M = np.atleast_2d(validate.as_array(name, M, complex_ok=True))
     if M.ndim != 2:
         raise ParameterError(f"{name} must be a 2-D matrix, got an array with {M.ndim} dimensions (shape {M.shape})")
-    if not np.isfinite(M).all():
-        raise ParameterError(f"{name} has a non-finite entry (NaN or inf); every entry must be a finite number")
     return M
 
 

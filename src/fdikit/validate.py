@@ -48,8 +48,10 @@ def _show(value) -> str:
     return text if len(text) <= 60 else text[:57] + "..."
 
 
-def as_array(name: str, value, *, error: type[Exception] = ParameterError, finite: bool = True) -> np.ndarray:
-    """``value`` as a float array (any number of dimensions); strings, complex and ragged input are refused."""
+def as_array(name: str, value, *, error: type[Exception] = ParameterError, finite: bool = True,
+             complex_ok: bool = False) -> np.ndarray:
+    """``value`` as a float array (any number of dimensions); strings, ragged input and (unless ``complex_ok``,
+    which gives a complex array) complex entries are refused."""
     if value is None:
         raise error(f"{name} is required (got None); pass an array of numbers")
     if isinstance(value, str | bytes):
@@ -60,11 +62,11 @@ def as_array(name: str, value, *, error: type[Exception] = ParameterError, finit
         raise error(f"{name} must be a rectangular array of numbers (got {_show(value)}: {exc})") from None
     if raw.dtype == object:
         raise error(f"{name} must be a rectangular array of numbers, got {_show(value)} (ragged rows or objects)")
-    if np.iscomplexobj(raw):
+    if np.iscomplexobj(raw) and not complex_ok:
         raise error(f"{name} must be real; it has complex entries ({_show(value)})")
-    if raw.dtype.kind not in "biuf":
+    if raw.dtype.kind not in "biufc":
         raise error(f"{name} must be an array of numbers, got entries of type {raw.dtype} ({_show(value)})")
-    out = raw.astype(float, copy=True)
+    out = raw.astype(complex if np.iscomplexobj(raw) else float, copy=True)
     if finite:
         bad = np.argwhere(~np.isfinite(out))
         if bad.size:
