@@ -184,9 +184,10 @@ def check_covariance(name: str, value, k: int, what: str) -> np.ndarray | None:
     if not np.allclose(arr, arr.T):
         raise ParameterError(f"{name} must be a symmetric positive semidefinite {k}x{k} covariance; it is not "
                              "symmetric")
-    if np.linalg.eigvalsh(arr).min() < -1e-12 * max(1.0, np.abs(arr).max()):
+    lowest = np.linalg.eigvalsh(arr).min()
+    if lowest < -1e-12 * max(1.0, np.abs(arr).max()):
         raise ParameterError(f"{name} must be a symmetric positive semidefinite {k}x{k} covariance (or std vector); "
-                             f"its smallest eigenvalue is {np.linalg.eigvalsh(arr).min():.3g}")
+                             f"its smallest eigenvalue is {lowest:.3g}")
     return arr
 
 
