@@ -471,7 +471,6 @@ class CusumEvaluator:
         treated like a NaN sample: the statistics and the decision hold.  ``names`` (optional) are
         checked against the residual names of the fit (:class:`DataError` on a difference).
 
-
         After the call, ``g_plus`` and ``g_minus`` hold the current statistics.  The
         parameters are read at the first step after :meth:`reset` (or :meth:`fit`).
         """
