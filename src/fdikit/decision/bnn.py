@@ -22,7 +22,7 @@ otherwise; when no input is tied to any hypothesis it falls back to the zero-pad
 ``eye(n_in, n_out)``.  ``'pad'`` forces the zero-padded identity, ``'learned'`` trains ``F``
 (initialised as ``'tied'``), an array sets it.
 
-**Inputs** (research note G9).  ``inputs='magnitude'``: one input per fault group, ``‖z_f‖₂`` over
+**Inputs** (Douglas et al. 1996, §5.1.1, §6.4).  ``inputs='magnitude'``: one input per fault group, ``‖z_f‖₂`` over
 the residuals tied to fault ``f`` (``Residuals.isolates``; untied residuals form a group each),
 divided by a scale (``'nominal'``: the mean magnitude over the training samples of fault ``f``, so
 the nominal training fault gives ≈ 1, §5.1.1; inputs of faults without training data keep scale 1).
@@ -33,9 +33,9 @@ filter's residual names as ``columns`` when the residuals are a stacked bank.
 all training sequences, minimised by a quasi-Newton method written here (:func:`quasi_newton`:
 rank-2 update of the inverse Hessian, strong-Wolfe line search, the report's stop test "the change
 of the Hessian estimate is small").  Gradients are exact back-propagation through time over the
-whole unrolled recurrence (no teacher forcing: the network sees its own ``y_{k−1}``; research note
-G12).  The report's update is DFP (``update='dfp'``); the default is its Broyden-family twin BFGS,
-which has every property §6.3.1 relies on (rank 2, positive definite, ``n``-step termination on a
+whole unrolled recurrence (no teacher forcing: the network sees its own ``y_{k−1}``, the one-step
+delayed output feedback of (6.1), §6.1).  The report's update is DFP (``update='dfp'``); the default is
+its Broyden-family twin BFGS, which has every property §6.3.1 relies on (rank 2, positive definite, ``n``-step termination on a
 quadratic with exact searches, where the two give identical iterates) but corrects a poor Hessian
 estimate under inexact line searches, where DFP stalls.  Measured on the 3-fault toy problem of the
 tests (6000 samples, 400 iterations, two seeds): BFGS J = 0.054 with 434–448 cost evaluations; DFP

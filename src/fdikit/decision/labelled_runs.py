@@ -1,8 +1,8 @@
 """Labelled residual runs as training data, and residual rows as classifier inputs (Douglas et al. 1996, §6.2–6.4).
 
 Shared by the Bayesian neural network (:mod:`fdikit.decision.bnn`) and the Gaussian ML classifier
-(:mod:`fdikit.decision.gaussian_ml`): the input map (one magnitude per fault group, or raw residuals; research note
-G9), the training-data forms (a mapping label → runs, or runs with per-sample labels), the one-hot targets of
+(:mod:`fdikit.decision.gaussian_ml`): the input map (one magnitude per fault group, or raw residuals;
+§5.1.1), the training-data forms (a mapping label → runs, or runs with per-sample labels), the one-hot targets of
 §6.2.2 and the decision rule on posterior probabilities.
 """
 

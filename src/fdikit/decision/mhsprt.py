@@ -3,7 +3,7 @@
 ``m + 1`` hypotheses: ``H_0`` (no fault, density ``f_0``) and ``H_i`` (fault ``i`` has happened, density
 ``f_i``).  ``p_i`` is the prior probability of a switch ``H_0 → H_i`` in one sample interval, ``π_i`` the
 probability that fault ``i`` happened before the first sample, ``F_{k,i} = P(θ_i ≤ t_k | x_1..x_k)``.
-Prop. 7.1, with the correction of research note G11 (the proof's step (7.6c) writes ``p_i (1 − F_{k,i})``; under
+Prop. 7.1, corrected (the proof's step (7.6c) writes ``p_i (1 − F_{k,i})``, which fails Prop. 7.2; under
 the single-fault assumption the probability that no fault has happened yet is ``1 − Σ_j F_{k,j} = F_{k,0}``)::
 
     F_{0,i}   = π_i,  F_{0,0} = 1 − Σ_i π_i                                   (7.1a)
@@ -14,7 +14,7 @@ This is the Bayes filter of the absorbing chain ``0 → i`` and satisfies Prop. 
 ``Σ_i F_{k,i} ≤ 1``) for any data.  It runs in the log domain: ``log F_{k,0}`` is a state of its own
 (``M_{k,0} = F_{k,0} (1 − Σ p_i)``), the update is a log-sum-exp, so 11-D Gaussian densities and long runs never
 underflow.  ``form="literal"`` runs the printed (7.1c) ``M_{k,i} = F_{k,i} + p_i (1 − F_{k,i})``, which lets
-``Σ_j M_{k,j}`` exceed 1 and breaks Prop. 7.2 (``Σ_i F_{k,i} > 1``, note §6.4); its quantities can leave
+``Σ_j M_{k,j}`` exceed 1 and breaks Prop. 7.2 (``Σ_i F_{k,i} > 1``); its quantities can leave
 ``[0, 1]``, so it is kept in linear form (densities scaled by their maximum).  For ``m = 1`` both are the same.
 
 Decision (§7.2.2–7.2.3): announce fault ``i`` while ``F_{k,i} ≥ F_{T,i}``; ``α_i = 1 − F_{T,i}`` bounds the
@@ -58,7 +58,7 @@ _LOG2PI = np.log(2.0 * np.pi)
 
 
 def magnitude_blocks(residuals: Residuals, groups: Sequence[str] | None = None) -> tuple[str, ...]:
-    """Per residual component, the label of its block for ``MhsprtEvaluator(blocks=...)`` (note G9).
+    """Per residual component, the label of its block for ``MhsprtEvaluator(blocks=...)``.
 
     Components tied to the same fault (and, with ``groups``, in the same filter of a bank) form one block whose
     Euclidean magnitude is one measurement component; an untied residual is a block of its own.
@@ -101,7 +101,7 @@ class MhsprtEvaluator:
     p : float, sequence or mapping
         Per-sample prior switch probability ``p_i`` for each fault (a scalar applies to each); ``Σ p_i < 1``.
         It is per *sample*, so it scales with the sample time.  Defaults ``p = 1e−4``, ``π = 1e−3``,
-        ``F_T = 0.95`` are note G11's assumptions (the report gives none for its application).
+        ``F_T = 0.95`` are assumptions made here (the report gives none for its application).
     pi : float, sequence or mapping
         ``π_i = P(fault i before the first sample)``; ``Σ π_i ≤ 1``.
     threshold : float, sequence or mapping
@@ -109,7 +109,7 @@ class MhsprtEvaluator:
     form : ``'corrected'`` (default, Prop. 7.2 holds) or ``'literal'`` (the printed (7.1c); violates Prop. 7.2).
     blocks : sequence of str, optional
         One label per residual component (:func:`magnitude_blocks`): each block is replaced by its Euclidean
-        magnitude before the test (the report's "residual magnitudes", note G9).  Magnitudes of fault-free
+        magnitude before the test (the report's "residual magnitudes", §5.1.1).  Magnitudes of fault-free
         residuals are far from Gaussian (χ-like, bounded by 0): on the PATH bank they gave false alarms where the
         raw components did not (docs/methods, R-SPRT-7).
 
