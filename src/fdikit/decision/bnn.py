@@ -33,13 +33,13 @@ filter's residual names as ``columns`` when the residuals are a stacked bank.
 all training sequences, minimised by a quasi-Newton method written here (:func:`quasi_newton`:
 rank-2 update of the inverse Hessian, strong-Wolfe line search, the report's stop test "the change
 of the Hessian estimate is small").  Gradients are exact back-propagation through time over the
-whole unrolled recurrence (no teacher forcing: the network sees its own ``y_{k−1}``, the one-step
-delayed output feedback of (6.1), §6.1).  The report's update is DFP (``update='dfp'``); the default is
-its Broyden-family twin BFGS, which has every property §6.3.1 relies on (rank 2, positive definite,
-``n``-step termination on a quadratic with exact searches, where the two give identical iterates) but corrects a poor Hessian
-estimate under inexact line searches, where DFP stalls.  Measured on the 3-fault toy problem of the
-tests (6000 samples, 400 iterations, two seeds): BFGS J = 0.054 with 434–448 cost evaluations; DFP
-J = 0.054 with 2735–2740 evaluations (``c2 = 0.1``), and J = 0.17–0.25 with a loose search (``c2 = 0.9``).
+whole unrolled recurrence (no teacher forcing: the network sees its own ``y_{k−1}``, the one-step delayed
+output feedback of (6.1), §6.1). The report's update is DFP (``update='dfp'``); the default is its
+Broyden-family twin BFGS, which has every property §6.3.1 relies on (rank 2, positive definite, ``n``-step
+termination on a quadratic with exact searches, where the two give identical iterates) but corrects a poor
+Hessian estimate under inexact line searches, where DFP stalls. Measured on the 3-fault toy problem of the
+tests (6000 samples, 400 iterations, two seeds): BFGS J = 0.054 with 434–448 cost evaluations; DFP J = 0.054
+with 2735–2740 evaluations (``c2 = 0.1``), and J = 0.17–0.25 with a loose search (``c2 = 0.9``).
 
 Then Robbins–Monro ``w_{k+1} = w_k − ρ_k g(w_k)``, ``ρ_k = ρ_0/(k+1)^a``, ``a ∈ (0.5, 1]`` (so
 ``Σρ_k = ∞``, ``Σρ_k² < ∞``), where ``g`` is the exact gradient of the cost of a random mini-batch of
