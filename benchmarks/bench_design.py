@@ -15,10 +15,10 @@ import numpy as np
 import scipy.signal
 
 from fdikit.model import sensor_fault_name
-from fdikit.monitors import path_bank, path_fault_model
-from fdikit.monitors.path_bank import EIGENVALUES
 from fdikit.plants import path_vehicle_12, path_vehicle_14
 from fdikit.simulate import simulate
+from fdikit.studies.path1996 import path_bank, path_fault_model
+from fdikit.studies.path1996.bank import EIGENVALUES
 from timing import best
 
 
@@ -55,7 +55,7 @@ def main() -> None:
     print(f"bank: 4 filters, {gen.n} states, {len(gen.residuals)} residuals, {args.samples} samples, "
           f"best of {args.repeat}")
     print("\n| step | time | ratio |\n|---|---|---|")
-    print(f"| design of the 4-filter bank (fdikit.monitors.path_bank) | {t_design * 1e3:.0f} ms | "
+    print(f"| design of the 4-filter bank (fdikit.studies.path1996.bank) | {t_design * 1e3:.0f} ms | "
           f"{t_design / t_place:.0f}x control.place of the same spectra ({t_place * 1e3:.1f} ms) |")
     base = res["fdikit bank run (batch)"][0]
     for k, (t, out) in res.items():

@@ -66,7 +66,7 @@ def build(train_n: int) -> tuple[list, list]:
         except Exception as exc:  # noqa: BLE001 - a benchmark reports, it does not fail
             skipped.append(("MhsprtEvaluator", f"could not be built: {type(exc).__name__}: {exc}"))
     try:
-        from fdikit.decision.bnn import BnnEvaluator
+        from fdikit.decision.learned.bnn import BnnEvaluator
     except ImportError as exc:
         skipped.append(("BnnEvaluator", f"not available ({exc})"))
     else:

@@ -18,9 +18,9 @@ import control
 import numpy as np
 import scipy.linalg
 
-from fdikit.design.game import game_filter, game_filter_bank, single_fault_game_filter
-from fdikit.design.game_riccati import solve_game_are
-from fdikit.design.reduced_order import goh_detector
+from fdikit.design.game.continuous import game_filter, game_filter_bank, single_fault_game_filter
+from fdikit.design.game.reduced_order import goh_detector
+from fdikit.design.game.riccati import solve_game_are
 from fdikit.plants.f16xl import f16xl_longitudinal
 from fdikit.plants.path_longitudinal import path_longitudinal_7, path_longitudinal_7_fault_maps
 from timing import best

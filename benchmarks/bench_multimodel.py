@@ -20,8 +20,9 @@ import time
 
 import numpy as np
 
+from fdikit.gaussian import LinearGaussianModel
 from fdikit.multimodel.imm import IMMFilter
-from fdikit.multimodel.kalman import KalmanFilter, LinearGaussianModel, kalman_filter
+from fdikit.multimodel.kalman import KalmanFilter, kalman_filter
 from timing import best
 
 

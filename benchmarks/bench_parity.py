@@ -17,11 +17,11 @@ import argparse
 import numpy as np
 import scipy.signal
 
-from fdikit.design.dae_parity import parity_filter
-from fdikit.design.scheduled import scheduled_parity_filter
+from fdikit.design.parity.polynomial import parity_filter
+from fdikit.design.parity.scheduled import scheduled_parity_filter
 from fdikit.estimate import isolate_steering_faults
 from fdikit.plants.single_track import single_track_lpv
-from fdikit.scenarios.vanderploeg import lateral_run
+from fdikit.studies.vanderploeg2018.scenarios import lateral_run
 from timing import best
 
 

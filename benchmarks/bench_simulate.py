@@ -20,9 +20,9 @@ import scipy
 import scipy.signal
 
 import fdikit
-from fdikit.demo import ACTUATOR_NOISE_STD, SENSOR_NOISE_STD, demo_model
 from fdikit.design import kalman
 from fdikit.simulate import simulate
+from fdikit.studies.path1996.demo import ACTUATOR_NOISE_STD, SENSOR_NOISE_STD, demo_model
 from timing import best
 
 

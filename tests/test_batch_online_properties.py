@@ -147,7 +147,7 @@ def test_continuous_generator_run_equals_online_at_the_trace_dt(seed, n, N, p_ga
 # ------------------------------------------------------------------------------------------ scheduled filter
 @cache
 def _scheduled():
-    from fdikit.design.scheduled import scheduled_parity_filter
+    from fdikit.design.parity.scheduled import scheduled_parity_filter
     from fdikit.plants.single_track import single_track_lpv
 
     return scheduled_parity_filter(single_track_lpv(), 70 / 3.6)

@@ -91,7 +91,7 @@ def test_compare_evaluators_command(tmp_path):
         assert f"| {name} |" in md
     rows = (tmp_path / "scores.csv").read_text().strip().splitlines()
     assert len(rows) == 1 + 16 * len(names)  # header + (15 faulty + 1 healthy runs) x evaluators
-    # the calibrated threshold bank isolates every fault with no false alarm (as in tests/monitors)
+    # the calibrated threshold bank isolates every fault with no false alarm (as in tests/studies/path1996)
     assert "| threshold (5 of 10) | 16 | 1 | 0 |" in md
 
 

@@ -70,8 +70,8 @@ def test_scores_csv_is_not_truncated_when_scoring_fails(tmp_path):
 
 def test_path_comparison_test_runs_are_those_of_path_runs():
     """The resumable comparison simulates each test run on its own, exactly as path_runs does in one go."""
-    from fdikit.monitors.path_bank import path_bank, path_runs
-    from fdikit.monitors.path_compare import _test_run, _test_specs
+    from fdikit.studies.path1996.bank import path_bank, path_runs
+    from fdikit.studies.path1996.compare import _test_run, _test_specs
 
     full = path_runs(path_bank(), runs_per_fault=1, healthy_runs=1, onset=5.0, seed=12)
     specs = _test_specs(1, 1, 12)

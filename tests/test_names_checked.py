@@ -153,7 +153,7 @@ def test_stacked_bank_checks_every_signal():
 
 
 def test_scheduled_generator_checks_signals_both_paths():
-    from fdikit.design.scheduled import scheduled_parity_filter
+    from fdikit.design.parity.scheduled import scheduled_parity_filter
     from fdikit.plants.single_track import single_track_lpv
 
     gen = scheduled_parity_filter(single_track_lpv(), 70 / 3.6)

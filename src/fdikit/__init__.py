@@ -1,7 +1,28 @@
-"""fdikit: model-based fault detection, isolation and fault-tolerant control."""
+"""fdikit: model-based fault detection, isolation and fault-tolerant control.
 
-from fdikit.errors import DataError, DesignError, FdiError, FdiWarning, ModelError, ParameterError
-from fdikit.model import FaultModel
+The layers, from data to decisions (``docs/ARCHITECTURE.md``):
 
-__all__ = ["FaultModel", "FdiError", "ModelError", "DesignError", "DataError", "ParameterError", "FdiWarning"]
+* model layer — :mod:`fdikit.model` (:class:`FaultModel`, LTI with named signals), :mod:`fdikit.lpv`,
+  :mod:`fdikit.ltv`, :mod:`fdikit.dae`, :mod:`fdikit.gaussian`; :mod:`fdikit.plants` (benchmark plants);
+* signals — :mod:`fdikit.faults`, :mod:`fdikit.simulate`, :mod:`fdikit.trace` (+ :mod:`fdikit.trace_io`),
+  :mod:`fdikit.gaps`;
+* residual generation — :mod:`fdikit.design` (observers, game, parity families), :mod:`fdikit.residuals`;
+* decisions — :mod:`fdikit.decision` (evaluators), :mod:`fdikit.multimodel` (banks of estimators),
+  :mod:`fdikit.estimate` (fault sizes), :mod:`fdikit.diagnosis`, :mod:`fdikit.metrics`, :mod:`fdikit.compare`;
+* analysis and plots — :mod:`fdikit.analysis`, :mod:`fdikit.linalg`, :mod:`fdikit.plots`;
+* infrastructure — :mod:`fdikit.errors`, :mod:`fdikit.validate`, :mod:`fdikit.atomic`, :mod:`fdikit.resume`,
+  :mod:`fdikit.protocols`;
+* reproductions of the source documents — :mod:`fdikit.studies`.
+"""
+
+import lazy_loader as lazy
+
+__getattr__, __dir__, __all__ = lazy.attach(
+    __name__,
+    submodules=["analysis", "decision", "design", "estimate", "multimodel", "plants", "studies"],
+    submod_attrs={
+        "errors": ["DataError", "DesignError", "FdiError", "FdiWarning", "ModelError", "ParameterError"],
+        "model": ["FaultModel"],
+    },
+)
 __version__ = "0.1.0"

@@ -45,7 +45,7 @@ def demo(
     method: str = typer.Option("bank", help="'bank': PATH Beard-Jones filter bank; 'kalman': Kalman detection only."),
 ) -> None:
     """End-to-end diagnosis of faults on the PATH vehicle: detection, isolation, report."""
-    from fdikit.demo import check_demo_arguments, run_demo, run_kalman_demo
+    from fdikit.studies.path1996.demo import check_demo_arguments, run_demo, run_kalman_demo
 
     try:
         check_demo_arguments(out=out, seed=seed, method=method)
@@ -192,7 +192,7 @@ def compare_evaluators(
     Each test run's scores are stored in OUT as soon as the run is scored; rerunning the same command
     after an interruption resumes where it stopped.
     """
-    from fdikit.monitors.path_compare import check_comparison_arguments, path_evaluator_comparison
+    from fdikit.studies.path1996.compare import check_comparison_arguments, path_evaluator_comparison
 
     start = time.perf_counter()
     try:
@@ -227,7 +227,7 @@ def target_tracking(
     from rich.progress import Progress
 
     from fdikit.resume import RunStore, check_count, check_seed
-    from fdikit.scenarios.target_tracking import plot_target_tracking, target_tracking_monte_carlo
+    from fdikit.studies.hallouzi2008.target_tracking import plot_target_tracking, target_tracking_monte_carlo
 
     start = time.perf_counter()
     try:
@@ -277,7 +277,7 @@ def multiple_model(
     from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 
     from fdikit.resume import check_output_folder
-    from fdikit.scenarios.multiple_model_report import check_multiple_model_arguments, multiple_model_report
+    from fdikit.studies.hallouzi2008.report import check_multiple_model_arguments, multiple_model_report
 
     try:
         check_multiple_model_arguments(runs=runs, seed=seed, msd_dt=msd_dt, model_sets=model_sets)

@@ -5,7 +5,7 @@ Every evaluator sees exactly the same residual series; each run is scored with
 :func:`fdikit.metrics.summarize` (:func:`tabulate`).  The per-run scores CSV is written
 atomically once every run is scored, so an earlier file is never truncated; the resumable
 comparison that stores each run's scores as it finishes is
-:func:`fdikit.monitors.path_compare.path_evaluator_comparison` (``fdikit compare-evaluators``).
+:func:`fdikit.studies.path1996.compare.path_evaluator_comparison` (``fdikit compare-evaluators``).
 """
 
 from __future__ import annotations

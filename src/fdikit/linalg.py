@@ -15,16 +15,18 @@ data (``max(shape) · eps · σ_max`` by default, or a caller's relative toleran
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 import scipy.linalg
 
 from fdikit import validate
 from fdikit.errors import DesignError, ModelError, ParameterError
-from fdikit.model import FaultModel
+from fdikit.model import FaultModel, actuator_fault_name, sensor_fault_name
 
 __all__ = [
+    "resolve_faults",
+    "output_projector",
     "rank",
     "orth",
     "null",
@@ -460,3 +462,51 @@ def mutually_detectable(
         else:
             extra.append(z)
     return not extra and not left, joint, union
+
+
+def resolve_faults(model: FaultModel, faults: Mapping[str, np.ndarray] | Sequence[str]) -> dict[str, np.ndarray]:
+    """Fault maps by name.
+
+    A mapping gives explicit ``F`` matrices (n x k).  A sequence is resolved by
+    :func:`fdikit.linalg.resolve_fault`: an output name means the sensor fault ``[F¹, A F¹]``
+    (named ``<output>_sensor``), ``'<output>:magnitude'`` its bias direction ``A F¹`` only
+    (Douglas et al. 1996 §4.1, the air-mass fix), a control name the actuator fault
+    ``B[:, j]`` (named ``<control>_actuator``), a fault input of the model its own map.
+    """
+    validate.instance("model", model, FaultModel)
+    if isinstance(faults, str):
+        faults = [faults]
+    if isinstance(faults, Mapping):
+        out = {}
+        for name, F in faults.items():
+            F = np.atleast_2d(validate.as_array(f"fault map {name!r}", F, error=ModelError))
+            if F.shape[0] != model.n and F.shape[1] == model.n:
+                F = F.T
+            if F.shape[0] != model.n:
+                raise ModelError(f"fault map {name!r} has {F.shape[0]} rows; the model has {model.n} states")
+            out[str(name)] = F
+        return out
+    out = {}
+    for spec in faults:
+        F, kind = resolve_fault(model, str(spec))
+        base = str(spec).partition(":")[0]
+        if base in model.faults:
+            name = base
+        elif kind.startswith("sensor"):
+            name = sensor_fault_name(base)
+        else:
+            name = actuator_fault_name(base)
+        out[name] = F
+    return out
+
+
+def output_projector(C: np.ndarray, W: np.ndarray, rtol: float | None = None) -> np.ndarray:
+    """Orthogonal projector ``I − h hᵀ`` onto the complement of ``range(C W)`` (``h`` an orthonormal basis).
+
+    The detection-space projector ``Ĥ`` of Murray 2012, (2.15); ``I`` when ``W`` has no columns.
+    """
+    p = C.shape[0]
+    if W.shape[1] == 0:
+        return np.eye(p)
+    h = orth(C @ W, rtol)
+    return np.eye(p) - h @ h.T

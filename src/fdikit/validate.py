@@ -254,3 +254,46 @@ def instance(name: str, value, cls: type | tuple[type, ...], hint: str = "", *,
         want = cls.__name__ if isinstance(cls, type) else " or ".join(c.__name__ for c in cls)
         raise error(f"{name} must be a {want}, got {type(value).__name__}" + (f"; {hint}" if hint else ""))
     return value
+
+
+def as_sized_matrix(name: str, value, rows: int | None = None, cols: int | None = None, *,
+                    error: type[Exception] = ParameterError) -> np.ndarray:
+    """A finite 2-D matrix with ``rows`` rows and ``cols`` columns (each checked when given); a scalar or vector is
+    promoted to a 2-D matrix (``np.atleast_2d``)."""
+    out = np.atleast_2d(as_array(name, value, error=error, finite=False))
+    if out.ndim != 2:
+        raise error(f"{name} must be a 2-D matrix, got an array with {out.ndim} dimensions")
+    if rows is not None and out.shape[0] != rows:
+        raise error(f"{name} has shape {out.shape} but must have {rows} rows; give a {rows} x {cols} matrix")
+    if cols is not None and out.shape[1] != cols:
+        raise error(f"{name} has shape {out.shape} but must have {cols} columns; give a {rows} x {cols} matrix")
+    if not np.all(np.isfinite(out)):
+        raise error(f"{name} has a non-finite entry; every entry must be a finite number")
+    return out
+
+
+def as_sized_vector(name: str, value, size: int, *, error: type[Exception] = ParameterError,
+                    finite: bool = False) -> np.ndarray:
+    """Any array of exactly ``size`` entries, flattened to a vector (non-finite entries allowed unless ``finite``)."""
+    out = as_array(name, value, error=error, finite=finite).reshape(-1)
+    if out.size != size:
+        raise error(f"{name} has {out.size} entries but must have {size}; pass a vector of length {size}")
+    return out
+
+
+def psd_part(name: str, M: np.ndarray, *, error: type[Exception] = ParameterError) -> np.ndarray:
+    """Symmetric part of ``M`` after checking symmetry and positive semi-definiteness."""
+    scale = max(1.0, float(np.max(np.abs(M)))) if M.size else 1.0
+    if M.shape[0] != M.shape[1]:
+        raise error(f"{name} must be square, got shape {M.shape}")
+    if np.max(np.abs(M - M.T), initial=0.0) > 1e-8 * scale:
+        raise error(f"{name} is not symmetric; pass a symmetric covariance matrix (e.g. (M + M.T) / 2)")
+    Ms = 0.5 * (M + M.T)
+    if M.size:
+        lam = float(np.linalg.eigvalsh(Ms)[0])
+        if lam < -1e-10 * scale:
+            raise error(
+                f"{name} is not positive semi-definite (smallest eigenvalue {lam:.3g}); "
+                "a covariance matrix must have non-negative eigenvalues"
+            )
+    return Ms

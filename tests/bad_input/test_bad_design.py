@@ -8,7 +8,6 @@ from harness import case, check, ids
 
 from fdikit import FaultModel
 from fdikit.design import (
-    LPVModel,
     beard_jones,
     detection_gain_family,
     dgtfdf,
@@ -29,12 +28,10 @@ from fdikit.design import (
     observer,
     observer_generator,
     parity_design,
-    resolve_faults,
     restricted_diagonal,
     scheduled_parity_filter,
     single_fault_game_filter,
     solve_game_are,
-    stacked_matrices,
     theorem1,
     uio,
     uio_bank,
@@ -43,6 +40,8 @@ from fdikit.design import (
 )
 from fdikit.errors import DataError, DesignError, ModelError, ParameterError
 from fdikit.estimate import SteeringFaultIsolator, isolate_steering_faults, isolation_error_bound, lateral_fault_map
+from fdikit.linalg import resolve_faults
+from fdikit.lpv import LPVModel, stacked_matrices
 from fdikit.plants import white_speyer
 
 
@@ -63,7 +62,7 @@ def _dgs():
 
 
 def _ltv():
-    from fdikit.design import LTVModel
+    from fdikit.ltv import LTVModel
 
     return LTVModel.from_lti(white_speyer(), ["f1", "f2"])
 

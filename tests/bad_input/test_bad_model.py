@@ -7,10 +7,10 @@ import pytest
 from harness import case, check, ids
 
 from fdikit import FaultModel
-from fdikit.analysis import default_freqs, fault_to_residual_gain, structure_matrix
+from fdikit.analysis.gains import default_freqs, fault_to_residual_gain, structure_matrix
+from fdikit.analysis.geometry import fdi_report
 from fdikit.design import kalman
 from fdikit.errors import DataError, ModelError, ParameterError
-from fdikit.fdi_report import fdi_report
 from fdikit.linalg import (
     actuator_fault_map,
     caisa,

@@ -8,13 +8,12 @@ from harness import case, check, ids
 
 from fdikit import FaultModel
 from fdikit.errors import DataError, DesignError, ModelError, ParameterError
+from fdikit.gaussian import LinearGaussianModel, NonlinearGaussianModel
 from fdikit.multimodel import (
     ExtendedKalmanFilter,
     GroupThresholdLogic,
     IMMFilter,
     KalmanFilter,
-    LinearGaussianModel,
-    NonlinearGaussianModel,
     augmented_ekf,
     convex_model_set,
     cp_model_set,

@@ -1,4 +1,4 @@
-"""Bad input for the benchmark plants (fdikit.plants), the PATH monitor (fdikit.monitors) and the metrics."""
+"""Bad input for the benchmark plants (fdikit.plants), the PATH monitor (fdikit.studies.path1996) and the metrics."""
 
 from __future__ import annotations
 
@@ -9,7 +9,6 @@ from harness import case, check, ids
 from fdikit.diagnosis import Diagnosis
 from fdikit.errors import DataError, ParameterError
 from fdikit.metrics import confusion_matrix, score, summarize, vaf
-from fdikit.monitors import path_bank, path_fault_model, path_runs
 from fdikit.plants import (
     SingleTrackParameters,
     b747_longitudinal,
@@ -31,6 +30,7 @@ from fdikit.plants import (
     white_speyer,
 )
 from fdikit.plants.target_tracking import tracking_A
+from fdikit.studies.path1996 import path_bank, path_fault_model, path_runs
 
 N = 10
 

@@ -1,4 +1,4 @@
-"""Bad-input battery: residual generators (fdikit.residuals, fdikit.design.scheduled).
+"""Bad-input battery: residual generators (fdikit.residuals, fdikit.design.parity.scheduled).
 
 Traces whose signals or sample time do not match the generator (issue 12 item 5), bad options of
 ``run``/``online`` (initial state, residual covariance, recovery tolerance), samples that are not
@@ -37,7 +37,7 @@ def trace(controls=("u",), outputs=("y1", "y2"), dt=DT, n=50):
 
 @cache
 def scheduled():
-    from fdikit.design.scheduled import scheduled_parity_filter
+    from fdikit.design.parity.scheduled import scheduled_parity_filter
     from fdikit.plants.single_track import single_track_lpv
 
     return scheduled_parity_filter(single_track_lpv(), 70 / 3.6)

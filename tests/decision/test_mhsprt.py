@@ -402,8 +402,8 @@ def test_dynamic_programming_threshold():
 @pytest.fixture(scope="module")
 def path_setup():
     from fdikit.model import sensor_fault_name
-    from fdikit.monitors import path_bank, path_runs
-    from fdikit.monitors.path_bank import path_fault_model
+    from fdikit.studies.path1996 import path_bank, path_runs
+    from fdikit.studies.path1996.bank import path_fault_model
 
     bank = path_bank()
     nf = 1e-2  # sensor noise: 1 % of each sensor's nominal fault

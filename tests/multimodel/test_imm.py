@@ -9,8 +9,8 @@ import pytest
 from filterpy.kalman import IMMEstimator, KalmanFilter
 
 from fdikit.errors import DataError, ModelError
+from fdikit.gaussian import LinearGaussianModel
 from fdikit.multimodel.imm import IMMFilter
-from fdikit.multimodel.kalman import LinearGaussianModel
 from fdikit.trace import Trace
 
 

@@ -16,15 +16,15 @@ from filterpy.kalman import ExtendedKalmanFilter as FpEKF
 from filterpy.kalman import KalmanFilter as FpKF
 
 from fdikit.errors import DataError, ModelError, ParameterError
+from fdikit.gaussian import LinearGaussianModel, NonlinearGaussianModel
 from fdikit.model import FaultModel
 from fdikit.multimodel.ekf import (
     ExtendedKalmanFilter,
-    NonlinearGaussianModel,
     ekf_update,
     extended_kalman_filter,
     numerical_jacobian,
 )
-from fdikit.multimodel.kalman import KalmanFilter, LinearGaussianModel, kalman_filter
+from fdikit.multimodel.kalman import KalmanFilter, kalman_filter
 from fdikit.multimodel.kalman_steps import kf_predict, kf_update, psd_sqrt, srcf_step, srkf_predict, srkf_update
 
 
@@ -405,7 +405,8 @@ def test_batch_runner_switches_to_the_steady_state_filter_exactly(inputs):
 def test_online_step_switches_to_the_steady_filter_and_back():
     """Once P(k+1|k) has settled the online step uses the constant gain: same numbers as the recursion to
     round-off; a NaN sample (skipped update) sends it back to the recursion."""
-    from fdikit.multimodel.kalman import KalmanFilter, LinearGaussianModel
+    from fdikit.gaussian import LinearGaussianModel
+    from fdikit.multimodel.kalman import KalmanFilter
 
     rng = np.random.default_rng(3)
     A = np.array([[0.9, 0.2], [0.0, 0.8]])

@@ -12,8 +12,8 @@ import dataclasses
 import numpy as np
 import pytest
 
-from fdikit.design.lpv import LPVModel
 from fdikit.errors import ModelError, ParameterError
+from fdikit.lpv import LPVModel
 from fdikit.plants.varrier_lateral import (
     RHO_STAR,
     SCENIC,

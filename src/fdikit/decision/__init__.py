@@ -16,34 +16,66 @@ names differ (:class:`~fdikit.errors.DataError` naming the missing and the extra
 positions of reordered ones: use ``residuals.select(evaluator.names)``), and so does ``step`` when
 given ``names=`` (or a mapping ``{name: value}``).  Bad arguments raise
 :class:`~fdikit.errors.ParameterError`.
+
+* :mod:`fdikit.decision.threshold` — Fixed thresholds per residual, calibrated on fault-free data, with k-of-n
+  persistence.
+* :mod:`fdikit.decision.cusum` — Two-sided CUSUM per residual (Page 1954; Basseville & Nikiforov 1993 §2.2), with
+  Siegmund's ARL.
+* :mod:`fdikit.decision.glr` — Window-limited GLR test for a change in mean of unknown size (Willsky & Jones 1976).
+* :mod:`fdikit.decision.sprt` — Wald's sequential probability ratio test per residual block, single or repeated
+  (Wald 1947).
+* :mod:`fdikit.decision.mhsprt` — Multiple-hypothesis Shiryayev SPRT (Malladi & Speyer; Douglas et al. 1996, Ch. 7).
+* :mod:`fdikit.decision.shiryayev` — Thresholds of the Shiryayev SPRT: the false-alarm bound and the dynamic-
+  programming threshold (§7.1).
+* :mod:`fdikit.decision.densities` — Hypothesis densities for the multiple-hypothesis Shiryayev SPRT (Douglas et al.
+  1996, §7.2).
+* :mod:`fdikit.decision.whiten` — Prewhitening of coloured residuals before a test that assumes white ones (CUSUM,
+  GLR, SPRT).
+* :mod:`fdikit.decision.common` — Pieces every evaluator shares: k-of-n persistence, holding decisions over bad
+  samples, cached isolation, residual names checked against the fit.
+* :mod:`fdikit.decision.learned` — Learned residual classifiers (Douglas et al. 1996, Ch. 7): the Bayesian neural
+  network and the Gaussian maximum-likelihood classifier, trained on labelled runs.
 """
 
-from fdikit.decision.bnn import BnnEvaluator
-from fdikit.decision.cusum import CusumEvaluator, cusum_arl, cusum_design
-from fdikit.decision.gaussian_ml import GaussianMlEvaluator
-from fdikit.decision.glr import GlrEvaluator, glr_threshold
-from fdikit.decision.mhsprt import MhsprtEvaluator
-from fdikit.decision.shiryayev import shiryayev_threshold
-from fdikit.decision.sprt import SprtEvaluator, sprt_asn, sprt_thresholds
-from fdikit.decision.threshold import ThresholdEvaluator, alpha_from_rate
-from fdikit.decision.whiten import Whitened
-from fdikit.diagnosis import StepDecision
+import lazy_loader as lazy
 
-__all__ = [
-    "BnnEvaluator",
-    "CusumEvaluator",
-    "GaussianMlEvaluator",
-    "GlrEvaluator",
-    "MhsprtEvaluator",
-    "SprtEvaluator",
-    "StepDecision",
-    "ThresholdEvaluator",
-    "Whitened",
-    "alpha_from_rate",
-    "cusum_arl",
-    "cusum_design",
-    "glr_threshold",
-    "shiryayev_threshold",
-    "sprt_asn",
-    "sprt_thresholds",
-]
+__getattr__, __dir__, __all__ = lazy.attach(
+    __name__,
+    submodules=["learned"],
+    submod_attrs={
+        "threshold": [
+            "ThresholdEvaluator", "alpha_from_rate",
+        ],
+        "cusum": [
+            "CusumEvaluator", "SIEGMUND_CORRECTION", "cusum_arl", "cusum_design",
+        ],
+        "glr": [
+            "BlockLayout", "GlrEvaluator", "as_covariance", "fit_moments", "glr_threshold", "residual_blocks",
+        ],
+        "sprt": [
+            "SprtEvaluator", "sprt_asn", "sprt_thresholds",
+        ],
+        "mhsprt": [
+            "GaussianDensity", "MhsprtEvaluator", "ShiryayevDP", "UniformMeanDensity", "gaussian_mean_density",
+            "magnitude_blocks", "shiryayev_dp", "shiryayev_threshold",
+        ],
+        "shiryayev": [
+            "ShiryayevDP", "shiryayev_dp", "shiryayev_threshold",
+        ],
+        "densities": [
+            "GaussianDensity", "UniformMeanDensity", "gaussian_mean_density",
+        ],
+        "whiten": [
+            "Whitened", "yule_walker",
+        ],
+        "common": [
+            "check_fitted_names", "checked_names", "checked_residuals", "held", "is_count", "isolate_cached",
+            "k_of_n", "step_vector",
+        ],
+        "learned": [
+            "BnnEvaluator", "BnnNetwork", "BnnNetwork", "GaussianMlEvaluator", "QuasiNewtonResult",
+            "QuasiNewtonResult", "TrainingReport", "quasi_newton", "quasi_newton", "robbins_monro_steps",
+            "robbins_monro_steps",
+        ],
+    },
+)

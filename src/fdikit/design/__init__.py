@@ -1,90 +1,38 @@
-"""Residual-generator synthesis: plain functions that return a design (generator + report)."""
+"""Residual-generator synthesis: plain functions that return a design (generator + report), by method family.
 
-from fdikit.design.beard_jones import (
-    BeardJonesDesign,
-    RestrictedDiagonalDesign,
-    beard_jones,
-    resolve_faults,
-    restricted_diagonal,
-)
-from fdikit.design.dae_parity import DAEModel, PolynomialParityDesign, dae_form, minimal_degree, parity_filter
-from fdikit.design.detection_gain import DetectionGainFamily, detection_gain_family
-from fdikit.design.game import (
-    GameBankDesign,
-    GameDesign,
-    SingleFaultGameDesign,
-    game_filter,
-    game_filter_bank,
-    single_fault_game_filter,
-)
-from fdikit.design.game_discrete import dgtfdf, dgtmfdf, discrete_game_setup
-from fdikit.design.game_ltv import LTVGameDesign, ltv_feasibility, ltv_game_filter
-from fdikit.design.game_riccati import game_riccati, solve_game_are
-from fdikit.design.game_setup import GameProblem, game_problem
-from fdikit.design.hinf import Enhancement, HinfDesign, enhancement_direction, hinf_detection_filter
-from fdikit.design.lpv import LPVModel, stacked_matrices
-from fdikit.design.ltv import LTVModel
-from fdikit.design.observer import ObserverDesign, kalman, observer, observer_generator, unobservable_modes
-from fdikit.design.parity import ParityDesign, lpv_parity_residuals, parity_design
-from fdikit.design.reduced_order import GohFilterDesign, goh_detector, goh_filter
-from fdikit.design.robust_parity import RobustParityDesign, robust_lpv_parity, theorem1
-from fdikit.design.scheduled import ScheduledResidualGenerator, scheduled_parity_filter
-from fdikit.design.uio import UIODesign, uio, uio_bank, unknown_input_matrix
+The most used designs are importable from here; every name of a family is in its subpackage.
 
-__all__ = [
-    "BeardJonesDesign",
-    "DAEModel",
-    "DetectionGainFamily",
-    "Enhancement",
-    "GameBankDesign",
-    "GameDesign",
-    "GameProblem",
-    "GohFilterDesign",
-    "HinfDesign",
-    "LPVModel",
-    "LTVGameDesign",
-    "LTVModel",
-    "ObserverDesign",
-    "ParityDesign",
-    "PolynomialParityDesign",
-    "RestrictedDiagonalDesign",
-    "RobustParityDesign",
-    "ScheduledResidualGenerator",
-    "SingleFaultGameDesign",
-    "UIODesign",
-    "beard_jones",
-    "dae_form",
-    "detection_gain_family",
-    "dgtfdf",
-    "dgtmfdf",
-    "discrete_game_setup",
-    "enhancement_direction",
-    "game_filter",
-    "game_filter_bank",
-    "game_problem",
-    "game_riccati",
-    "goh_detector",
-    "goh_filter",
-    "hinf_detection_filter",
-    "kalman",
-    "lpv_parity_residuals",
-    "ltv_feasibility",
-    "ltv_game_filter",
-    "minimal_degree",
-    "observer",
-    "observer_generator",
-    "parity_design",
-    "parity_filter",
-    "resolve_faults",
-    "restricted_diagonal",
-    "robust_lpv_parity",
-    "scheduled_parity_filter",
-    "single_fault_game_filter",
-    "solve_game_are",
-    "stacked_matrices",
-    "theorem1",
-    "uio",
-    "uio_bank",
-    "unknown_input_matrix",
-    "unobservable_modes",
-]
+* :mod:`fdikit.design.observers` — Observer-type residual generators: full-order observers, Beard–Jones and
+  restricted-diagonal detection filters, unknown-input observers, detection-gain families and the H∞-bounded
+  detection filter.
+* :mod:`fdikit.design.game` — Game-theoretic detection filters (Murray 2012): problem set-up, Riccati equations,
+  continuous, discrete and time-varying filters, and the γ → 0 limit (Goh transformation, reduced-order detector).
+* :mod:`fdikit.design.parity` — Parity-space residual generators: state-space parity relations, polynomial (DAE)
+  parity filters, speed-scheduled parity filters and the robust LPV parity design.
+"""
+
+import lazy_loader as lazy
+
+__getattr__, __dir__, __all__ = lazy.attach(
+    __name__,
+    submodules=["observers", "game", "parity"],
+    submod_attrs={
+        "observers": [
+            "BeardJonesDesign", "DetectionGainFamily", "Enhancement", "HinfDesign", "ObserverDesign",
+            "RestrictedDiagonalDesign", "UIODesign", "beard_jones", "detection_gain_family", "enhancement_direction",
+            "hinf_detection_filter", "kalman", "observer", "observer_generator", "restricted_diagonal", "uio",
+            "uio_bank", "unknown_input_matrix", "unobservable_modes",
+        ],
+        "game": [
+            "GameBankDesign", "GameDesign", "GameProblem", "GohFilterDesign", "LTVGameDesign",
+            "SingleFaultGameDesign", "dgtfdf", "dgtmfdf", "discrete_game_setup", "game_filter", "game_filter_bank",
+            "game_problem", "game_riccati", "goh_detector", "goh_filter", "ltv_feasibility", "ltv_game_filter",
+            "single_fault_game_filter", "solve_game_are",
+        ],
+        "parity": [
+            "ParityDesign", "PolynomialParityDesign", "RobustParityDesign", "ScheduledResidualGenerator",
+            "lpv_parity_residuals", "minimal_degree", "parity_design", "parity_filter", "robust_lpv_parity",
+            "scheduled_parity_filter", "theorem1",
+        ],
+    },
+)

@@ -1,41 +1,65 @@
 """Multiple-model estimation and diagnosis (Hallouzi 2008): Kalman/EKF building blocks, the IMM filter,
 convex-model filters and model-set design.
 
-* :mod:`fdikit.multimodel.kalman`, :mod:`fdikit.multimodel.ekf` — Kalman filter (covariance and square-root
-  forms) and EKF, returning innovations, their covariances and log-likelihoods;
-* :mod:`fdikit.multimodel.imm` — the IMM filter for jump-Markov linear systems (Table 2.1, corrected);
-* :mod:`fdikit.multimodel.isolation` — the Table 4.7 isolation logic on mode probabilities;
-* :mod:`fdikit.multimodel.model_set` — model-set design (Ch. 3, App. B);
-* :mod:`fdikit.multimodel.convex`, :mod:`fdikit.multimodel.convex_ekf` — convex-model filters (dual filter and
-  augmented EKF) and fault-size reconstruction from the weights.
+* :mod:`fdikit.multimodel.kalman_steps` — Kalman-filter steps on arrays: covariance (Joseph) form and square-root
+  (QR) form.
+* :mod:`fdikit.multimodel.kalman` — Discrete Kalman filter for one linear Gaussian model: batch runner and online
+  filter.
+* :mod:`fdikit.multimodel.ekf` — Extended Kalman filter with user Jacobians or central finite differences.
+* :mod:`fdikit.multimodel.imm` — Interacting multiple-model (IMM) filter for jump-Markov linear systems.
+* :mod:`fdikit.multimodel.isolation` — Fault isolation from multiple-model weights: the group-sum threshold logic of
+  Hallouzi 2008, Table 4.7.
+* :mod:`fdikit.multimodel.model_set` — Model-set design for multiple-model estimation: Hallouzi 2008, Ch. 3 and App.
+  B.
+* :mod:`fdikit.multimodel.cp_design` — CP model-set design: an enclosing convex polytope (Hallouzi 2008, §3.4,
+  (3.25)–(3.33)), after Kanev (2006).
+* :mod:`fdikit.multimodel.convex` — Convex-model (CM) structure and the dual convex-model filter (Hallouzi 2008,
+  §2.2.2, §2.3.2).
+* :mod:`fdikit.multimodel.convex_ekf` — Augmented EKF for the convex-model structure (Hallouzi 2008, §2.3.3, Table
+  2.3).
+* :mod:`fdikit.multimodel.simplex` — Projection of convex-model weights on the simplex (Hallouzi 2008,
+  (2.37)–(2.38)).
 """
 
-from fdikit.multimodel.convex import ConvexFilterResult, convex_model_set, dual_convex_filter
-from fdikit.multimodel.convex_ekf import augmented_ekf
-from fdikit.multimodel.cp_design import cp_model_set
-from fdikit.multimodel.ekf import ExtendedKalmanFilter, NonlinearGaussianModel, extended_kalman_filter
-from fdikit.multimodel.imm import IMMFilter, IMMResult
-from fdikit.multimodel.isolation import GroupThresholdLogic, table_4_7_logic
-from fdikit.multimodel.kalman import KalmanFilter, KalmanResult, LinearGaussianModel, kalman_filter
-from fdikit.multimodel.model_set import limit_value_model_set, od_model_set
+import lazy_loader as lazy
 
-__all__ = [
-    "ConvexFilterResult",
-    "ExtendedKalmanFilter",
-    "GroupThresholdLogic",
-    "IMMFilter",
-    "IMMResult",
-    "KalmanFilter",
-    "KalmanResult",
-    "LinearGaussianModel",
-    "NonlinearGaussianModel",
-    "augmented_ekf",
-    "convex_model_set",
-    "cp_model_set",
-    "dual_convex_filter",
-    "extended_kalman_filter",
-    "kalman_filter",
-    "limit_value_model_set",
-    "od_model_set",
-    "table_4_7_logic",
-]
+__getattr__, __dir__, __all__ = lazy.attach(
+    __name__,
+    submod_attrs={
+        "kalman_steps": [
+            "gaussian_log_likelihood", "kf_predict", "kf_update", "psd_sqrt", "srcf_step", "srkf_predict",
+            "srkf_update",
+        ],
+        "kalman": [
+            "KalmanFilter", "KalmanResult", "KalmanStep", "kalman_filter",
+        ],
+        "ekf": [
+            "ExtendedKalmanFilter", "ekf_predict", "ekf_update", "extended_kalman_filter", "numerical_jacobian",
+        ],
+        "imm": [
+            "IMMFilter", "IMMResult", "IMMStep", "IMMStepper",
+        ],
+        "isolation": [
+            "GroupThresholdLogic", "mode_diagnosis", "most_probable_mode", "table_4_7_logic",
+        ],
+        "model_set": [
+            "LimitValueModelSet", "ODModelSet", "affine_weights", "first_order_discretize", "gap_rank",
+            "limit_value_model_set", "minimum_mismatch_points", "nearest_model", "observability_condition",
+            "od_model_set", "pair_observability", "pivoted_qr", "taylor_remainder_bound", "unvectorize", "vectorize",
+        ],
+        "cp_design": [
+            "CPModelSet", "convex_weights", "cp_model_set", "fit_enclosing_polytope",
+        ],
+        "convex": [
+            "ConvexFilterResult", "ConvexModelSet", "convex_model_set", "dual_convex_filter",
+            "estimated_model_vector", "fault_size_from_weights", "innovation_regressors", "limit_value_convex_set",
+            "lv_parameter", "lv_reciprocal_parameter", "project_to_simplex", "rls_weight_step", "weight_regressors",
+        ],
+        "convex_ekf": [
+            "augmented_ekf", "augmented_jacobians",
+        ],
+        "simplex": [
+            "constrain_weights", "project_to_affine", "project_to_simplex", "project_to_simplex_weighted",
+        ],
+    },
+)

@@ -26,7 +26,7 @@ import scipy.linalg
 
 from fdikit import validate
 from fdikit.errors import DataError, ModelError, ParameterError
-from fdikit.multimodel.kalman_steps import _tria, psd_sqrt, srcf_step, srkf_predict, srkf_update
+from fdikit.multimodel.kalman_steps import psd_sqrt, srcf_step, srkf_predict, srkf_update, tria
 from fdikit.multimodel.simplex import constrain_weights, project_to_simplex
 
 __all__ = [
@@ -257,7 +257,7 @@ class ConvexFilterResult:
     names: tuple[str, ...]
 
 
-def _check_data(models: ConvexModelSet, y, u):
+def check_data(models: ConvexModelSet, y, u):
     y = validate.as_array("y", y, error=DataError, finite=False)
     if y.ndim != 2 or y.shape[1] != models.p:
         raise DataError(f"y must be (K, {models.p}) measurements, got shape {y.shape}")
@@ -295,7 +295,7 @@ def innovation_regressors(models: ConvexModelSet, x_prev, S_prev, u_prev, u, y, 
     _, H = models.weight_columns(x_pred, u)
     G = C @ F + H
     e = y - C @ x_pred - D @ u
-    Re = _tria(np.hstack([C @ S_pred, R_sqrt]))
+    Re = tria(np.hstack([C @ S_pred, R_sqrt]))
     Phi = scipy.linalg.solve_triangular(Re, G, lower=True)
     Gamma = scipy.linalg.solve_triangular(Re, e + G @ mu_prev, lower=True)
     return Phi, Gamma, F, x_pred, S_pred
@@ -374,7 +374,7 @@ def dual_convex_filter(models: ConvexModelSet, y, u, x0, P0, mu0=None, lam: floa
         validate.as_vector("mu0", mu0, models.N)
     if form == "thesis" and models.offset is not None:
         raise ModelError("the printed weight step (2.33) has no offset term; use form='corrected' for limit-value sets")
-    y, u = _check_data(models, y, u)
+    y, u = check_data(models, y, u)
     N, n = models.N, models.n
     mu = np.full(N, 1.0 / N) if mu0 is None else models.check_weights(mu0)
     x_pred = validate.as_vector("x0", x0, n)

@@ -22,7 +22,7 @@ from fdikit.errors import ParameterError
 from fdikit.multimodel.convex import (
     ConvexFilterResult,
     ConvexModelSet,
-    _check_data,
+    check_data,
 )
 from fdikit.multimodel.simplex import constrain_weights
 
@@ -98,7 +98,7 @@ def augmented_ekf(models: ConvexModelSet, y, u, x0, P0, mu0=None, Q_mu=None, P_m
     Q_mu = validate.as_covariance("Q_mu", Q_mu, N)
     P_mu0 = validate.as_covariance("P_mu0", P_mu0, N)
     P0 = validate.as_covariance("P0", P0, n)
-    y, u = _check_data(models, y, u)
+    y, u = check_data(models, y, u)
     mu = np.full(N, 1.0 / N) if mu0 is None else models.check_weights(mu0)
     Qa = np.zeros((n + N, n + N))
     Qa[:n, :n], Qa[n:, n:] = models.Q, Q_mu

@@ -24,7 +24,7 @@ import scipy.spatial
 
 from fdikit import validate
 from fdikit.errors import DesignError
-from fdikit.multimodel.model_set import _as_model_matrix, gap_rank
+from fdikit.multimodel.model_set import as_model_matrix, gap_rank
 
 __all__ = ["CPModelSet", "cp_model_set", "convex_weights", "fit_enclosing_polytope"]
 
@@ -135,7 +135,7 @@ def cp_model_set(models, rank: int | None = None, min_gap: float = 10.0, n_verti
         rank = validate.integer("rank", rank, minimum=1)
     if n_vertices is not None:
         n_vertices = validate.integer("n_vertices", n_vertices, minimum=1)
-    M = _as_model_matrix(models)
+    M = as_model_matrix(models)
     U, s, Vt = np.linalg.svd(M, full_matrices=False)
     n_g = gap_rank(s, min_gap) if rank is None else int(rank)
     basis = U[:, :n_g]

@@ -27,19 +27,16 @@ array([[2., 0.]])
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
-
 import numpy as np
 import scipy.linalg
 
 from fdikit import validate
 from fdikit.errors import DataError, ModelError, ParameterError
-from fdikit.multimodel.kalman import KalmanResult, KalmanStep, _check_record, _collect
-from fdikit.multimodel.kalman_steps import _as_matrix, _as_vector, _check_psd, gaussian_log_likelihood
+from fdikit.gaussian import Fun, NonlinearGaussianModel
+from fdikit.multimodel.kalman import KalmanResult, KalmanStep, check_record, collect_steps
+from fdikit.multimodel.kalman_steps import gaussian_log_likelihood
 
 __all__ = [
-    "NonlinearGaussianModel",
     "ExtendedKalmanFilter",
     "numerical_jacobian",
     "ekf_predict",
@@ -47,7 +44,6 @@ __all__ = [
     "extended_kalman_filter",
 ]
 
-Fun = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
 _FD_STEP = float(np.finfo(float).eps) ** (1.0 / 3.0)
 
@@ -129,50 +125,6 @@ def ekf_update(
     return x + K @ e, 0.5 * (P_filt + P_filt.T), e, S, gaussian_log_likelihood(e, S_chol)
 
 
-@dataclass(frozen=True, eq=False)
-class NonlinearGaussianModel:
-    """``x⁺ = f(x, u) + w``, ``y = h(x, u) + v`` with ``cov(w) = Q``, ``cov(v) = R``.
-
-    ``f_jacobian(x, u)`` / ``h_jacobian(x, u)`` are optional analytic Jacobians; when
-    omitted, central finite differences are used (:func:`numerical_jacobian`).
-    ``n_inputs`` is the length of ``u`` (0: ``u`` is an empty vector).
-    """
-
-    f: Fun
-    h: Fun
-    Q: np.ndarray
-    R: np.ndarray
-    n_inputs: int = 0
-    f_jacobian: Fun | None = None
-    h_jacobian: Fun | None = None
-
-    def __post_init__(self) -> None:
-        Q = _as_matrix("Q", self.Q)
-        R = _as_matrix("R", self.R)
-        object.__setattr__(self, "Q", _check_psd("Q", Q))
-        object.__setattr__(self, "R", _check_psd("R", R))
-        if not callable(self.f) or not callable(self.h):
-            raise ModelError("f and h must be callables f(x, u) -> x_next, h(x, u) -> y")
-        object.__setattr__(self, "n_inputs", validate.integer("n_inputs", self.n_inputs, minimum=0, error=ModelError))
-        for nm in ("f_jacobian", "h_jacobian"):
-            if getattr(self, nm) is not None and not callable(getattr(self, nm)):
-                raise ModelError(
-                    f"{nm} must be a callable (x, u) -> matrix or None, got {type(getattr(self, nm)).__name__}"
-                )
-        if np.linalg.eigvalsh(self.R)[0] <= 0:
-            raise ModelError("R must be positive definite (the innovation covariance must be invertible)")
-
-    @property
-    def n(self) -> int:
-        """Number of states."""
-        return self.Q.shape[0]
-
-    @property
-    def p(self) -> int:
-        """Number of outputs."""
-        return self.R.shape[0]
-
-
 class ExtendedKalmanFilter:
     """Online EKF; ``step(u, y)`` as :class:`~fdikit.multimodel.kalman.KalmanFilter` (NaN ``y`` skips the update).
 
@@ -187,14 +139,15 @@ class ExtendedKalmanFilter:
         if not isinstance(model, NonlinearGaussianModel):
             raise ParameterError(f"model must be a NonlinearGaussianModel, got {type(model).__name__}")
         self.model = model
-        self.x = _as_vector("x0", x0, model.n, error=ParameterError, finite=True)
-        self.P = _check_psd("P0", _as_matrix("P0", P0, model.n, model.n, error=ParameterError), error=ParameterError)
+        self.x = validate.as_sized_vector("x0", x0, model.n, error=ParameterError, finite=True)
+        P0 = validate.as_sized_matrix("P0", P0, model.n, model.n, error=ParameterError)
+        self.P = validate.psd_part("P0", P0, error=ParameterError)
 
     def step(self, u, y) -> KalmanStep:
         """Update with ``y(k)`` (skipped if it has a NaN), then predict with ``u(k)``."""
         m = self.model
-        u = _as_vector("u", np.zeros(0) if u is None else u, m.n_inputs)
-        y = _as_vector("y", y, m.p)
+        u = validate.as_sized_vector("u", np.zeros(0) if u is None else u, m.n_inputs, error=DataError)
+        y = validate.as_sized_vector("y", y, m.p, error=DataError)
         if not np.all(np.isfinite(u)):
             raise DataError("u has a NaN/inf entry; the time update needs every input (fill or drop the sample)")
         valid = bool(np.all(np.isfinite(y)))
@@ -213,6 +166,6 @@ def extended_kalman_filter(model: NonlinearGaussianModel, u, y, x0, P0) -> Kalma
     NaN/inf in ``u`` or ``y`` raises :class:`~fdikit.errors.DataError` (use the online filter).
     """
     ekf = ExtendedKalmanFilter(model, x0, P0)
-    u, y = _check_record(u, y, model.n_inputs, model.p)
+    u, y = check_record(u, y, model.n_inputs, model.p)
     steps = [ekf.step(uk, yk) for uk, yk in zip(u, y, strict=True)]
-    return _collect(steps, model.n, model.p)
+    return collect_steps(steps, model.n, model.p)

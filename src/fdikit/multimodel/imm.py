@@ -30,9 +30,8 @@ import numpy as np
 
 from fdikit import validate
 from fdikit.errors import DataError, ModelError, ParameterError
+from fdikit.gaussian import LinearGaussianModel
 from fdikit.multimodel.isolation import GroupThresholdLogic, mode_diagnosis
-from fdikit.multimodel.kalman import LinearGaussianModel
-from fdikit.multimodel.kalman_steps import _check_psd
 from fdikit.trace import Trace
 
 __all__ = ["IMMFilter", "IMMStepper", "IMMStep", "IMMResult"]
@@ -150,7 +149,7 @@ class IMMFilter:
         if P0 is None:
             raise ParameterError(f"P0 must have shape ({n}, {n}) or ({M}, {n}, {n})")
         for i in range(M):
-            _check_psd("P0" if M == 1 else f"P0[{i}]", P0[i], error=ParameterError)
+            validate.psd_part("P0" if M == 1 else f"P0[{i}]", P0[i], error=ParameterError)
         nominal = validate.integer("nominal", self.nominal)
         if not 0 <= nominal < M:
             raise ParameterError(f"nominal = {nominal} is not a mode index in [0, {M})")

@@ -29,13 +29,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from fdikit import validate
-from fdikit.errors import DataError, ModelError, ParameterError
+from fdikit.errors import DataError, ParameterError
+from fdikit.gaussian import LinearGaussianModel
 from fdikit.lti import dlsim_blocked
 from fdikit.model import FaultModel
 from fdikit.multimodel.kalman_steps import (
-    _as_matrix,
-    _as_vector,
-    _check_psd,
     kf_predict,
     kf_update,
     psd_sqrt,
@@ -43,72 +41,10 @@ from fdikit.multimodel.kalman_steps import (
     srkf_update,
 )
 
-__all__ = ["LinearGaussianModel", "KalmanResult", "KalmanStep", "KalmanFilter", "kalman_filter"]
+__all__ = ["KalmanResult", "KalmanStep", "KalmanFilter", "kalman_filter"]
 
 
 # ---------------------------------------------------------------------------------------- model + results
-@dataclass(frozen=True, eq=False)
-class LinearGaussianModel:
-    """Discrete linear Gaussian model ``x⁺ = A x + B u + w``, ``y = C x + D u + v`` (Hallouzi 2008, (2.3)–(2.4)).
-
-    ``Q = cov(w)`` (n x n) and ``R = cov(v)`` (p x p) are the state-space covariances
-    (the thesis's ``(Q)^{1/2} w̄`` with unit-variance ``w̄``).  Build from a discrete
-    :class:`~fdikit.model.FaultModel` with :meth:`from_fault_model` (uses ``A, Bu, C, Du``).
-    ``name`` labels the model as one mode of a bank (the IMM's hypotheses).
-    """
-
-    A: np.ndarray
-    B: np.ndarray
-    C: np.ndarray
-    D: np.ndarray
-    Q: np.ndarray
-    R: np.ndarray
-    name: str = ""
-
-    def __init__(self, A, C, Q, R, B=None, D=None, name: str = "") -> None:
-        A = _as_matrix("A", A)
-        n = A.shape[0]
-        if A.shape != (n, n):
-            raise ModelError(f"A must be square, got shape {A.shape}")
-        C = _as_matrix("C", C, cols=n)
-        p = C.shape[0]
-        B = np.zeros((n, 0)) if B is None else _as_matrix("B", B, rows=n)
-        D = np.zeros((p, B.shape[1])) if D is None else _as_matrix("D", D, p, B.shape[1])
-        Q = _check_psd("Q", _as_matrix("Q", Q, n, n))
-        R = _check_psd("R", _as_matrix("R", R, p, p))
-        if p and np.linalg.eigvalsh(R)[0] <= 1e-14 * max(1.0, float(np.max(np.abs(R)))):
-            raise ModelError("R must be positive definite (the innovation covariance must be invertible)")
-        object.__setattr__(self, "name", str(name))
-        for key, val in zip("ABCDQR", (A, B, C, D, Q, R), strict=True):
-            val = np.array(val)
-            val.setflags(write=False)
-            object.__setattr__(self, key, val)
-
-    @classmethod
-    def from_fault_model(cls, model: FaultModel, Q, R) -> LinearGaussianModel:
-        """Take ``A, Bu, C, Du`` of a discrete ``FaultModel``; ``Q``, ``R`` are state/output covariances."""
-        if not isinstance(model, FaultModel):
-            raise ModelError(f"expected a FaultModel, got {type(model).__name__}")
-        if not model.is_discrete:
-            raise ModelError("the Kalman filter needs a discrete model; discretize it first (model.discretize(dt))")
-        return cls(model.A, model.C, Q, R, B=model.Bu, D=model.Du)
-
-    @property
-    def n(self) -> int:
-        """Number of states."""
-        return self.A.shape[0]
-
-    @property
-    def p(self) -> int:
-        """Number of outputs."""
-        return self.C.shape[0]
-
-    @property
-    def m(self) -> int:
-        """Number of inputs."""
-        return self.B.shape[1]
-
-
 @dataclass(frozen=True)
 class KalmanStep:
     """One online step: filtered and next predicted estimates, innovation, validity."""
@@ -195,8 +131,9 @@ class KalmanFilter:
         self.model = _as_model(model, Q, R)
         n = self.model.n
         self.form = form
-        self.x = _as_vector("x0", x0, n, error=ParameterError, finite=True)
-        P0 = _check_psd("P0", _as_matrix("P0", P0, n, n, error=ParameterError), error=ParameterError)
+        self.x = validate.as_sized_vector("x0", x0, n, error=ParameterError, finite=True)
+        P0 = validate.as_sized_matrix("P0", P0, n, n, error=ParameterError)
+        P0 = validate.psd_part("P0", P0, error=ParameterError)
         self.P = P0
         self._S = psd_sqrt(P0, "P0")
         self._Qs = psd_sqrt(self.model.Q, "Q")
@@ -212,8 +149,8 @@ class KalmanFilter:
     def step(self, u, y) -> KalmanStep:
         """Update with ``y(k)``, predict with ``u(k)``; returns the :class:`KalmanStep`."""
         m = self.model
-        u = _as_vector("u", np.zeros(0) if u is None else u, m.m)
-        y = _as_vector("y", y, m.p)
+        u = validate.as_sized_vector("u", np.zeros(0) if u is None else u, m.m, error=DataError)
+        y = validate.as_sized_vector("y", y, m.p, error=DataError)
         if not np.all(np.isfinite(u)):
             raise DataError("u has a NaN/inf entry; the time update needs every input (fill or drop the sample)")
         valid = bool(np.all(np.isfinite(y)))
@@ -273,7 +210,7 @@ class KalmanFilter:
         return KalmanStep(xf, Pf, xp, Pp, e, S, float(const - 0.5 * (w @ w)), True)
 
 
-def _check_record(u, y, m: int, p: int) -> tuple[np.ndarray, np.ndarray]:
+def check_record(u, y, m: int, p: int) -> tuple[np.ndarray, np.ndarray]:
     y = validate.as_array("y", y, error=DataError, finite=False)
     if y.ndim == 1 and p == 1:
         y = y.reshape(-1, 1)
@@ -321,13 +258,13 @@ def kalman_filter(model, u, y, x0, P0, *, form: str = "covariance", Q=None, R=No
     ((2, 1), [True, True])
     """
     kf = KalmanFilter(model, x0, P0, form=form, Q=Q, R=R)
-    u, y = _check_record(u, y, kf.model.m, kf.model.p)
+    u, y = check_record(u, y, kf.model.m, kf.model.p)
     steps = []
     for k, (uk, yk) in enumerate(zip(u, y, strict=True)):
         steps.append(kf.step(uk, yk))
         if kf._steady is not None and k + 1 < len(y):  # P(k+1|k) has settled (KalmanFilter._track_settling)
-            return _stack_results(_collect(steps, kf.model.n, kf.model.p), _steady_run(kf, u[k + 1:], y[k + 1:]))
-    return _collect(steps, kf.model.n, kf.model.p)
+            return _stack_results(collect_steps(steps, kf.model.n, kf.model.p), _steady_run(kf, u[k + 1:], y[k + 1:]))
+    return collect_steps(steps, kf.model.n, kf.model.p)
 
 
 def _steady_run(kf: KalmanFilter, u: np.ndarray, y: np.ndarray) -> KalmanResult:
@@ -370,7 +307,7 @@ def _stack_results(first: KalmanResult, rest: KalmanResult) -> KalmanResult:
                            for f in KalmanResult.__dataclass_fields__})
 
 
-def _collect(steps: list[KalmanStep], n: int, p: int) -> KalmanResult:
+def collect_steps(steps: list[KalmanStep], n: int, p: int) -> KalmanResult:
     def stack(attr, shape):
         vals = [getattr(s, attr) for s in steps]
         return np.array(vals, dtype=float).reshape((len(steps), *shape))

@@ -40,45 +40,6 @@ _LOG_2PI = float(np.log(2.0 * np.pi))
 
 
 # ---------------------------------------------------------------------------------------- helpers
-def _as_matrix(name: str, value, rows: int | None = None, cols: int | None = None, *,
-               error: type[Exception] = ModelError) -> np.ndarray:
-    out = np.atleast_2d(validate.as_array(name, value, error=error, finite=False))
-    if out.ndim != 2:
-        raise error(f"{name} must be a 2-D matrix, got an array with {out.ndim} dimensions")
-    if rows is not None and out.shape[0] != rows:
-        raise error(f"{name} has shape {out.shape} but must have {rows} rows; give a {rows} x {cols} matrix")
-    if cols is not None and out.shape[1] != cols:
-        raise error(f"{name} has shape {out.shape} but must have {cols} columns; give a {rows} x {cols} matrix")
-    if not np.all(np.isfinite(out)):
-        raise error(f"{name} has a non-finite entry; every entry must be a finite number")
-    return out
-
-
-def _as_vector(name: str, value, size: int, *, error: type[Exception] = DataError, finite: bool = False) -> np.ndarray:
-    out = validate.as_array(name, value, error=error, finite=finite).reshape(-1)
-    if out.size != size:
-        raise error(f"{name} has {out.size} entries but must have {size}; pass a vector of length {size}")
-    return out
-
-
-def _check_psd(name: str, M: np.ndarray, *, error: type[Exception] = ModelError) -> np.ndarray:
-    """Symmetric part of ``M`` after checking symmetry and positive semi-definiteness."""
-    scale = max(1.0, float(np.max(np.abs(M)))) if M.size else 1.0
-    if M.shape[0] != M.shape[1]:
-        raise error(f"{name} must be square, got shape {M.shape}")
-    if np.max(np.abs(M - M.T), initial=0.0) > 1e-8 * scale:
-        raise error(f"{name} is not symmetric; pass a symmetric covariance matrix (e.g. (M + M.T) / 2)")
-    Ms = 0.5 * (M + M.T)
-    if M.size:
-        lam = float(np.linalg.eigvalsh(Ms)[0])
-        if lam < -1e-10 * scale:
-            raise error(
-                f"{name} is not positive semi-definite (smallest eigenvalue {lam:.3g}); "
-                "a covariance matrix must have non-negative eigenvalues"
-            )
-    return Ms
-
-
 def psd_sqrt(M, name: str = "covariance") -> np.ndarray:
     """Lower-triangular factor ``S`` with ``S Sᵀ = M`` of a symmetric PSD matrix.
 
@@ -97,16 +58,16 @@ def psd_sqrt(M, name: str = "covariance") -> np.ndarray:
     array([[2., 0.],
            [1., 1.]])
     """
-    M = _check_psd(name, _as_matrix(name, M))
+    M = validate.psd_part(name, validate.as_sized_matrix(name, M, error=ModelError), error=ModelError)
     try:
         return np.linalg.cholesky(M)
     except np.linalg.LinAlgError:
         lam, V = np.linalg.eigh(M)
         root = V * np.sqrt(np.clip(lam, 0.0, None))
-        return _tria(root)
+        return tria(root)
 
 
-def _tria(M: np.ndarray) -> np.ndarray:
+def tria(M: np.ndarray) -> np.ndarray:
     """Lower-triangular ``L`` (non-negative diagonal) with ``L Lᵀ = M Mᵀ``, by QR of ``Mᵀ``."""
     r = np.linalg.qr(M.T, mode="r")
     rows = M.shape[0]
@@ -233,7 +194,7 @@ def srkf_predict(x, S, A, B=None, u=None, Q_sqrt=None) -> tuple[np.ndarray, np.n
     pre = A @ np.asarray(S, dtype=float)
     if Q_sqrt is not None:
         pre = np.hstack([pre, np.asarray(Q_sqrt, dtype=float)])
-    return x_pred, _tria(pre)
+    return x_pred, tria(pre)
 
 
 def srkf_update(
@@ -263,7 +224,7 @@ def srkf_update(
     Rs = np.zeros((p, p)) if R_sqrt is None else np.atleast_2d(np.asarray(R_sqrt, dtype=float))
     e = np.asarray(y, dtype=float).reshape(-1) - C @ x - _input_term(D, u, p)
     pre = np.block([[Rs, C @ S], [np.zeros((n, Rs.shape[1])), S]])
-    post = _tria(pre)
+    post = tria(pre)
     Re, G, S_filt = post[:p, :p], post[p:, :p], post[p:, p:]
     if np.min(np.abs(np.diag(Re)), initial=np.inf) <= 1e-300:
         raise DataError("the innovation covariance C P Cᵀ + R is singular; give R positive definite")
@@ -304,11 +265,11 @@ def srcf_step(
             [A @ S_pred, np.zeros((n, Rs.shape[1])), Qs],
         ]
     )
-    post = _tria(pre)
+    post = tria(pre)
     Re = post[:p, :p]
     G1, S_filt = post[p : p + n, :p], post[p : p + n, p : p + n]
     G2, V = post[p + n :, :p], post[p + n :, p:]
-    S_next = _tria(V)
+    S_next = tria(V)
     e = np.asarray(y, dtype=float).reshape(-1) - C @ x_pred - _input_term(D, u, p)
     z = scipy.linalg.solve_triangular(Re, e, lower=True)
     x_filt = x_pred + G1 @ z

@@ -70,7 +70,7 @@ def unvectorize(vector, n: int, m: int, p: int) -> tuple[np.ndarray, np.ndarray,
     return M[:n, :n].copy(), M[:n, n:].copy(), M[n:, :n].copy(), M[n:, n:].copy()
 
 
-def _as_model_matrix(models) -> np.ndarray:
+def as_model_matrix(models) -> np.ndarray:
     M = np.asarray(models, float)
     if M.ndim != 2 or M.shape[1] < 1:
         raise ModelError(f"the large model set must be a 2-D array with one model vector per column, got {M.shape}")
@@ -163,8 +163,8 @@ def affine_weights(reduced, models) -> np.ndarray:
     sum-to-one condition is one more least-squares row: it holds exactly for models in the affine hull
     of ``M_r`` (e.g. every large-set model once OD has found the rank) and approximately otherwise.
     """
-    Mr = _as_model_matrix(reduced)
-    M = _as_model_matrix(models)
+    Mr = as_model_matrix(reduced)
+    M = as_model_matrix(models)
     if Mr.shape[0] != M.shape[0]:
         raise ModelError(f"reduced set vectors have {Mr.shape[0]} entries, the models {M.shape[0]}")
     return np.linalg.pinv(np.vstack([Mr, np.ones(Mr.shape[1])])) @ np.vstack([M, np.ones(M.shape[1])])
@@ -237,7 +237,7 @@ def pivoted_qr(matrix, tie_tol: float = 1e-10, priority=None) -> tuple[np.ndarra
     >>> pivoted_qr([[1.0, 0.0, 1.0], [0.0, 1.0, 1.0]], priority=[1, 0, 2])[0].tolist()
     [2, 1, 0]
     """
-    M = _as_model_matrix(matrix)
+    M = as_model_matrix(matrix)
     m, n = M.shape
     tie_tol = float(tie_tol) if isinstance(tie_tol, (int, float, np.floating, np.integer)) else np.nan
     if not 0.0 <= tie_tol < 1.0:
@@ -322,7 +322,7 @@ def od_model_set(models, rank: int | None = None, min_gap: float = 10.0, *, tie_
     >>> len(od.indices), bool(od.residual.max() < 1e-10)
     (3, True)
     """
-    M = _as_model_matrix(models)
+    M = as_model_matrix(models)
     if not isinstance(min_gap, (int, float, np.floating, np.integer)) or not min_gap > 0 or not np.isfinite(min_gap):
         raise ParameterError(f"min_gap must be a positive number (a ratio of successive |diag R|), got {min_gap!r}")
     if rank is not None and (isinstance(rank, bool) or not isinstance(rank, (int, np.integer)) or rank < 1):
@@ -438,7 +438,7 @@ def nearest_model(models, estimate):
     them (K, n_q); returns an int, or an int array (K,).  The reported parameters are those of model
     ``n_s``, hence quantised to the grid of the large set.
     """
-    M = _as_model_matrix(models)
+    M = as_model_matrix(models)
     E = np.atleast_2d(np.asarray(estimate, float))
     if E.shape[1] != M.shape[0]:
         raise ModelError(f"the estimate has {E.shape[1]} entries, the model vectors {M.shape[0]}")

@@ -1,7 +1,7 @@
 """Benchmark plants as library data.
 
 Each plant is a function returning a :class:`~fdikit.model.FaultModel`; :data:`PLANTS`
-maps a short name to that function and :func:`get_plant` looks one up by name.
+maps a short name to that function and :func:`~fdikit.plants.registry.get_plant` looks one up by name.
 
 ===================  ==============================================  ======================
 name                 model                                            source
@@ -23,115 +23,68 @@ Examples
 >>> from fdikit.plants import get_plant
 >>> get_plant("single-track", speed=25.0).states
 ('lateral_velocity', 'yaw_rate', 'lateral_error', 'heading_error')
+
+* :mod:`fdikit.plants.registry` — The registry of benchmark plants: :data:`PLANTS` maps a short name to its
+  constructor, :func:`get_plant` builds one.
+* :mod:`fdikit.plants.path_vehicle` — PATH linear vehicle models of Douglas et al. (1996), Appendix D.
+* :mod:`fdikit.plants.path_longitudinal` — PATH 7-state longitudinal car model: the game-filter example of Douglas
+  et al. (1996), §9.6.
+* :mod:`fdikit.plants.single_track` — Linear single-track (bicycle) lateral model with lane-error states (van der
+  Ploeg 2018, App. B).
+* :mod:`fdikit.plants.f16xl` — F-16XL longitudinal dynamics, the aircraft example of the game-theoretic and H∞
+  filters.
+* :mod:`fdikit.plants.white_speyer` — The three-state White–Speyer system: Murray 2012, §6.2 (Example 2).
+* :mod:`fdikit.plants.varrier_lateral` — Renault Scénic lateral dynamics, LPV in ρ = 1/v (Varrier, Koenig & Martinez
+  2014, §5.1, (47)–(48)).
+* :mod:`fdikit.plants.msd` — Three-mass mass–spring–damper (MSD) LPV benchmark: Hallouzi 2008, §3.6 (after Fekri et
+  al. 2006b).
+* :mod:`fdikit.plants.b747` — Boeing 747 linear longitudinal FDI example: Hallouzi 2008, §2.4.1, (2.54)–(2.61),
+  Tables 2.5–2.6.
+* :mod:`fdikit.plants.target_tracking` — The maneuvering-target tracking benchmark of Hallouzi 2008, §2.4.2,
+  (2.65)–(2.68).
 """
 
-from __future__ import annotations
+import lazy_loader as lazy
 
-import inspect
-from collections.abc import Callable
-
-from fdikit.errors import ParameterError
-from fdikit.model import FaultModel
-from fdikit.plants.b747 import b747_longitudinal, b747_model_set
-from fdikit.plants.f16xl import F16XL_DRYDEN_GAIN, f16xl_gust, f16xl_longitudinal
-from fdikit.plants.msd import msd, msd_matrices
-from fdikit.plants.path_longitudinal import path_longitudinal_7, path_longitudinal_7_fault_maps
-from fdikit.plants.path_vehicle import (
-    TABLE_2_1_EIGENVALUES_12,
-    TABLE_2_1_EIGENVALUES_14,
-    path_vehicle_12,
-    path_vehicle_14,
-    rounding_intervals,
+__getattr__, __dir__, __all__ = lazy.attach(
+    __name__,
+    submod_attrs={
+        "registry": [
+            "PLANTS", "get_plant",
+        ],
+        "path_vehicle": [
+            "CONTROLS", "OUTPUTS", "STATES_12", "STATES_14", "TABLE_2_1_EIGENVALUES_12", "TABLE_2_1_EIGENVALUES_14",
+            "path_vehicle_12", "path_vehicle_14", "rounding_intervals",
+        ],
+        "path_longitudinal": [
+            "PATH7_A", "PATH7_A_PRINTED", "PATH7_C", "PATH7_C_PRINTED", "PATH7_F_ACCEL_X", "PATH7_F_ENGINE_SPEED",
+            "PATH7_OUTPUTS", "path_longitudinal_7", "path_longitudinal_7_fault_maps",
+        ],
+        "single_track": [
+            "CONTROLS", "DISTURBANCES", "OUTPUTS", "PRIUS_2010", "STATES", "SingleTrackLPV", "SingleTrackParameters",
+            "single_track", "single_track_lpv", "understeer_gradient",
+        ],
+        "f16xl": [
+            "F16XL_A", "F16XL_DRYDEN_GAIN", "F16XL_GUST_POLE", "f16xl_gust", "f16xl_longitudinal",
+        ],
+        "white_speyer": [
+            "WHITE_SPEYER_CASES", "white_speyer",
+        ],
+        "varrier_lateral": [
+            "CONTROLS", "OUTPUTS", "RHO_STAR", "SCENIC", "STATES", "T_D", "VarrierParameters", "rho_from_speed",
+            "varrier_lateral", "varrier_lateral_continuous", "varrier_lateral_lpv", "varrier_uncertainty",
+        ],
+        "msd": [
+            "MSD_CONSTANTS", "MSD_RANGES", "MSD_SAMPLE_TIME", "msd", "msd_matrices", "msd_model_vectors",
+            "msd_parameter_grid", "msd_parameters_to_weights", "msd_weights_to_parameters",
+        ],
+        "b747": [
+            "B747_FAULT_SCHEDULE", "B747_MODEL_NAMES", "B747_NOISE", "B747_STATES", "B747_TRANSITION",
+            "b747_longitudinal", "b747_model_set",
+        ],
+        "target_tracking": [
+            "PI_TRACKING", "Q_TRACKING", "R_TRACKING", "TRACKING_MODES", "TS", "X0_TRACKING", "tracking_A",
+            "tracking_B",
+        ],
+    },
 )
-from fdikit.plants.single_track import (
-    PRIUS_2010,
-    SingleTrackLPV,
-    SingleTrackParameters,
-    single_track,
-    single_track_lpv,
-    understeer_gradient,
-)
-from fdikit.plants.varrier_lateral import (
-    SCENIC,
-    VarrierParameters,
-    rho_from_speed,
-    varrier_lateral,
-    varrier_lateral_lpv,
-    varrier_uncertainty,
-)
-from fdikit.plants.white_speyer import WHITE_SPEYER_CASES, white_speyer
-
-__all__ = [
-    "PLANTS",
-    "get_plant",
-    "path_vehicle_12",
-    "path_vehicle_14",
-    "rounding_intervals",
-    "TABLE_2_1_EIGENVALUES_12",
-    "TABLE_2_1_EIGENVALUES_14",
-    "SingleTrackParameters",
-    "PRIUS_2010",
-    "single_track",
-    "understeer_gradient",
-    "single_track_lpv",
-    "SingleTrackLPV",
-    "varrier_lateral",
-    "varrier_lateral_lpv",
-    "varrier_uncertainty",
-    "VarrierParameters",
-    "SCENIC",
-    "rho_from_speed",
-    "f16xl_longitudinal",
-    "f16xl_gust",
-    "F16XL_DRYDEN_GAIN",
-    "white_speyer",
-    "path_longitudinal_7",
-    "msd",
-    "msd_matrices",
-    "b747_longitudinal",
-    "b747_model_set",
-    "path_longitudinal_7_fault_maps",
-    "WHITE_SPEYER_CASES",
-]
-
-#: Plant constructors by name; call with the plant's own keyword parameters.
-PLANTS: dict[str, Callable[..., FaultModel]] = {
-    "path12": path_vehicle_12,
-    "path14": path_vehicle_14,
-    "single-track": single_track,
-    "f16xl": f16xl_longitudinal,
-    "f16xl-gust": f16xl_gust,
-    "white-speyer": white_speyer,
-    "varrier-lateral": varrier_lateral,
-    "path7": path_longitudinal_7,
-    "msd": msd,
-    "b747": b747_longitudinal,
-}
-
-
-def get_plant(name: str, **params) -> FaultModel:
-    """Build the benchmark plant called ``name`` with its keyword parameters.
-
-    Parameters
-    ----------
-    name : str
-        One of the keys of :data:`PLANTS` (``"path12"``, ``"path14"``, ``"single-track"``).
-    **params
-        Passed to the plant's constructor, e.g. ``speed=19.44, dt=0.01`` for
-        ``"single-track"``.
-
-    Raises
-    ------
-    ParameterError
-        If ``name`` is not a known plant, or the parameters do not fit its constructor.
-    """
-    try:
-        factory = PLANTS[name]
-    except (KeyError, TypeError):
-        raise ParameterError(f"unknown plant {name!r}; known plants: {', '.join(sorted(PLANTS))}") from None
-    signature = inspect.signature(factory)
-    try:
-        signature.bind(**params)
-    except TypeError as exc:
-        raise ParameterError(f"bad parameters for plant {name!r}: {exc}; its signature is {name}{signature}") from None
-    return factory(**params)

@@ -19,9 +19,9 @@ import numpy as np
 
 from fdikit import validate
 from fdikit.errors import ModelError, ParameterError
-from fdikit.multimodel.convex import ConvexModelSet, convex_model_set
 
 __all__ = [
+    "TRACKING_MODES",
     "TS",
     "Q_TRACKING",
     "R_TRACKING",
@@ -29,8 +29,6 @@ __all__ = [
     "X0_TRACKING",
     "tracking_A",
     "tracking_B",
-    "tracking_convex_set",
-    "tracking_imm_modes",
 ]
 
 #: Sample time T_s [s] (§2.4.2).
@@ -44,7 +42,7 @@ PI_TRACKING = np.full((3, 3), 0.01) + 0.97 * np.eye(3)
 #: Initial target state [p_x, v_x, p_y, v_y] (§2.4.2).
 X0_TRACKING = np.array([-500.0, 0.0, -500.0, 5.0])
 
-_NAMES = ("straight", "left_turn", "right_turn")
+TRACKING_MODES = ("straight", "left_turn", "right_turn")
 
 
 def tracking_A(dt: float = TS) -> np.ndarray:
@@ -74,28 +72,7 @@ def tracking_B(model: str) -> np.ndarray:
     left = np.sqrt(2.0) * np.array([[-0.25], [-0.5], [0.25], [0.5]])
     table = {"straight": 0.0 * left, "left_turn": left, "right_turn": -left}
     if model not in table:
-        raise ModelError(f"unknown tracking model {model!r}; choose one of {_NAMES}")
+        raise ModelError(f"unknown tracking model {model!r}; choose one of {TRACKING_MODES}")
     return table[model]
 
 
-def tracking_convex_set(dt: float = TS) -> ConvexModelSet:
-    """The two-model convex set {left turn, right turn} of §2.4.2 (``Q``, ``R`` of (2.67)).
-
-    Example
-    -------
-    >>> ms = tracking_convex_set()
-    >>> ms.names, bool(np.allclose(ms.blend([0.5, 0.5])[1], 0))
-    (('left_turn', 'right_turn'), True)
-    """
-    B = np.stack([tracking_B("left_turn"), tracking_B("right_turn")])
-    return convex_model_set(tracking_A(dt), B, np.eye(4), Q=Q_TRACKING, R=R_TRACKING,
-                            names=("left_turn", "right_turn"))
-
-
-def tracking_imm_modes(dt: float = TS) -> list:
-    """The three IMM modes (straight, left, right) of §2.4.2 as :class:`~fdikit.multimodel.imm.LinearGaussianModel`."""
-    from fdikit.multimodel.kalman import LinearGaussianModel
-
-    A = tracking_A(dt)
-    return [LinearGaussianModel(A=A, C=np.eye(4), Q=Q_TRACKING, R=R_TRACKING, B=tracking_B(nm), name=nm)
-            for nm in _NAMES]

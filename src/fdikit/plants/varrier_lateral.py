@@ -29,8 +29,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from fdikit import validate
-from fdikit.design.lpv import LPVModel, Uncertainty
 from fdikit.errors import ModelError, ParameterError
+from fdikit.lpv import LPVModel, Uncertainty
 from fdikit.model import FaultModel
 
 __all__ = [

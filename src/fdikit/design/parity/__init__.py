@@ -1,0 +1,43 @@
+"""Parity-space residual generators: state-space parity relations, polynomial (DAE) parity filters,
+speed-scheduled parity filters and the robust LPV parity design.
+
+* :mod:`fdikit.design.parity.state_space` — State-space parity space for discrete LTI and LPV models (Varrier,
+  Koenig & Martinez 2014, §3).
+* :mod:`fdikit.design.parity.polynomial` — Parity-space fault detection filters from the DAE (polynomial) form (van
+  der Ploeg 2018, Ch. 2, Sec. 4-3-1).
+* :mod:`fdikit.design.parity.scheduled` — Speed-scheduled (LPV) parity fault detection filter (van der Ploeg 2018,
+  Sec. 3-3, Thm 3-3.4; Sec. 4-3-4).
+* :mod:`fdikit.design.parity.robust` — Robust parity design for uncertain LPV systems (Varrier, Koenig & Martinez
+  2014, §4).
+* :mod:`fdikit.design.parity.polytope` — Polytopic machinery of the robust LPV parity design (Varrier, Koenig &
+  Martinez 2014, §4.5–4.6, (32)–(46)).
+"""
+
+import lazy_loader as lazy
+
+__getattr__, __dir__, __all__ = lazy.attach(
+    __name__,
+    submod_attrs={
+        "state_space": [
+            "ParityDesign", "lpv_parity_residuals", "minimal_horizon", "parity_design", "parity_matrix",
+            "regular_rows",
+        ],
+        "polynomial": [
+            "PolynomialParityDesign", "RankTest", "bar", "bar_matrices", "detectability", "isolability",
+            "left_null_space", "minimal_degree", "normal_rank", "parity_filter", "time_varying_bar",
+        ],
+        "scheduled": [
+            "ScheduledResidualGenerator", "ScheduledStepper", "lpv_bar_matrices", "lpv_parity_row", "lpv_rank_test",
+            "scheduled_parity_filter",
+        ],
+        "robust": [
+            "EigenDesign", "LmiDesign", "RobustCriteria", "RobustParityDesign", "gamma_kappa", "kappa_max",
+            "lti_lmi", "p2_solution", "pointwise_theorem1", "robust_criteria", "robust_lpv_parity", "theorem1",
+            "theorem1_batch",
+        ],
+        "polytope": [
+            "PolytopicLmi", "adjugate", "box_vertices", "is_admissible", "polynomial_coefficients", "polytopic_lmi",
+            "property1_vertices", "repair_vertex", "scheduling_weights",
+        ],
+    },
+)

@@ -1,0 +1,369 @@
+"""Parity-space fault detection filters from the DAE (polynomial) form (van der Ploeg 2018, Ch. 2, Sec. 4-3-1).
+
+A discrete model is written as the difference-algebraic equation (2.1)::
+
+    H(q)[x] + L(q)[z] + F(q)[f] = 0,        x = [states; disturbances],  z = [outputs; controls]
+
+with ``q`` the forward shift.  A :class:`~fdikit.model.FaultModel` maps to it as in (2.10)
+(with ``G = I``) and (4.6)::
+
+    H(q) = [[−q I + A, Bd], [C, Dd]],   L = [[0, Bu], [−I, Du]],   F = [[Bf], [Df]]
+
+A row polynomial ``N(q) = Σ N_i qⁱ`` with ``N H = 0`` (2.4a) and ``N F ≠ 0`` (2.4b) gives the
+residual generator (2.6) ``r = d⁻¹(q) N(q) L(q)[z]``, whose fault map is (2.7)
+``r = G(q)[f]``, ``G = −N F / d``.  Lemma 2-1.2 turns ``N H = 0`` into the linear equation
+``N̄ H̄ = 0`` on the coefficient row ``N̄ = [N_0 … N_dN]`` and the block-Toeplitz ("bar")
+matrix ``H̄`` (block row ``i`` holds ``H_0 … H_dH`` from block column ``i``), and fixes the
+DC gain by (2.8b)/(2.9) ``Σ N̄ F̄ / Σ d̄ = −1`` so that ``G(1) = 1``.
+
+Choices and errata (research note §3.2, §3.4, §4 A5–A7, §8):
+
+* the sign of the DC condition is that of (2.8b)/(2.9), ``−1``; the case-study LP (4.8) prints
+  ``+1``, which gives ``G(1) = −1`` under (2.7) (note §8 item 10);
+* the thesis solves the LP (2.9) with GUROBI.  With the minimal degree the left null space is
+  one-dimensional and the solution is unique; otherwise fdikit takes the least-norm ``N̄`` in
+  the null space that meets the DC condition (an orthogonal projection, no LP solver);
+* ``d(q) = Π (q − p_i)`` with real poles (default a triple pole at ``p = 0.9048 = e^{−10 h}``
+  for ``h = 0.01``, Sec. 4-3-1); its degree is ``d_N + d_L + 1`` so that the filter is
+  strictly proper, ``deg d > deg N L``;
+* the filter is realised as a minimal state space (the thesis, Sec. 4-3-1): a chain of
+  first-order sections ``1/(q − p_i)`` with the numerator in the Newton basis
+  ``Π_{j<i} (q − p_j)``, which stays well conditioned for the high orders of the
+  experimental model (a companion form of ``(q − 0.9)²⁹`` would not);
+* polynomial ranks (2.5) are normal ranks, evaluated at three fixed generic complex points
+  (rank is lower only at finitely many points), with :func:`fdikit.linalg.rank`'s relative
+  tolerance.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from fdikit import linalg
+from fdikit.dae import DAEModel, dae_form
+from fdikit.errors import DesignError, ModelError, ParameterError
+from fdikit.model import FaultModel
+from fdikit.residuals import ResidualGenerator
+
+__all__ = [
+    "PolynomialParityDesign",
+    "RankTest",
+    "bar",
+    "bar_matrices",
+    "detectability",
+    "isolability",
+    "left_null_space",
+    "minimal_degree",
+    "normal_rank",
+    "parity_filter",
+    "time_varying_bar",
+]
+
+#: Generic points at which polynomial matrices are evaluated for their normal rank.
+_RANK_POINTS = (0.3141 + 0.7183j, -0.5772 + 0.4142j, 1.7321 - 0.2718j)
+
+
+def time_varying_bar(rows: Sequence[Sequence[np.ndarray]]) -> np.ndarray:
+    """Block-Toeplitz pattern with per-row coefficients: block row ``i`` holds ``rows[i][j]`` at block column ``i + j``.
+
+    With the same coefficients in every row this is the bar matrix of Lemma 2-1.2; with the
+    coefficients of the model at instant ``τ_i`` it is the LPV ``H̄_k`` of Lemma 3-3.2.
+    """
+    rows = [list(r) for r in rows]
+    if not rows or not rows[0]:
+        raise ModelError("a bar matrix needs at least one block row with one coefficient")
+    r, c = rows[0][0].shape
+    width = max(i + len(coeffs) for i, coeffs in enumerate(rows))
+    out = np.zeros((len(rows) * r, width * c))
+    for i, coeffs in enumerate(rows):
+        for j, block in enumerate(coeffs):
+            out[i * r : (i + 1) * r, (i + j) * c : (i + j + 1) * c] = block
+    return out
+
+
+def bar(coefficients: Sequence[np.ndarray], degree: int) -> np.ndarray:
+    """The bar matrix of Lemma 2-1.2: ``degree + 1`` block rows of ``[C_0 … C_d]`` shifted by one block each.
+
+    ``N̄ · bar(C, d_N)`` is the coefficient row of ``N(q) C(q)`` for ``N`` of degree ``d_N``.
+
+    Examples
+    --------
+    >>> bar([np.array([[1.0]]), np.array([[2.0]])], 1)
+    array([[1., 2., 0.],
+           [0., 1., 2.]])
+    """
+    if int(degree) != degree or degree < 0:
+        raise ModelError(f"the parity degree must be a non-negative integer, got {degree!r}")
+    return time_varying_bar([coefficients] * (int(degree) + 1))
+
+
+def bar_matrices(dae: DAEModel, degree: int, fault: str | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(H̄, L̄, F̄)`` of Lemma 2-1.2 for parity degree ``d_N``; ``F̄`` for one fault column."""
+    j = dae.fault_index(fault)
+    return bar(dae.H, degree), bar(dae.L, degree), bar([F[:, [j]] for F in dae.F], degree)
+
+
+def normal_rank(coefficients: Sequence[np.ndarray], rtol: float | None = None) -> int:
+    """Normal rank of ``Σ C_i qⁱ``: the largest rank at three fixed generic complex points."""
+    return max(linalg.rank(sum(c * lam**i for i, c in enumerate(coefficients)), rtol) for lam in _RANK_POINTS)
+
+
+@dataclass(frozen=True)
+class RankTest:
+    """Outcome of a rank condition ``rank_with > rank_without``; true in a boolean context when it holds."""
+
+    holds: bool
+    rank_with: int
+    rank_without: int
+
+    def __bool__(self) -> bool:
+        return self.holds
+
+
+def _hstack_poly(*polys: Sequence[np.ndarray]) -> list[np.ndarray]:
+    deg = max(len(p) for p in polys)
+    out = []
+    for i in range(deg):
+        out.append(np.hstack([p[i] if i < len(p) else np.zeros_like(p[0]) for p in polys]))
+    return out
+
+
+def detectability(dae: DAEModel, fault: str | None = None) -> RankTest:
+    """Condition (2.5) (Assumption 2-1.1, [21] Fact 4.4): ``Rank [H(q) F(q)] > Rank H(q)`` (normal ranks)."""
+    j = dae.fault_index(fault)
+    F = [c[:, [j]] for c in dae.F]
+    r_with, r_without = normal_rank(_hstack_poly(dae.H, F)), normal_rank(dae.H)
+    return RankTest(r_with > r_without, r_with, r_without)
+
+
+def isolability(dae: DAEModel, fault: str, nuisance: str) -> RankTest:
+    """Sec. 2-3: ``fault`` is isolable from ``nuisance`` iff ``Rank [H̃ F] > Rank H̃`` with ``H̃ = [H F_nuisance]``.
+
+    For an additive and a multiplicative fault on the same signal both columns are ``F``, so
+    the condition fails: they are "dynamically inseparable" by any LTI parity filter.
+    """
+    Fa = [c[:, [dae.fault_index(fault)]] for c in dae.F]
+    Fn = [c[:, [dae.fault_index(nuisance)]] for c in dae.F]
+    Ht = _hstack_poly(dae.H, Fn)
+    r_with, r_without = normal_rank(_hstack_poly(Ht, Fa)), normal_rank(Ht)
+    return RankTest(r_with > r_without, r_with, r_without)
+
+
+def left_null_space(dae: DAEModel, degree: int) -> np.ndarray:
+    """Orthonormal rows spanning ``{N̄ : N̄ H̄ = 0}`` for parity degree ``d_N`` (Lemma 2-1.2)."""
+    return linalg.null(bar(dae.H, degree).T).T
+
+
+def minimal_degree(dae: DAEModel, fault: str | None = None, max_degree: int | None = None) -> int:
+    """Smallest ``d_N`` with ``Rank [H̄ F̄] > Rank H̄`` (a parity row that sees the fault exists).
+
+    ``max_degree`` defaults to ``n_x · d_H`` (the degree of a minimal polynomial basis of the
+    left null space of ``H(q)`` cannot exceed it).
+
+    Raises
+    ------
+    DesignError
+        If no degree up to ``max_degree`` works: the fault is not detectable (2.5).
+    ParameterError
+        If ``dae`` is not a :class:`DAEModel`.
+    """
+    if not isinstance(dae, DAEModel):
+        raise ParameterError(f"dae must be a DAEModel (build one with dae_form(model)), got {type(dae).__name__}")
+    j = dae.fault_index(fault)
+    top = len(dae.unknowns) * (len(dae.H) - 1) if max_degree is None else int(max_degree)
+    for d in range(top + 1):
+        Hb, Fb = bar(dae.H, d), bar([c[:, [j]] for c in dae.F], d)
+        if linalg.rank(np.hstack([Hb, Fb])) > linalg.rank(Hb):
+            return d
+    test = detectability(dae, fault)
+    raise DesignError(
+        f"no parity relation of degree <= {top} detects fault {dae.faults[j]!r} "
+        f"(normal ranks: [H F] {test.rank_with}, H {test.rank_without}); "
+        + ("the fault is not detectable (2.5): it acts like a disturbance" if not test else "raise max_degree")
+    )
+
+
+def real_poles(poles, count: int) -> np.ndarray:
+    arr = np.atleast_1d(np.asarray(poles, dtype=complex))
+    if np.ndim(poles) == 0:
+        arr = np.repeat(arr, count)
+    if np.any(np.abs(arr.imag) > 0) or not np.all(np.isfinite(arr)):
+        raise DesignError(f"poles must be finite real numbers (a repeated real pole as in Sec. 4-3-1), got {poles!r}")
+    arr = arr.real
+    if np.any(np.abs(arr) >= 1):
+        raise DesignError(f"poles {arr.tolist()} must lie strictly inside the unit circle for a stable d(q)")
+    return arr
+
+
+def _newton_chain(num: np.ndarray, poles: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Minimal realisation of ``num(q) / Π (q − p_i)`` (``num`` ascending, one column per input).
+
+    Chain ``x_1⁺ = p_1 x_1 + b_1ᵀ v``, ``x_i⁺ = p_i x_i + x_{i−1} + b_iᵀ v``, ``r = x_n + D v``:
+    its numerator is ``Σ b_i Π_{j<i}(q − p_j)`` (Newton basis).
+    """
+    n = poles.size
+    num = np.vstack([num, np.zeros((n + 1 - num.shape[0], num.shape[1]))])
+    D = num[n].copy()
+    rem = num[:n] - np.outer(np.poly(poles)[::-1][:n], D)  # num − D d(q), degree < n
+    B = np.zeros((n, num.shape[1]))
+    for i, p in enumerate(poles):  # synthetic division by (q − p): remainder b_i, quotient carries on
+        quot = np.zeros_like(rem)
+        acc = np.zeros(num.shape[1])
+        for k in range(rem.shape[0] - 1, -1, -1):
+            acc = rem[k] + p * acc
+            if k:
+                quot[k - 1] = acc
+        B[i] = acc
+        rem = quot
+    A = np.diag(poles) + np.diag(np.ones(n - 1), -1)
+    C = np.zeros((1, n))
+    C[0, -1] = 1.0
+    return A, B, C, D.reshape(1, -1)
+
+
+@dataclass(frozen=True, eq=False)
+class PolynomialParityDesign:
+    """An LTI parity (DAE null-space) fault detection filter (van der Ploeg 2018, (2.6)–(2.9)).
+
+    Attributes
+    ----------
+    generator : residual generator ``r = d⁻¹ N L [z]`` reading the model's controls and outputs.
+    dae : the DAE model it was designed on; fault : the detected fault column.
+    degree : ``d_N``; null_dimension : dimension of the left null space of ``H̄`` at ``d_N``.
+    N : ``(d_N + 1, n_r)`` coefficients ``N_i`` (after the DC normalisation).
+    NL : coefficients of ``N(q) L(q)``, row ``i`` = ``qⁱ``, columns ``z = [outputs; controls]``.
+    NF : coefficients of ``N(q) F(q)`` (``qⁱ``).
+    denominator : ``d̄ = [d_0 … d_n]`` (monic); poles : its roots.
+    decoupling : ``‖N̄ H̄‖ / (‖N̄‖ ‖H̄‖)`` (0 for exact decoupling, round-off in practice).
+    """
+
+    generator: ResidualGenerator
+    dae: DAEModel
+    fault: str
+    degree: int
+    null_dimension: int
+    N: np.ndarray
+    NL: np.ndarray
+    NF: np.ndarray
+    denominator: np.ndarray
+    poles: np.ndarray
+    decoupling: float
+
+    @property
+    def N_bar(self) -> np.ndarray:
+        """``N̄ = [N_0 N_1 … N_dN]`` (one row)."""
+        return self.N.reshape(1, -1)
+
+    def fault_gain(self, z) -> np.ndarray:
+        """``G(z) = −N(z) F(z) / d(z)`` (2.7) at complex ``z``."""
+        z = np.asarray(z, dtype=complex)
+        return -np.polyval(self.NF[::-1], z) / np.prod(z[..., None] - self.poles, axis=-1)
+
+    @property
+    def dc_gain(self) -> float:
+        """``G(1)``; 1 by the normalisation (2.8b)."""
+        return float(self.fault_gain(1.0).real)
+
+    @property
+    def fault_map(self) -> tuple[np.ndarray, np.ndarray]:
+        """``G(q) = −N(q) F(q) / d(q)`` (2.7) as ``(num, den)`` in descending powers of ``q`` (scipy.signal order).
+
+        This is the pre-filter of :func:`fdikit.estimate.isolate_steering_faults` (Sec. 3-2).
+        """
+        return -self.NF[::-1], self.denominator[::-1]
+
+    @property
+    def fault_zeros(self) -> np.ndarray:
+        """Zeros of ``N(q) F(q)`` (leading coefficients below ``1e-10 · max|NF|`` dropped)."""
+        nf = self.NF.copy()
+        while nf.size > 1 and abs(nf[-1]) <= 1e-10 * np.abs(self.NF).max():
+            nf = nf[:-1]
+        return np.roots(nf[::-1])
+
+
+def parity_filter(
+    model: DAEModel | FaultModel,
+    fault: str | None = None,
+    *,
+    degree: int | None = None,
+    poles: float | Sequence[float] = 0.9048,
+    name: str | None = None,
+) -> PolynomialParityDesign:
+    """LTI parity-space fault detection filter (van der Ploeg 2018, Lemma 2-1.2, (2.6)–(2.9); Sec. 4-3-1).
+
+    Parameters
+    ----------
+    model : DAEModel or FaultModel
+        The DAE (2.1), or a discrete FaultModel converted by :func:`dae_form`.
+    fault : str, optional
+        The fault to detect (a column of ``F``); may be omitted when there is one.
+    degree : int, optional
+        Parity degree ``d_N``; default the minimal one (:func:`minimal_degree`).
+    poles : float or sequence of float
+        Real poles of ``d(q)``: one value is repeated ``d_N + d_L + 1`` times (default 0.9048,
+        the thesis' triple pole); a sequence needs at least ``deg N L`` entries (the filter
+        is strictly proper with more).
+    name : str, optional
+        Residual name (default ``r_<fault>``).
+
+    Returns
+    -------
+    PolynomialParityDesign
+        With ``G(1) = 1`` (2.8b) and ``N̄ H̄ = 0`` (2.8a).
+
+    Raises
+    ------
+    DesignError
+        Undetectable fault, unstable or complex poles, too few poles, or a fault whose
+        residual response vanishes at DC (the normalisation (2.8b) is then impossible).
+
+    Examples
+    --------
+    >>> from fdikit.plants.single_track import single_track_lpv
+    >>> design = parity_filter(single_track_lpv()(70 / 3.6))
+    >>> design.degree, design.null_dimension, design.generator.n
+    (2, 1, 3)
+    >>> round(design.dc_gain, 12), round(float(design.fault_zeros[0].real), 5)
+    (1.0, -0.97294)
+    """
+    dae = dae_form(model) if isinstance(model, FaultModel) else model
+    if not isinstance(dae, DAEModel):
+        raise ModelError(f"parity_filter needs a DAEModel or a discrete FaultModel, got {type(model).__name__}")
+    j = dae.fault_index(fault)
+    fault = dae.faults[j]
+    dN = minimal_degree(dae, fault) if degree is None else int(degree)
+    Hb, Lb, Fb = bar_matrices(dae, dN, fault)
+    V = linalg.null(Hb.T).T
+    g = Fb.sum(axis=1)  # N̄ F̄ 1 = N(1) F(1)
+    Vg = V @ g
+    if V.shape[0] == 0 or np.linalg.norm(Vg) <= 1e-10 * np.linalg.norm(g):
+        raise DesignError(
+            f"no parity row of degree {dN} sees fault {fault!r} at DC: N(1)F(1) = 0 for every N̄ with N̄H̄ = 0 "
+            f"(null space dimension {V.shape[0]}); use degree=None (minimal) or a larger degree"
+        )
+    dL = len(dae.L) - 1
+    p = real_poles(poles, dN + dL + 1)
+    den = np.poly(p)[::-1]
+    # least-norm N̄ in the null space with Σ N̄F̄ = −Σ d̄ = −d(1) (2.9); d(1) from the factors, since the
+    # expanded coefficients of (q − 0.9)¹³ cancel to ~1e-13 = d(1) itself
+    Nb = -np.prod(1.0 - p) * (Vg @ V) / (Vg @ Vg)
+    NL = (Nb @ Lb).reshape(-1, len(dae.knowns))
+    NF = Nb @ Fb
+    nz = np.flatnonzero(np.abs(NL).max(axis=1) > 1e-10 * np.abs(NL).max())
+    deg_NL = int(nz[-1]) if nz.size else 0
+    if p.size < deg_NL:
+        raise DesignError(f"d(q) has degree {p.size} but N(q)L(q) has degree {deg_NL}: the filter would be improper "
+                          f"(use at least {deg_NL} poles, or {deg_NL + 1} for a strictly proper filter)")
+    n_y = len(dae.outputs)
+    num = np.hstack([NL[:, n_y:], NL[:, :n_y]])[: p.size + 1]  # generator inputs are [controls; outputs]
+    A, B, C, D = _newton_chain(num, p)
+    name = name or f"r_{fault}"
+    gen = ResidualGenerator(A, B, C, D, dae.controls, dae.outputs, (name,), dae.dt, (fault,))
+    decoupling = float(np.linalg.norm(Nb @ Hb) / (np.linalg.norm(Nb) * np.linalg.norm(Hb)))
+    return PolynomialParityDesign(
+        generator=gen, dae=dae, fault=fault, degree=dN, null_dimension=V.shape[0], N=Nb.reshape(dN + 1, -1),
+        NL=NL, NF=NF, denominator=den, poles=p, decoupling=decoupling,
+    )

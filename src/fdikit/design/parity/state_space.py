@@ -1,0 +1,295 @@
+"""State-space parity space for discrete LTI and LPV models (Varrier, Koenig & Martinez 2014, §3).
+
+The stacked matrices of the parity relation (7)–(8) (``Y_s = H_os x + H_us U_s + …``) are built
+in :mod:`fdikit.lpv`.  The parity matrix (10)–(12) splits ``H_os`` into ``n`` regular rows
+``H_os1`` (the "regular part of the observability matrix", Remark 2: the first linearly
+independent rows, in order) and the ``q = (s+1)p − n`` others ``H_os2``, and sets::
+
+    P(ρ) = [−H_os2 H_os1⁻¹,  I_q]   (columns permuted back to the row order of H_os),   P H_os = 0
+
+so that ``r = W₂ᵀ P (Y_s − H_us U_s)`` (9), (12) is zero on healthy, noise-free data for any
+``W₂``.  fdikit runs the window backwards, ``Y_s(k) = [y(k−s); …; y(k)]``, so the residual
+at sample ``k`` is causal (research note G14); in the frozen mode ρ is frozen at the
+newest sample ``ρ_k``.  :func:`parity_design` builds the LTI residual generator (an FIR
+:class:`~fdikit.residuals.ResidualGenerator`); :func:`lpv_parity_residuals` recomputes ``P(ρ)``
+at every sample of a trace (16).  The robust choice of ``W₂`` is in
+:mod:`fdikit.design.parity.robust`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from fdikit import validate
+from fdikit.errors import DataError, DesignError, ModelError, ParameterError
+from fdikit.lpv import LPVModel, StackedMatrices, check_horizon, lpv_stacked_matrices, stacked_matrices
+from fdikit.model import FaultModel
+from fdikit.residuals import ResidualGenerator, Residuals
+from fdikit.trace import Trace
+
+__all__ = [
+    "minimal_horizon",
+    "regular_rows",
+    "parity_matrix",
+    "ParityDesign",
+    "parity_design",
+    "lpv_parity_residuals",
+]
+
+
+def minimal_horizon(n: int, p: int, residuals: int = 1) -> int:
+    """Smallest ``s`` with ``q = (s+1)p − n >= residuals`` (cf. Varrier 2014, (13): ``s = ⌈n/m⌉``).
+
+    >>> minimal_horizon(2, 2)
+    1
+    """
+    if n < 0 or p < 1 or residuals < 1:
+        raise ModelError(f"need n >= 0, p >= 1 and residuals >= 1, got n={n}, p={p}, residuals={residuals}")
+    return max(0, -(-(n + residuals) // p) - 1)
+
+
+# ---------------------------------------------------------------------------------------------- parity matrix
+def regular_rows(H_os: np.ndarray, rtol: float = 1e-9) -> tuple[int, ...]:
+    """The first ``n`` linearly independent rows of ``H_os``, in order (Remark 2: ``reg(𝒪)``).
+
+    Raises
+    ------
+    DesignError
+        If ``H_os`` has rank < n (the pair (A, C) is not observable over the horizon).
+    """
+    H = np.asarray(H_os)
+    if H.ndim != 2:
+        raise ModelError(f"regular_rows needs one 2-D H_os, got shape {H.shape}")
+    n = H.shape[1]
+    scale = max(np.linalg.norm(H, 2), np.finfo(float).tiny)
+    rows: list[int] = []
+    for i in range(H.shape[0]):
+        trial = H[rows + [i]]
+        if np.linalg.svd(trial, compute_uv=False)[-1] > rtol * scale:
+            rows.append(i)
+            if len(rows) == n:
+                return tuple(rows)
+    raise DesignError(
+        f"H_os has rank {len(rows)} < n = {n}: the model is not observable over the horizon; "
+        "check (A, C) observability or increase s"
+    )
+
+
+def parity_matrix(H_os: np.ndarray, rows: Sequence[int] | None = None, cond_max: float = 1e12) -> np.ndarray:
+    """Parity basis ``P = [−H_os2 H_os1⁻¹, I_q]`` with ``P H_os = 0`` (Varrier 2014, (10)–(12)).
+
+    Parameters
+    ----------
+    H_os : (..., (s+1)p, n) array
+        Stacked observability matrices (batch axes allowed, real or complex).
+    rows : sequence of int, optional
+        Rows forming ``H_os1``; default :func:`regular_rows` of the first batch element.
+    cond_max : float
+        Largest accepted condition number of ``H_os1``.
+
+    Returns
+    -------
+    (..., q, (s+1)p) array; the columns of the ``H_os2`` rows hold ``I_q``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> parity_matrix(np.array([[2.0], [1.0], [0.5]])).tolist()
+    [[-0.5, 1.0, 0.0], [-0.25, 0.0, 1.0]]
+    """
+    H = np.asarray(H_os)
+    N, n = H.shape[-2], H.shape[-1]
+    if rows is None:
+        rows = regular_rows(H.reshape((-1, N, n))[0].real)
+    rows = [int(i) for i in rows]
+    if len(rows) != n or len(set(rows)) != n or not all(0 <= i < N for i in rows):
+        raise ModelError(f"rows must be {n} distinct row indices of H_os (0..{N - 1}), got {rows}")
+    rest = [i for i in range(N) if i not in rows]
+    H1, H2 = H[..., rows, :], H[..., rest, :]
+    cond = np.linalg.cond(H1)
+    if np.any(~np.isfinite(cond)) or np.max(cond) > cond_max:
+        raise DesignError(
+            f"H_os1 (rows {rows}) is singular or ill-conditioned (condition number {np.max(cond):.3g}); "
+            "pass other rows= or check observability over the scheduling range"
+        )
+    X = np.swapaxes(np.linalg.solve(np.swapaxes(H1, -1, -2), np.swapaxes(H2, -1, -2)), -1, -2)  # H2 H1⁻¹
+    P = np.zeros(H.shape[:-2] + (N - n, N), dtype=X.dtype)
+    P[..., rows] = -X
+    P[..., rest] = np.eye(N - n)
+    return P
+
+
+# ---------------------------------------------------------------------------------------------- LTI generator
+@dataclass(frozen=True, eq=False)
+class ParityDesign:
+    """An LTI parity-space residual generator and its design data.
+
+    Attributes
+    ----------
+    generator : FIR :class:`ResidualGenerator`, ``r(k) = Wᵀ(Y_s(k) − H_us U_s(k))`` over ``[k−s, k]``.
+    P : (q, (s+1)p) parity basis; W2 : (q, k) free parameter; W : ((s+1)p, k) parity matrix ``Pᵀ W₂``.
+    stacked : the stacked matrices; rows : the rows of ``H_os1``; s : horizon.
+    """
+
+    generator: ResidualGenerator
+    P: np.ndarray
+    W2: np.ndarray
+    W: np.ndarray
+    stacked: StackedMatrices
+    rows: tuple[int, ...]
+    s: int
+
+    @property
+    def q(self) -> int:
+        """Dimension of the parity space, ``(s+1)p − n``."""
+        return self.P.shape[0]
+
+
+def _as_w2(W2, q: int) -> np.ndarray:
+    W2 = np.eye(q) if W2 is None else validate.as_array("W2", W2, finite=False)
+    if W2.ndim == 1:
+        W2 = W2[:, None]
+    if W2.ndim != 2 or W2.shape[0] != q or not np.all(np.isfinite(W2)):
+        raise ParameterError(f"W2 must be a finite vector or matrix with q = {q} rows, got shape {W2.shape}")
+    if np.linalg.norm(W2) == 0:
+        raise DesignError("W2 = 0 gives the trivial residual r = 0; choose a non-zero W2 (Varrier 2014, (28))")
+    return W2
+
+
+def parity_design(model: FaultModel, s: int | None = None, *, W2=None, rows: Sequence[int] | None = None,
+                  names: Sequence[str] | None = None, isolates: Sequence[str | None] | None = None) -> ParityDesign:
+    """Parity-space residual generator of a discrete LTI model (Varrier 2014, (7)–(12); Chow & Willsky 1984).
+
+    The residual is ``r(k) = W₂ᵀ P (Y_s(k) − H_us U_s(k))`` over the window ``[k−s, k]``,
+    built as an FIR :class:`ResidualGenerator` whose state holds the last ``s`` samples of
+    ``[u; y]`` (the first ``s`` outputs are start-up transients).
+
+    Parameters
+    ----------
+    model : FaultModel
+        Discrete model; the generator reads all its controls and outputs.
+    s : int, optional
+        Horizon; default :func:`minimal_horizon` for one residual.
+    W2 : array_like, optional
+        (q,) or (q, k); default ``I_q`` (the q primary parity residuals).
+    rows, names, isolates
+        Rows of ``H_os1``; residual names (default ``parity_0, …``); fault tied to each residual.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit import FaultModel
+    >>> m = FaultModel([[0.9]], [[1.0], [2.0]], Bu=[[1.0]], dt=0.1)
+    >>> d = parity_design(m, 0)
+    >>> d.q, bool(np.allclose(d.P @ d.stacked.H_os, 0))
+    (1, True)
+    """
+    if not isinstance(model, FaultModel):
+        raise ModelError(f"parity_design needs a FaultModel, got {type(model).__name__}")
+    if not model.is_discrete:
+        raise ModelError("parity_design needs a discrete model; use model.discretize(dt) first")
+    s = minimal_horizon(model.n, model.p) if s is None else check_horizon(s)
+    st = stacked_matrices(model, s)
+    if st.H_os.shape[0] <= model.n:
+        raise DesignError(f"horizon s={s} gives (s+1)p = {st.H_os.shape[0]} <= n = {model.n} rows: no parity "
+                          f"space; use s >= {minimal_horizon(model.n, model.p)}")
+    rows = regular_rows(st.H_os) if rows is None else tuple(int(i) for i in rows)
+    P = parity_matrix(st.H_os, rows)
+    W2 = _as_w2(W2, P.shape[0])
+    W = P.T @ W2
+    k, p, mu = W2.shape[1], model.p, len(model.controls)
+    Wy = W.T  # (k, (s+1)p)
+    Wu = -(W.T @ st.H_us)  # (k, (s+1)mu)
+    nv = mu + p
+    M = [np.hstack([Wu[:, i * mu:(i + 1) * mu], Wy[:, i * p:(i + 1) * p]]) for i in range(s + 1)]
+    A = np.eye(s * nv, k=nv) if s else np.zeros((0, 0))  # z = [v(k−s); …; v(k−1)] shifts up
+    B = np.zeros((s * nv, nv))
+    if s:
+        B[-nv:] = np.eye(nv)
+    C = np.hstack(M[:s]) if s else np.zeros((k, 0))
+    names = tuple(f"parity_{i}" for i in range(k)) if names is None else tuple(names)
+    gen = ResidualGenerator(A, B, C, M[s], model.controls, model.outputs, names, model.dt,
+                            tuple(isolates) if isolates is not None else ())
+    return ParityDesign(gen, P, W2, W, st, tuple(rows), s)
+
+
+# ---------------------------------------------------------------------------------------------- LPV runner
+def lpv_parity_residuals(
+    lpv: LPVModel,
+    trace: Trace,
+    rho,
+    s: int,
+    *,
+    W2: np.ndarray | Callable[[np.ndarray], np.ndarray] | None = None,
+    mode: str = "frozen",
+    rows: Sequence[int] | None = None,
+    names: Sequence[str] | None = None,
+) -> Residuals:
+    """LPV parity residual ``r(k) = W₂(ρ_k)ᵀ P(ρ) (Y_s(k) − H_us(ρ) U_s(k))``, P recomputed every sample.
+
+    Varrier 2014, (9), (12) and (16), on the causal window ``[k−s, k]``.
+
+    Parameters
+    ----------
+    lpv : LPVModel
+    trace : Trace
+        Must hold the controls and outputs of ``lpv`` by name.
+    rho : (N,) array_like
+        Scheduling parameter per sample (e.g. ``1 / speed``).
+    s : int
+        Horizon.
+    W2 : array, callable or None
+        (q,) or (q, k) constant; or a function of a 1-D array of ρ_k returning (N, q) or
+        (N, q, k) (a scheduled ``W₂(ρ)``, e.g. :meth:`RobustParityDesign.w2`); default ``I_q``.
+    mode : ``"frozen"`` (ρ frozen at ρ_k over the window, §4.6.1) or ``"exact"``
+        (time-varying stacking with ρ_{k−s}, …, ρ_k).
+    rows : rows of ``H_os1``; default :func:`regular_rows` at the median ρ.
+    names : residual names; default ``parity_0, …``.
+
+    Returns
+    -------
+    Residuals
+        The first ``s`` samples (incomplete window) are NaN and marked invalid.
+    """
+    s = check_horizon(s)
+    u = trace.columns("u", lpv.controls)
+    y = trace.columns("y", lpv.outputs)
+    rho = np.asarray(rho, dtype=float).ravel()
+    N = len(trace)
+    if rho.shape != (N,):
+        raise DataError(f"rho has {rho.size} samples but the trace has {N}; give one scheduling value per sample")
+    for label, arr in (("rho", rho), ("controls", u), ("outputs", y)):
+        if not np.all(np.isfinite(arr)):
+            raise DataError(f"{label} contain NaN/inf at sample {int(np.argwhere(~np.isfinite(arr))[0][0])}; "
+                            "clean the data first")
+    if N <= s:
+        raise DataError(f"the trace has {N} samples; a horizon s={s} needs more than {s}")
+    win = np.lib.stride_tricks.sliding_window_view
+    Y = win(y, s + 1, axis=0).transpose(0, 2, 1).reshape(N - s, -1)  # [y(k−s); …; y(k)]
+    U = win(u, s + 1, axis=0).transpose(0, 2, 1).reshape(N - s, -1)
+    sched = rho[s:] if mode == "frozen" else win(rho, s + 1)
+    st = lpv_stacked_matrices(lpv, sched, s, mode=mode, groups=("u",))
+    if rows is None:
+        rows = regular_rows(lpv_stacked_matrices(lpv, float(np.median(rho)), s, groups=()).H_os)
+    P = parity_matrix(st.H_os, rows)
+    z = np.einsum("kqj,kj->kq", P, Y - np.einsum("kij,kj->ki", st.H_us, U))
+    q = P.shape[-2]
+    if callable(W2):
+        w = np.asarray(W2(rho[s:]), dtype=float)
+        if w.ndim == 2:
+            w = w[..., None]
+        if w.shape[:2] != (N - s, q):
+            raise ModelError(f"the W2 function returned shape {w.shape}; need ({N - s}, {q}) or ({N - s}, {q}, k)")
+        r = np.einsum("kqi,kq->ki", w, z)
+    else:
+        r = z @ _as_w2(W2, q)
+    k = r.shape[1]
+    out = np.full((N, k), np.nan)
+    out[s:] = r
+    valid = np.arange(N) >= s
+    names = tuple(f"parity_{i}" for i in range(k)) if names is None else tuple(names)
+    meta = {"trace": dict(trace.meta), "s": s, "mode": mode, "rows": list(rows)}
+    return Residuals(trace.t, out, names, (), valid, meta)

@@ -1,0 +1,45 @@
+"""Hallouzi 2008: the target-tracking, B747 and mass–spring–damper benchmarks of the multiple-model
+methods, Table 3.1 and the model-set comparison (Table 3.3), and the report command.
+
+* :mod:`fdikit.studies.hallouzi2008.target_tracking` — Maneuvering-target tracking: dual CMF vs augmented EKF vs IMM
+  (Hallouzi 2008, §2.4.2, Figs 2.4–2.5).
+* :mod:`fdikit.studies.hallouzi2008.b747` — B747 linear longitudinal FDI benchmark: dual CMF vs augmented EKF vs IMM
+  (Hallouzi 2008, §2.4.1, Figs 2.2–2.3).
+* :mod:`fdikit.studies.hallouzi2008.msd` — MSD benchmark with an OD model set and convex-model filters (Hallouzi
+  2008, §3.6.2, Table 3.3, Figs 3.8–3.9).
+* :mod:`fdikit.studies.hallouzi2008.msd_model_sets` — MSD benchmark with the CP and LV model sets next to the OD set
+  (Hallouzi 2008, §3.6.2, Table 3.3, Figs 3.7–3.11).
+* :mod:`fdikit.studies.hallouzi2008.example_3_1` — Example 3.1: basis conditioning vs degree of observability of
+  model pairs (Hallouzi 2008, §3.3.1, Table 3.1).
+* :mod:`fdikit.studies.hallouzi2008.report` — One command for the multiple-model reproductions of Hallouzi 2008
+  (research note §4.2, items 17–20).
+"""
+
+import lazy_loader as lazy
+
+__getattr__, __dir__, __all__ = lazy.attach(
+    __name__,
+    submod_attrs={
+        "target_tracking": [
+            "INTERVALS", "N_SAMPLES", "TargetTrackingResult", "maneuver_profile", "plot_target_tracking",
+            "target_tracking_monte_carlo", "target_tracking_trace", "tracking_convex_set", "tracking_imm_modes",
+        ],
+        "b747": [
+            "B747MonteCarloResult", "INTERVALS", "N_SAMPLES", "TS", "b747_convex_set", "b747_lq_gain",
+            "b747_monte_carlo", "b747_snr", "b747_trace", "b747_weight_profile",
+        ],
+        "msd": [
+            "MSDFilterResult", "MSDModelSet", "MSDSimulation", "MSD_STATES", "ObservabilityComparison",
+            "msd_observability_comparison", "msd_od_model_set", "msd_profile", "run_msd_filter", "simulate_msd",
+        ],
+        "msd_model_sets": [
+            "ModelSetRun", "msd_cp_model_set", "msd_lv_model_set", "msd_table_3_3", "run_msd_model_set",
+        ],
+        "example_3_1": [
+            "Example31Result", "PAIRS", "example_3_1", "example_3_1_models",
+        ],
+        "report": [
+            "PARTS", "check_multiple_model_arguments", "multiple_model_report", "plot_b747", "plot_msd",
+        ],
+    },
+)

@@ -1,0 +1,256 @@
+"""Residual processors side by side on the PATH bank's residuals (``fdikit compare-evaluators``).
+
+Training and test data come from separate seeds: a 10-minute fault-free run calibrates the
+fault-free statistics (thresholds, CUSUM, GLR, SPRT); one labelled run per fault trains the
+multiple-hypothesis SPRT (Douglas et al. 1996, Ch. 7), the Gaussian ML classifier (§6.2.1) and
+the Bayesian neural network (Ch. 6); every evaluator is then scored on the same fresh runs
+(:func:`fdikit.compare.compare_evaluators`).
+
+With an output folder the comparison is resumable: each test run's scores are stored as soon as
+the run is scored, and a rerun with the same arguments skips them (rules in :mod:`fdikit.resume`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import asdict
+from pathlib import Path
+
+from fdikit.compare import Comparison, compare_evaluators, score_run, scores_csv_text, tabulate
+from fdikit.errors import ParameterError
+from fdikit.studies.path1996.bank import path_bank, path_fault_model, path_runs
+
+__all__ = ["path_evaluator_comparison", "check_comparison_arguments", "EVALUATORS"]
+
+#: The evaluators of the comparison: command-line key → table name (the table's row order).
+EVALUATORS = {
+    "threshold": "threshold (5 of 10)",
+    "cusum": "CUSUM",
+    "glr": "GLR (M = 50)",
+    "sprt": "SPRT",
+    "cusum-whitened": "CUSUM, whitened",
+    "glr-whitened": "GLR, whitened",
+    "sprt-whitened": "SPRT, whitened",
+    "mhsprt": "MHSSPRT",
+    "gaussian-ml": "Gaussian ML",
+    "bnn": "Bayesian NN",
+}
+_ONSET = 5.0
+
+
+def check_comparison_arguments(runs_per_fault=2, healthy_runs=5, seed=0, bnn=True, noise_fraction=1e-4,
+                               evaluators: Sequence[str] | None = None) -> dict:
+    """Validate the arguments of :func:`path_evaluator_comparison` before any work; return them normalised.
+
+    ``evaluators`` (keys of :data:`EVALUATORS`, or ``None`` for all) comes back as a list in table order
+    (``'bnn'`` dropped when ``bnn`` is false).
+
+    Raises
+    ------
+    ParameterError
+        Naming the argument and what would be accepted.
+    """
+    from fdikit.resume import check_count, check_positive, check_seed, option_name
+
+    args = {"runs_per_fault": check_count(runs_per_fault, "runs_per_fault", 0),
+            "healthy_runs": check_count(healthy_runs, "healthy_runs", 0), "seed": check_seed(seed)}
+    if args["runs_per_fault"] + args["healthy_runs"] == 0:
+        raise ParameterError(f"no test runs: {option_name('runs_per_fault')} and {option_name('healthy_runs')} "
+                             "are both 0; ask for at least one run (e.g. --healthy-runs 1)")
+    if not isinstance(bnn, bool):
+        raise ParameterError(f"{option_name('bnn')} must be True or False, got {bnn!r}")
+    args["noise_fraction"] = check_positive(noise_fraction, "noise_fraction")
+    known = ", ".join(EVALUATORS)
+    if evaluators is None:
+        chosen = [k for k in EVALUATORS if bnn or k != "bnn"]
+    else:
+        if isinstance(evaluators, str) or not all(isinstance(e, str) for e in evaluators):
+            raise ParameterError(f"{option_name('evaluators')} must be a list of names from: {known}; "
+                                 f"got {evaluators!r}")
+        names = [e.strip().lower() for e in evaluators if e.strip()]
+        if not names:
+            raise ParameterError(f"{option_name('evaluators')} is empty; name at least one of: {known}")
+        bad = [e for e in names if e not in EVALUATORS]
+        if bad:
+            raise ParameterError(f"{option_name('evaluators')}: unknown evaluator {bad[0]!r}; choose from: {known}")
+        if "bnn" in names and not bnn:
+            raise ParameterError(f"{option_name('evaluators')} names 'bnn' but bnn=False (--no-bnn) excludes it; "
+                                 "drop one of the two")
+        chosen = [k for k in EVALUATORS if k in names]
+    args["evaluators"] = chosen
+    return args
+
+
+def path_evaluator_comparison(
+    runs_per_fault: int = 2,
+    healthy_runs: int = 5,
+    seed: int = 0,
+    out: str | Path | None = None,
+    progress: bool = False,
+    bnn: bool = True,
+    noise_fraction: float = 1e-4,
+    evaluators: Sequence[str] | None = None,
+    fresh: bool = False,
+) -> Comparison:
+    """Fit every evaluator on training runs and score them on fresh PATH runs.
+
+    Parameters
+    ----------
+    runs_per_fault, healthy_runs : int
+        Test runs per fault (15 faults) and fault-free test runs (>= 0 each, not both 0).
+    seed : int
+        Seed (>= 0) of the training runs (``seed``, ``seed + 1``) and the test runs (``seed + 2``).
+    out : str or PathLike, optional
+        Folder for ``scores.csv`` and ``comparison.md``.  With ``out``, each test run's scores are
+        stored atomically in ``out/parts-*/run-NNNNN.json`` as soon as the run is scored, and a rerun
+        with the same arguments after a kill resumes (finished runs are reused; the evaluators are
+        refitted, deterministically, only when some run is missing).  ``scores.csv`` and
+        ``comparison.md`` are written atomically once every run is scored.  Rules:
+        :mod:`fdikit.resume`.
+    progress : bool
+        Show rich progress bars.
+    bnn : bool
+        Include the Bayesian neural network (slowest to train).
+    noise_fraction : float
+        Sensor noise as a fraction of each sensor's nominal fault size (> 0).
+    evaluators : sequence of str, optional
+        Keys of :data:`EVALUATORS` to compare (default: all).
+    fresh : bool
+        Start over even when ``out`` holds a resumable run of other arguments.
+
+    Raises
+    ------
+    ParameterError
+        For a bad argument (checked before any work) or an ``out`` holding a run of other arguments.
+    """
+    args = check_comparison_arguments(runs_per_fault, healthy_runs, seed, bnn, noise_fraction, evaluators)
+    chosen = args["evaluators"]
+    if out is None:
+        fitted = _fit(chosen, seed, noise_fraction, progress)
+        runs = path_runs(_bank(), runs_per_fault=runs_per_fault, healthy_runs=healthy_runs, onset=_ONSET,
+                         seed=seed + 2, noise_fraction=noise_fraction, progress=progress)
+        return compare_evaluators(fitted, runs, progress=progress)
+
+    from fdikit.metrics import Score
+    from fdikit.resume import RunStore
+
+    store = RunStore(out, "compare-evaluators", args, fresh=fresh)
+    specs = _test_specs(runs_per_fault, healthy_runs, seed + 2)
+    keys = [f"run-{k:05d}" for k in range(len(specs))]
+    records = {key: store.load(key) for key in keys}
+    todo = [k for k, key in enumerate(keys) if records[key] is None]
+    if todo:
+        fitted = _fit(chosen, seed, noise_fraction, progress)
+        items = todo
+        if progress:
+            from rich.progress import track
+
+            done = len(specs) - len(todo)
+            items = track(todo, description=f"scoring test runs ({done} of {len(specs)} done earlier)"
+                          if done else "scoring test runs", total=len(todo))
+        for k in items:
+            trace, residuals = _test_run(specs[k], noise_fraction)
+            scored = score_run(fitted, trace, residuals)
+            records[keys[k]] = store.save(keys[k], {"run": k, "scores": {n: asdict(s) for n, s in scored.items()}})
+    names = [EVALUATORS[k] for k in chosen]
+    scores = {n: [Score(**records[key]["scores"][n]) for key in keys] for n in names}
+    result = tabulate(scores)
+    store.publish({"scores.csv": scores_csv_text(scores), "comparison.md": result.to_markdown() + "\n"})
+    return result
+
+
+_CACHE: dict = {}
+
+
+def _bank():
+    if "bank" not in _CACHE:
+        _CACHE["bank"] = path_bank()
+    return _CACHE["bank"]
+
+
+def _test_specs(runs_per_fault: int, healthy_runs: int, seed: int, dt: float = 0.01):
+    """The test runs of :func:`fdikit.studies.path1996.bank.path_runs`: ``[(fault or None, seed), ...]``."""
+    import numpy as np
+
+    plant = path_fault_model(14).discretize(dt)
+    specs = [None] * healthy_runs + [f for f in plant.faults for _ in range(runs_per_fault)]
+    seeds = np.random.default_rng(seed).integers(2**31, size=len(specs))
+    return [(f, int(s)) for f, s in zip(specs, seeds)]
+
+
+def _test_run(spec, noise_fraction: float, size: float = 1.0, duration: float = 20.0, dt: float = 0.01):
+    """One test run, exactly as :func:`fdikit.studies.path1996.bank.path_runs` simulates it."""
+    import numpy as np
+
+    from fdikit.faults import Bias, FaultScenario
+    from fdikit.model import sensor_fault_name
+    from fdikit.simulate import simulate
+
+    bank = _bank()
+    key = ("plant", dt)
+    if key not in _CACHE:
+        plant = path_fault_model(14).discretize(dt)
+        _CACHE[key] = (plant, bank.generator.discretize(dt))
+    plant, gen = _CACHE[key]
+    noise = noise_fraction * np.array([bank.nominal[sensor_fault_name(o)] for o in plant.outputs])
+    fault, s = spec
+    faults = []
+    if fault is not None:
+        signal, loc = fault.rsplit("_", 1)
+        faults = [Bias(signal, size * bank.nominal[fault], onset=_ONSET, location=loc)]
+    trace = simulate(plant, FaultScenario(faults), duration=duration, measurement_noise=noise, rng=s)
+    return trace, gen.run(trace)
+
+
+def _fit(chosen: Sequence[str], seed: int, noise_fraction: float, progress: bool) -> dict:
+    """Fit the chosen evaluators (keys of EVALUATORS) on the training runs; ``{table name: evaluator}``."""
+    import numpy as np
+
+    from fdikit.decision import CusumEvaluator, GlrEvaluator, SprtEvaluator, ThresholdEvaluator, Whitened
+    from fdikit.decision.learned.bnn import BnnEvaluator
+    from fdikit.decision.learned.gaussian_ml import GaussianMlEvaluator
+    from fdikit.decision.mhsprt import MhsprtEvaluator
+
+    bank = _bank()
+    onset = _ONSET
+    healthy = path_runs(bank, runs_per_fault=0, healthy_runs=1, duration=600.0, seed=seed,
+                        noise_fraction=noise_fraction)[0][1].slice(start=10.0)
+    g = bank.groups
+    # design shift of CUSUM and SPRT: 4 fault-free standard deviations per residual (the nominal faults move
+    # their own scaled residual by 1, far more than 4σ at this noise level)
+    shift = 4.0 * healthy.r.std(axis=0, ddof=1)
+    # vector tests (GLR, SPRT) per fault within each filter: residual '<filter>:<fault>[k]' → '<filter>:<fault>'
+    blocks = [name.split("[")[0] for name in healthy.names]
+    w_shift = None
+    if any(k in chosen for k in ("cusum-whitened", "sprt-whitened")):
+        # the same tests on AR(5)-prewhitened residuals (the bank's residuals are coloured; decision.whiten)
+        innov = Whitened(ThresholdEvaluator(), order=5).fit(healthy, false_alarm_prob=1e-3).whiten(healthy)
+        w_shift = 4.0 * np.nanstd(innov.r, axis=0, ddof=1)
+    labelled = None
+    if any(k in chosen for k in ("mhsprt", "gaussian-ml", "bnn")):
+        labelled = path_runs(bank, runs_per_fault=1, healthy_runs=1, onset=onset, seed=seed + 1,
+                             noise_fraction=noise_fraction, progress=progress)
+    fits = {
+        "threshold": lambda: ThresholdEvaluator(groups=g, persistence=(5, 10)).fit(healthy, false_alarms_per_hour=1),
+        "cusum": lambda: CusumEvaluator(groups=g).fit(healthy, mean_time_between_false_alarms=3600.0, shift=shift),
+        "glr": lambda: GlrEvaluator(window=50, blocks=blocks, groups=g).fit(healthy, false_alarms_per_hour=1),
+        "sprt": lambda: SprtEvaluator(shift=shift, alpha=1e-6, beta=1e-3, blocks=blocks, groups=g).fit(healthy),
+        "cusum-whitened": lambda: Whitened(CusumEvaluator(groups=g), 5).fit(
+            healthy, mean_time_between_false_alarms=3600.0, shift=w_shift),
+        "glr-whitened": lambda: Whitened(GlrEvaluator(window=50, blocks=blocks, groups=g), 5).fit(
+            healthy, false_alarms_per_hour=1),
+        "sprt-whitened": lambda: Whitened(
+            SprtEvaluator(shift=w_shift, alpha=1e-6, beta=1e-3, blocks=blocks, groups=g), 5).fit(healthy),
+        "mhsprt": lambda: MhsprtEvaluator().fit(_by_fault(healthy, labelled, onset), regularization=1e-6),
+        "gaussian-ml": lambda: GaussianMlEvaluator().fit([res for _, res in labelled],
+                                                         [trace.fault for trace, _ in labelled]),
+        "bnn": lambda: BnnEvaluator().fit([res for _, res in labelled], [trace.fault for trace, _ in labelled]),
+    }
+    return {EVALUATORS[k]: fits[k]() for k in chosen}
+
+
+def _by_fault(healthy, labelled, onset):
+    by_fault = {"none": healthy}
+    for trace, res in labelled[1:]:
+        by_fault[str(trace.fault[-1])] = res.slice(start=onset + 1.0)
+    return by_fault
