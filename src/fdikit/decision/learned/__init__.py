@@ -10,6 +10,8 @@ Gaussian maximum-likelihood classifier, trained on labelled runs.
   step sizes (Douglas et al. 1996, §6.3).
 * :mod:`fdikit.decision.learned.gaussian_ml` — Gaussian maximum-likelihood classifier as a single-layer perceptron
   (Douglas et al. 1996, §6.2.1).
+* :mod:`fdikit.decision.learned.labelled_runs` — Labelled residual runs as training data, and residual rows as
+  classifier inputs (Douglas et al. 1996, §6.2–6.4).
 """
 
 import lazy_loader as lazy
@@ -29,6 +31,9 @@ __getattr__, __dir__, __all__ = lazy.attach(
         ],
         "gaussian_ml": [
             "GaussianMlEvaluator",
+        ],
+        "labelled_runs": [
+            "LabelledInputs", "as_runs", "one_hot_targets", "posterior_decisions",
         ],
     },
 )

@@ -18,6 +18,8 @@ from fdikit.errors import DataError, ParameterError
 from fdikit.faults import NO_FAULT
 from fdikit.residuals import Residuals
 
+__all__ = ["LabelledInputs", "as_runs", "one_hot_targets", "posterior_decisions"]
+
 
 @dataclass(frozen=True)
 class LabelledInputs:

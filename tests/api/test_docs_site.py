@@ -1,0 +1,42 @@
+"""The documentation site's sources: the API pages cover every module and are current; the nav lists every page."""
+
+from __future__ import annotations
+
+import importlib.util
+import pathlib
+import re
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+
+
+def _api_pages():
+    spec = importlib.util.spec_from_file_location("api_pages", ROOT / "tools" / "api_pages.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_api_pages_are_current():
+    pages = _api_pages()
+    for name, text in pages.expected().items():
+        path = ROOT / "docs" / "api" / name
+        assert path.exists() and path.read_text(encoding="utf-8") == text, (
+            f"docs/api/{name} is missing or stale; run `python tools/api_pages.py`")
+
+
+def test_every_module_has_an_api_page():
+    pages = _api_pages()
+    listed = {m for _, pkg, _ in pages.PAGES for m in pages.modules(pkg)}
+    src = ROOT / "src" / "fdikit"
+    every = {"fdikit." + ".".join(p.with_suffix("").relative_to(src).parts)
+             for p in src.rglob("*.py") if p.name != "__init__.py"}
+    assert every - listed == pages.SKIP
+
+
+def test_nav_lists_every_page():
+    nav = (ROOT / "mkdocs.yml").read_text(encoding="utf-8")
+    listed = set(re.findall(r":\s*([\w/.-]+\.md)\s*$|^\s*-\s*([\w/.-]+\.md)\s*$", nav, re.M))
+    listed = {a or b for a, b in listed}
+    pages = {str(p.relative_to(ROOT / "docs")) for p in (ROOT / "docs").rglob("*.md")}
+    assert pages - listed == set(), f"pages not in the mkdocs.yml nav: {sorted(pages - listed)}"
+    assert listed - pages == set(), f"nav entries without a page: {sorted(listed - pages)}"

@@ -1,0 +1,80 @@
+"""Write the API reference pages of the documentation site (docs/api/*.md), one page per package.
+
+Each page lists the package's modules as mkdocstrings ``:::`` blocks; the members shown are each module's ``__all__``.
+Run ``python tools/api_pages.py`` after adding or removing a module; ``tests/test_docs_site.py`` fails when a page is
+missing or stale.
+"""
+
+from __future__ import annotations
+
+import ast
+import pathlib
+import sys
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+SRC = ROOT / "src" / "fdikit"
+API = ROOT / "docs" / "api"
+
+#: Package pages in site order: (page file stem, package dotted name, title).
+PAGES = [
+    ("core", "fdikit", "Core: models, faults, simulation, traces, residuals, diagnoses"),
+    ("plants", "fdikit.plants", "Plants"),
+    ("design-observers", "fdikit.design.observers", "Design: observer-type filters"),
+    ("design-game", "fdikit.design.game", "Design: game-theoretic filters"),
+    ("design-parity", "fdikit.design.parity", "Design: parity space"),
+    ("decision", "fdikit.decision", "Decision: residual evaluators"),
+    ("decision-learned", "fdikit.decision.learned", "Decision: learned classifiers"),
+    ("multimodel", "fdikit.multimodel", "Multiple-model estimation"),
+    ("estimate", "fdikit.estimate", "Fault estimation"),
+    ("analysis", "fdikit.analysis", "Analysis"),
+    ("studies-path1996", "fdikit.studies.path1996", "Study: Douglas et al. 1996 (PATH)"),
+    ("studies-hallouzi2008", "fdikit.studies.hallouzi2008", "Study: Hallouzi 2008"),
+    ("studies-vanderploeg2018", "fdikit.studies.vanderploeg2018", "Study: van der Ploeg 2018"),
+    ("studies-varrier2014", "fdikit.studies.varrier2014", "Study: Varrier et al. 2014"),
+]
+
+#: Modules without an API page: the command-line entry point (documented by ``fdikit --help``).
+SKIP = {"fdikit.cli"}
+
+
+def modules(package: str) -> list[str]:
+    """Dotted names of the modules directly in ``package`` (not its subpackages), in file order."""
+    folder = SRC.joinpath(*package.split(".")[1:])
+    out = []
+    for path in sorted(folder.glob("*.py")):
+        name = f"{package}.{path.stem}"
+        if path.stem == "__init__" or name in SKIP:
+            continue
+        out.append(name)
+    return out
+
+
+def summary(module: str) -> str:
+    """First line of a module's docstring."""
+    path = SRC.joinpath(*module.split(".")[1:]).with_suffix(".py")
+    doc = ast.get_docstring(ast.parse(path.read_text(encoding="utf-8"))) or ""
+    return doc.split("\n")[0]
+
+
+def page(package: str, title: str) -> str:
+    """Markdown of one API page."""
+    lines = [f"# {title}", "", f"Package `{package}`.", ""]
+    for mod in modules(package):
+        lines += [f"## `{mod}`", "", f"::: {mod}", "    options:", "      show_root_heading: false", ""]
+    return "\n".join(lines)
+
+
+def expected() -> dict[str, str]:
+    """Page file name → content."""
+    return {f"{stem}.md": page(pkg, title) for stem, pkg, title in PAGES}
+
+
+def main() -> int:
+    API.mkdir(parents=True, exist_ok=True)
+    for name, text in expected().items():
+        (API / name).write_text(text, encoding="utf-8")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
