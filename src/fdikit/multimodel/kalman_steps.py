@@ -47,6 +47,18 @@ def psd_sqrt(M, name: str = "covariance") -> np.ndarray:
     re-triangularised by a QR factorisation (so singular covariances are accepted).
     The diagonal of ``S`` is non-negative.
 
+    Parameters
+    ----------
+    M : array_like
+        Symmetric positive semidefinite matrix (n x n), e.g. a covariance ``Q`` or ``P``.
+    name : str, optional
+        Name of the matrix in error messages (default ``"covariance"``).
+
+    Returns
+    -------
+    ndarray
+        Lower-triangular ``S`` (n x n) with ``S Sᵀ = M``.
+
     Raises
     ------
     ModelError
@@ -57,6 +69,10 @@ def psd_sqrt(M, name: str = "covariance") -> np.ndarray:
     >>> psd_sqrt([[4.0, 2.0], [2.0, 2.0]])
     array([[2., 0.],
            [1., 1.]])
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.2, (2.25)–(2.26): the factors ``S`` with ``S Sᵀ = P`` of the square-root filter.
     """
     M = validate.psd_part(name, validate.as_sized_matrix(name, M, error=ModelError), error=ModelError)
     try:
@@ -80,10 +96,26 @@ def tria(M: np.ndarray) -> np.ndarray:
 def gaussian_log_likelihood(innovation: np.ndarray, S_chol: np.ndarray) -> float:
     """``log N(e; 0, S)`` from the Cholesky factor of ``S`` (Hallouzi 2008, (2.12), log domain).
 
+    Parameters
+    ----------
+    innovation : ndarray
+        Innovation ``e`` (p).
+    S_chol : ndarray
+        Lower-triangular factor of the innovation covariance (p x p), ``S_chol S_cholᵀ = S``.
+
+    Returns
+    -------
+    float
+        ``−½ (eᵀ S⁻¹ e + log det S + p log 2π)``.
+
     Examples
     --------
     >>> round(gaussian_log_likelihood(np.zeros(1), np.eye(1)), 6)
     -0.918939
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.1, Table 2.1 step 3, (2.12) (the mode likelihood).
     """
     z = np.linalg.solve(S_chol, innovation)  # triangular; numpy's solve avoids scipy's per-call checks
     logdet = 2.0 * float(np.sum(np.log(np.abs(np.diag(S_chol)))))
@@ -119,6 +151,16 @@ def kf_predict(x, P, A, B=None, u=None, Q=None) -> tuple[np.ndarray, np.ndarray]
     -------
     x_pred, P_pred : ndarray
         ``x̂(k+1|k)`` and the symmetrised ``P(k+1|k)``.
+
+    Examples
+    --------
+    >>> x, P = kf_predict(np.zeros(1), np.eye(1), [[0.9]], Q=0.1 * np.eye(1))
+    >>> x.tolist(), P.round(6).tolist()
+    ([0.0], [[0.91]])
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.1, Table 2.1 step 2 (mode-matched filtering).
     """
     A = np.asarray(A, dtype=float)
     x = np.asarray(x, dtype=float)
@@ -136,6 +178,19 @@ def kf_update(x, P, y, C, D=None, u=None, R=None) -> tuple[np.ndarray, np.ndarra
     ``P⁺ = (I − K C) P (I − K C)ᵀ + K R Kᵀ`` (Joseph form: equal to Table 2.1's
     ``P − K S Kᵀ`` in exact arithmetic, but symmetric and PSD in floating point).
 
+    Parameters
+    ----------
+    x, P : array_like
+        Predicted state ``x̂(k|k−1)`` (n) and covariance ``P(k|k−1)`` (n x n).
+    y : array_like
+        Measurement ``y(k)`` (p).
+    C, D : array_like
+        Output and feedthrough matrices; ``D``/``u`` may be omitted (no feedthrough).
+    u : array_like, optional
+        Input ``u(k)``.
+    R : array_like, optional
+        Measurement noise covariance (p x p); zero if omitted (then ``C P Cᵀ`` must be nonsingular).
+
     Returns
     -------
     x_filt, P_filt : ndarray
@@ -146,6 +201,21 @@ def kf_update(x, P, y, C, D=None, u=None, R=None) -> tuple[np.ndarray, np.ndarra
         Innovation covariance (p x p).
     log_likelihood : float
         ``log N(e; 0, S)``; ``exp`` of it is the mode likelihood ``L`` of (2.12).
+
+    Raises
+    ------
+    DataError
+        If the innovation covariance ``C P Cᵀ + R`` is not positive definite, or ``u`` does not match ``D``.
+
+    Examples
+    --------
+    >>> x, P, e, S, ll = kf_update(np.zeros(1), np.eye(1), [1.0], [[1.0]], R=np.eye(1))
+    >>> x.tolist(), P.round(6).tolist(), S.tolist(), round(ll, 6)
+    ([0.5], [[0.5]], [[2.0]], -1.515512)
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.1, Table 2.1 steps 2–3, (2.12).
     """
     x = np.asarray(x, dtype=float)
     P = np.asarray(P, dtype=float)
@@ -188,6 +258,16 @@ def srkf_predict(x, S, A, B=None, u=None, Q_sqrt=None) -> tuple[np.ndarray, np.n
     -------
     x_pred, S_pred : ndarray
         ``x̂(k+1|k)`` and lower-triangular ``S(k+1|k)``.
+
+    Examples
+    --------
+    >>> x, S = srkf_predict(np.zeros(1), np.eye(1), [[0.9]], Q_sqrt=[[0.3]])
+    >>> (S @ S.T).round(6).tolist()
+    [[0.9]]
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.2, Table 2.2 step 1, (2.29), (2.31).
     """
     A = np.asarray(A, dtype=float)
     x_pred = A @ np.asarray(x, dtype=float) + _input_term(B, u, A.shape[0])
@@ -206,6 +286,17 @@ def srkf_update(
     transformation into ``[[R_e, 0], [G, S⁺]]``; then ``R_e R_eᵀ = C P Cᵀ + R``,
     ``G = P Cᵀ R_e⁻ᵀ``, ``x⁺ = x + G R_e⁻¹ e`` and ``S⁺ S⁺ᵀ = P − P Cᵀ (C P Cᵀ + R)⁻¹ C P``.
 
+    Parameters
+    ----------
+    x, S : array_like
+        ``x̂(k|k−1)`` (n) and a factor ``S(k|k−1)`` (n x n) with ``S Sᵀ = P(k|k−1)``.
+    y : array_like
+        Measurement ``y(k)`` (p).
+    C, D, u : array_like
+        As in :func:`kf_update`.
+    R_sqrt : array_like, optional
+        A factor ``R^{1/2}`` (p x p) of the measurement noise covariance; zero if omitted.
+
     Returns
     -------
     x_filt, S_filt : ndarray
@@ -216,6 +307,21 @@ def srkf_update(
         Lower-triangular factor of the innovation covariance (``R_e R_eᵀ = S``).
     log_likelihood : float
         ``log N(e; 0, R_e R_eᵀ)``.
+
+    Raises
+    ------
+    DataError
+        If the innovation covariance is singular (a zero diagonal entry of ``R_e``), or ``u`` does not match ``D``.
+
+    Examples
+    --------
+    >>> x, S, e, Re, ll = srkf_update(np.zeros(1), np.eye(1), [1.0], [[1.0]], R_sqrt=np.eye(1))
+    >>> x.round(6).tolist(), (S @ S.T).round(6).tolist(), (Re @ Re.T).round(6).tolist(), round(ll, 6)
+    ([0.5], [[0.5]], [[2.0]], -1.515512)
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.2, Table 2.2 step 1, (2.29)–(2.30).
     """
     x = np.asarray(x, dtype=float)
     S = np.asarray(S, dtype=float)
@@ -242,6 +348,19 @@ def srcf_step(
     ``[V₁ V₂]`` into ``S(k+1|k)``.  (2.30), (2.32) give the filtered and predicted states.
     The residual sign of (2.30)/(2.32), ``C x̂ + D u − y``, is written here as ``−e``.
 
+    Parameters
+    ----------
+    x_pred, S_pred : array_like
+        ``x̂(k|k−1)`` (n) and a factor ``S(k|k−1)`` (n x n) of its covariance.
+    y : array_like
+        Measurement ``y(k)`` (p).
+    A, C : array_like
+        State (n x n) and output (p x n) matrices.
+    B, D, u : array_like, optional
+        Input, feedthrough matrices and input ``u(k)``; the input terms are dropped when omitted.
+    Q_sqrt, R_sqrt : array_like, optional
+        Factors of the process (n x n) and measurement (p x p) noise covariances; zero if omitted.
+
     Returns
     -------
     x_filt, S_filt, x_next, S_next : ndarray
@@ -250,6 +369,17 @@ def srcf_step(
         ``e(k) = y − C x̂(k|k−1) − D u`` and the factor ``R_e`` of its covariance.
     log_likelihood : float
         ``log N(e; 0, R_e R_eᵀ)``.
+
+    Examples
+    --------
+    >>> out = srcf_step(np.zeros(1), np.eye(1), [1.0], [[0.9]], [[1.0]], Q_sqrt=[[0.3]], R_sqrt=[[1.0]])
+    >>> x_filt, S_filt, x_next, S_next, e, Re, ll = out
+    >>> x_filt.round(6).tolist(), x_next.round(6).tolist(), (S_next @ S_next.T).round(6).tolist()
+    ([0.5], [0.45], [[0.495]])
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.2, Table 2.2 step 1, (2.29)–(2.32).
     """
     A = np.asarray(A, dtype=float)
     C = np.atleast_2d(np.asarray(C, dtype=float))
