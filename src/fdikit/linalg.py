@@ -7,7 +7,8 @@ data (``max(shape) · eps · σ_max`` by default, or a caller's relative toleran
   ``C F¹ = e_i`` (Douglas et al. 1996, eqs. (3.3)–(3.5); App. A.2), actuator faults as
   columns of ``B`` (§3.2);
 * the minimal (C, A)-invariant subspace containing ``F`` by CAISA (App. A, Theorem A.1,
-  with ``W⁰ = 0``: the report prints ∅, an OCR slip);
+  with ``W⁰ = 0``: the report prints ∅, which is not a subspace; the
+  iteration starts from the zero subspace);
 * invariant zeros of ``(C, A, F)`` and their state directions from the Rosenbrock pencil;
 * the minimal unobservability subspace ``T* = W* ⊕ V`` (§4.1, App. A.3), output
   separability (a.7) and mutual detectability (§4.1).
@@ -26,6 +27,9 @@ from fdikit.model import FaultModel, actuator_fault_name, sensor_fault_name
 
 __all__ = [
     "resolve_faults",
+    "resolve_nuisance",
+    "split_fault_name",
+    "check_fault_inputs",
     "output_projector",
     "rank",
     "orth",
@@ -182,7 +186,8 @@ def sensor_fault_map_tv(
     """Two-dimensional sensor-fault map of a time-varying model at time ``t``: ``[F¹(t), F²(t)]``.
 
     ``C(t) F¹(t) = e_i`` (minimum-norm) and ``F² = A F¹ − dF¹/dt`` (Douglas et al. 1996, App. A.2; the
-    printed (a.9b) has ``+ ḃ``, the sign G16 of the research note corrects, consistent with A.2 and (9.38)).
+    printed (a.9b) reads ``A b + ḃ``; the Goh transformation it names gives ``A b − ḃ``, the sign of
+    ``A B₁ − Ḃ₁`` in (9.38) and of ``A F_i − Ḟ_i`` in App. A.2).
     ``dF1`` gives the derivative; otherwise a central difference with ``step`` (default ``1e-6 · max(1, |t|)``).
     ``A`` and ``C`` are callables ``t -> matrix``; ``output`` is the output's index.
     """
@@ -231,15 +236,32 @@ def actuator_fault_map(model: FaultModel, control: str) -> np.ndarray:
     return model.Bu[:, [j]]
 
 
-def resolve_fault(model: FaultModel, name: str) -> tuple[np.ndarray, str]:
-    """State-space fault map of a named fault and its kind.
+def _signal_hint(model: FaultModel, base: str, suffix: str = "") -> str | None:
+    """The message refusing a bare signal name, naming the fault to use (None if ``base`` is no signal)."""
+    tail = f":{suffix}" if suffix else ""
+    if base in model.outputs:
+        return f"{base!r} is an output; its sensor fault is {sensor_fault_name(base) + tail!r}"
+    if base in model.controls:
+        return f"{base!r} is a control; its actuator fault is {actuator_fault_name(base) + tail!r}"
+    return None
 
-    * an output name → :func:`sensor_fault_map` ``[F¹, A F¹]`` (kind ``'sensor'``);
-    * ``'<output>:magnitude'`` → ``A F¹`` only (the bias assumption, Douglas et al. 1996 §3.1),
-      ``'<output>:rate'`` → ``F¹`` only;
-    * a control name → :func:`actuator_fault_map`, the column of ``Bu`` (``'actuator'``);
-    * a fault input of the model (group ``f``) → its ``Bf`` column when ``Df`` is zero, the sensor
-      map of output ``i`` when it is a pure sensor fault (``Df = e_i``, ``Bf = 0``).
+
+def split_fault_name(model: FaultModel, name: str) -> tuple[str, str, str]:
+    """Parse a fault name against a model: ``(kind, signal, suffix)``.
+
+    * a fault input of the model (group ``f``) by its own name → ``('fault', name, suffix)``;
+    * ``'<output>_sensor'`` → ``('sensor', output, suffix)``, with the optional suffix ``':magnitude'``
+      (``A F¹`` only, the bias assumption, Douglas et al. 1996 §3.1) or ``':rate'`` (``F¹`` only);
+    * ``'<control>_actuator'`` → ``('actuator', control, '')``.
+
+    Raises
+    ------
+    ParameterError
+        A name that is not a string, an unknown suffix, or a bare signal name (an output or control):
+        the message gives the fault name to use (``'theta' is an output; its sensor fault is
+        'theta_sensor'``).
+    ModelError
+        A name the model does not know, or a suffix on an actuator fault.
     """
     validate.instance("model", model, FaultModel)
     if not isinstance(name, str):
@@ -249,16 +271,69 @@ def resolve_fault(model: FaultModel, name: str) -> tuple[np.ndarray, str]:
         raise ParameterError(
             f"unknown fault suffix {suffix!r} in {name!r}; use ':magnitude' or ':rate' (sensor faults)"
         )
-    where = [k for k, pool in (("output", model.outputs), ("control", model.controls), ("fault", model.faults))
-             if base in pool]
-    if not where:
-        raise ModelError(
-            f"{base!r} is not an output, control or fault input of the model; outputs {list(model.outputs)}, "
-            f"controls {list(model.controls)}, faults {list(model.faults)}"
-        )
-    if len(where) > 1:
-        raise ModelError(f"{base!r} names both an {where[0]} and a {where[1]}; pass its fault map in a dict instead")
-    kind = where[0]
+    if base in model.faults:
+        return "fault", base, suffix
+    sensors = {sensor_fault_name(o): o for o in model.outputs}
+    if base in sensors:
+        return "sensor", sensors[base], suffix
+    actuators = {actuator_fault_name(c): c for c in model.controls}
+    if base in actuators:
+        if suffix:
+            raise ModelError(f"{name!r}: the ':{suffix}' suffix applies to sensor faults only, {base!r} is an "
+                             "actuator fault")
+        return "actuator", actuators[base], ""
+    hint = _signal_hint(model, base, suffix)
+    if hint:
+        raise ParameterError(f"{hint}; faults are named by fault name, not by signal name")
+    raise ModelError(
+        f"{base!r} is not a fault of the model; fault names are <output>_sensor {list(sensors)}, "
+        f"<control>_actuator {list(actuators)} and the fault inputs {list(model.faults)}"
+    )
+
+
+def check_fault_inputs(model: FaultModel, names: Sequence[str] | str, what: str = "fault") -> tuple[str, ...]:
+    """Names of fault inputs of the model (group ``f``), checked; a bare signal name is refused.
+
+    For designs that act on the model's fault inputs themselves (:func:`fdikit.design.observers.uio.uio`,
+    the gain tables of :mod:`fdikit.analysis`).  Raises :class:`ParameterError` for a signal name (with the
+    fault name to use) and :class:`ModelError` for a name that is no fault input of the model.
+    """
+    validate.instance("model", model, FaultModel)
+    names = (names,) if isinstance(names, str) else tuple(names)
+    for nm in names:
+        if not isinstance(nm, str):
+            raise ParameterError(f"{what} names must be strings, got {nm!r} ({type(nm).__name__})")
+        if nm in model.faults:
+            continue
+        hint = _signal_hint(model, nm)
+        if hint:
+            raise ParameterError(f"{hint}; faults are named by fault name, not by signal name")
+        kind = "sensor" if nm in {sensor_fault_name(o) for o in model.outputs} else (
+            "actuator" if nm in {actuator_fault_name(c) for c in model.controls} else None)
+        if kind:
+            add = "with_sensor_faults" if kind == "sensor" else "with_actuator_faults"
+            raise ModelError(f"{nm!r} is not a fault input of the model; add it with model.{add}([...]) "
+                             f"(the model has fault inputs {list(model.faults)})")
+        raise ModelError(f"no fault input named {nm!r}; the model has {list(model.faults)}")
+    return names
+
+
+def resolve_fault(model: FaultModel, name: str) -> tuple[np.ndarray, str]:
+    """State-space fault map of a named fault and its kind.
+
+    ``name`` is a fault name (:func:`split_fault_name`):
+
+    * ``'<output>_sensor'`` → :func:`sensor_fault_map` ``[F¹, A F¹]`` (kind ``'sensor'``);
+      ``'<output>_sensor:magnitude'`` → ``A F¹`` only (the bias assumption, Douglas et al. 1996 §3.1),
+      ``'<output>_sensor:rate'`` → ``F¹`` only (kind ``'sensor:magnitude'`` / ``'sensor:rate'``);
+    * ``'<control>_actuator'`` → :func:`actuator_fault_map`, the column of ``Bu`` (``'actuator'``);
+    * a fault input of the model (group ``f``) by its own name → its ``Bf`` column when ``Df`` is
+      zero (``'fault input'``), the sensor map of output ``i`` when it is a pure sensor fault
+      (``Df = e_i``, ``Bf = 0``).
+
+    A bare signal name (``'theta'``, ``'throttle'``) raises :class:`ParameterError` naming the fault.
+    """
+    kind, base, suffix = split_fault_name(model, name)
     if kind == "fault":
         j = model.index("f", base)[0]
         df, bf = model.Df[:, j], model.Bf[:, j]
@@ -270,12 +345,10 @@ def resolve_fault(model: FaultModel, name: str) -> tuple[np.ndarray, str]:
         if np.any(bf) or np.count_nonzero(df) != 1 or df[i] != 1.0:
             raise DesignError(f"fault {base!r} reaches the outputs directly and is not a pure sensor fault; "
                               "pass its state-space fault map in a dict")
-        base, kind = model.outputs[i], "output"
-    if kind == "output":
+        base, kind = model.outputs[i], "sensor"
+    if kind == "sensor":
         direction = suffix or "both"
         return sensor_fault_map(model, base, direction), "sensor" if direction == "both" else f"sensor:{suffix}"
-    if suffix:
-        raise ModelError(f"{name!r}: the ':{suffix}' suffix applies to sensor faults only, {base!r} is a control")
     return actuator_fault_map(model, base), "actuator"
 
 
@@ -464,14 +537,16 @@ def mutually_detectable(
     return not extra and not left, joint, union
 
 
-def resolve_faults(model: FaultModel, faults: Mapping[str, np.ndarray] | Sequence[str]) -> dict[str, np.ndarray]:
-    """Fault maps by name.
+def resolve_faults(model: FaultModel, faults: Mapping[str, np.ndarray] | Sequence[str] | str) -> dict[str, np.ndarray]:
+    """Fault maps by fault name.
 
-    A mapping gives explicit ``F`` matrices (n x k).  A sequence is resolved by
-    :func:`fdikit.linalg.resolve_fault`: an output name means the sensor fault ``[F¹, A F¹]``
-    (named ``<output>_sensor``), ``'<output>:magnitude'`` its bias direction ``A F¹`` only
-    (Douglas et al. 1996 §4.1, the air-mass fix), a control name the actuator fault
-    ``B[:, j]`` (named ``<control>_actuator``), a fault input of the model its own map.
+    A mapping gives explicit ``F`` matrices (n x k) under its keys.  A name or a sequence of
+    names is resolved by :func:`fdikit.linalg.resolve_fault`: ``'<output>_sensor'`` is the sensor
+    fault ``[F¹, A F¹]``, ``'<output>_sensor:magnitude'`` its bias direction ``A F¹`` only
+    (Douglas et al. 1996 §4.1, the air-mass fix), ``'<control>_actuator'`` the actuator fault
+    ``B[:, j]``, a fault input of the model (group ``f``) its own map.  The keys are the names
+    without the suffix.  A bare signal name (``'theta'``) raises :class:`ParameterError` whose
+    message gives the fault name (``'theta_sensor'``).
     """
     validate.instance("model", model, FaultModel)
     if isinstance(faults, str):
@@ -488,16 +563,27 @@ def resolve_faults(model: FaultModel, faults: Mapping[str, np.ndarray] | Sequenc
         return out
     out = {}
     for spec in faults:
-        F, kind = resolve_fault(model, str(spec))
-        base = str(spec).partition(":")[0]
-        if base in model.faults:
-            name = base
-        elif kind.startswith("sensor"):
-            name = sensor_fault_name(base)
-        else:
-            name = actuator_fault_name(base)
-        out[name] = F
+        F, _ = resolve_fault(model, spec)
+        out[spec.partition(":")[0]] = F
     return out
+
+
+def resolve_nuisance(
+    model: FaultModel, nuisance: Mapping[str, np.ndarray] | Sequence[str] | str, targets: Sequence[str] = ()
+) -> dict[str, np.ndarray]:
+    """Fault maps of the faults a design must ignore (the ``nuisance=`` convention).
+
+    ``()`` (or an empty mapping) means none; the string ``'others'`` means every fault input of the
+    model (group ``f``) not named in ``targets``; anything else is resolved by :func:`resolve_faults`.
+    """
+    if nuisance is None:
+        raise ParameterError("nuisance=None is not a fault set; use () for none or 'others' for every other fault")
+    if isinstance(nuisance, str) and nuisance == "others":
+        given = {str(t).partition(":")[0] for t in targets}
+        return {f: resolve_fault(model, f)[0] for f in model.faults if f not in given}
+    if isinstance(nuisance, Mapping) or len(nuisance):
+        return resolve_faults(model, nuisance)
+    return {}
 
 
 def output_projector(C: np.ndarray, W: np.ndarray, rtol: float | None = None) -> np.ndarray:

@@ -9,7 +9,7 @@ Over a horizon ``s`` the outputs of a discrete model obey the parity relation (7
 
 with the stacked observability matrix and the block-Toeplitz input maps.  The paper's
 (7)–(8) print wrong time indices (s−1 factors in the last row of ``H_os``, ``D(ρ_k)`` and
-``B(ρ_k)`` on every block); the exact time-varying forms used here are (research note M6)::
+``B(ρ_k)`` on every block); the exact time-varying forms used here, obtained by iterating (6), are::
 
     Φ(i, j)        = A(ρ_{k+i−1}) ··· A(ρ_{k+j}),   Φ(j, j) = I
     [H_os]_i       = C(ρ_{k+i}) Φ(i, 0)
@@ -330,7 +330,8 @@ class Uncertainty:
 
     ``A`` and ``C`` are constant matrices or mappings power -> coefficient of ``ρ^power``;
     ``n`` and ``p`` are the model's sizes (checked against the LPV model when stacking).
-    As in (5), ``B`` and ``D`` are certain; δ is taken constant over the window (note G22).
+    As in (5), ``B`` and ``D`` are certain; δ is taken constant over the window, as (14) does (its ``ζ_k`` is built
+    from ``δ_k`` alone).
     """
 
     A: np.ndarray
@@ -361,7 +362,7 @@ class UncertainStack:
     ``nominal`` holds ``H_os, H_us, …`` at δ = 0; ``tilde[kind][e]`` is the coefficient of the
     monomial ``δ^e`` (``e`` an exponent tuple, total degree ≥ 1) in the stacked ``kind``
     map, ``kind`` in ``"os"`` and the input groups ``"u", "d", "f", "w"``.  Printed (14) has
-    ``H̃_ds U_s``; it is ``H̃_ds U_ds`` (typo, note G17).
+    ``H̃_ds U_s``; it is ``H̃_ds U_ds`` (typo: ``H̃_ds`` multiplies the unknown inputs, as ``H_ds`` does).
     """
 
     nominal: StackedMatrices

@@ -20,14 +20,14 @@ The **pre-filter** variant (Sec. 3-2, (3.7)–(3.8)) regresses on ``Ẽ = G(q)[E
 makes the estimate exact for constant faults once the transients of ``G`` have died out
 (Cor. 3-2.2; the convergence is exponential, not finite-time, unless ``G`` is deadbeat).
 
-Conventions and errata applied (research note §3.3, §8):
+Conventions and errata applied (van der Ploeg 2018, Def. 3-1.1, (2.7), (4.6), Sec. 4-1):
 
 * Def. 3-1.1 prints the regressor columns as ``[E, 1]`` but (3.4) and the proofs (A.1)–(A.2) read
   the result as ``[f̂_a; f̂_m]``; fdikit uses ``[1, E]`` so the output is ``(f̂_a, f̂_m)``.
 * The residual of the case study carries ``(f_m − 1) δ_set`` (4.6); ``f̂_m = nominal_gain + slope``
   with ``nominal_gain = 1``.  Pass ``nominal_gain=0`` for the generic (2.7) form
   ``r = G[f_a + f_m E]``.
-* Guard (Sec. 4-1, checklist 14): a window with ``V_n[E] ≈ 0`` (no excitation) has an unbounded
+* Guard (Sec. 4-1): a window with ``V_n[E] ≈ 0`` (no excitation) has an unbounded
   error bound; it is flagged invalid and its estimates are NaN (never an exception).  So are the
   first ``n − 1`` samples and every window holding a non-finite value.
 
@@ -71,7 +71,8 @@ def lateral_fault_map(pole: float = 0.9048, zero: float = -0.97294, dt: float = 
 
     van der Ploeg (2018), (4.10) with the triple pole of Sec. 4-3-1; ``K = (1 − p)^3/(1 − z_0)``
     makes the DC gain 1 (Lemma 2-1.2, (2.8b)).  The zero ``z_0 = −0.97294`` is that of ``N(q)F`` for
-    the Table 4-1 vehicle at 70 km/h (research note §5.2; derived, not printed in the thesis).
+    the Table 4-1 vehicle at 70 km/h (computed from the Sec. 4-3-1 filter, not printed in the thesis;
+    ``tests/studies/vanderploeg2018`` recompute it).
     Poles used in the thesis: 0.9048, 0.6065, 0.3679 (``e^{-10h}, e^{-50h}, e^{-100h}``).
 
     Examples
@@ -148,7 +149,8 @@ class SteeringFaultEstimate:
     regressor : (N,) the regressor signal used: ``E`` or the pre-filtered ``Ẽ = G(q)[E]``.
     mean, variance : (N,) ``μ_n`` and ``V_n`` of the regressor over each window (NaN before the first full window).
     excitation_factor : (N,) ``sqrt((max(1, σ_n²) + |μ_n|)/(n V_n))``, the bound of Lemma A-1.1 on
-        ``‖Φ_n‖_2`` with the ``max(1, σ²)`` correction (erratum, note §8 item 14); measurable online, it is
+        ``‖Φ_n‖_2`` with the ``max(1, σ²)`` correction (erratum: see :mod:`fdikit.estimate.steering_bound`);
+        measurable online, it is
         the excitation monitor (6.1).  inf where ``V_n = 0``.
     n : window length.
     nominal_gain : the healthy gain (1 in the thesis convention).

@@ -7,7 +7,7 @@ The bounds compare the moving-window estimates with the window means of the true
 and therefore need the true faults: they are analysis tools for simulation (Sec. 4-3-2, 4-3-3).
 ``κ_n`` bounds the induced norm of the regression operator ``Φ_n`` (Lemma A-1.1).
 
-Errata applied (research note §3.7, §8 items 14–17), each checked against the proofs in App. A:
+Errata applied, each checked against the proofs in App. A (and numerically by ``tests/test_estimate_steering.py``):
 
 * **Lemma A-1.1.** ``‖Φ_n‖_2² = ((1+σ²) + sqrt((1−σ²)² + 4μ²)) / (2 n V)``; the printed bound
   ``(1 + |μ|)/(n V)`` drops ``|1 − σ²|`` and holds only for ``σ_n² ≤ 1``.  fdikit uses

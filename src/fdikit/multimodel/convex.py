@@ -165,7 +165,8 @@ def limit_value_convex_set(lv, Q, R) -> ConvexModelSet:
 
     ``lv`` is a :class:`~fdikit.multimodel.model_set.LimitValueModelSet`.  Each weight ``μ_j ∈ [0, 1]`` scales
     its change ``M^Δ_j``; there is no sum constraint (filter with ``constrain="box"``), and the Jacobian
-    columns of the augmented EKF are ``A^Δ_j x + B^Δ_j u`` and ``C^Δ_j x + D^Δ_j u`` (research note §2.6).
+    columns of the augmented EKF are ``A^Δ_j x + B^Δ_j u`` and ``C^Δ_j x + D^Δ_j u`` (the derivatives of the
+    blended model with respect to ``μ_j``).
 
     Example
     -------
@@ -192,7 +193,8 @@ def weight_regressors(models: ConvexModelSet, x_prev, u_prev, x_filt, u, y, weig
     Rows ``[W_Q [A^(i) x̂_{k−1|k−1} + B^(i) u_{k−1}]_i ; W_R [C^(i) x̂_{k|k} + D^(i) u_k]_i]`` and
     ``[W_Q x̂_{k|k} ; W_R y_k]``.  ``weighting="whitened"`` (default) uses ``W = Q^{-1/2}, R^{-1/2}``, for
     which ``‖Φμ − Γ‖²`` is the cost (2.27); ``"inverse"`` uses ``Q^{-1}, R^{-1}`` as printed in (2.33)
-    (research note §2.5: the printed form likely lost the "/2").
+    (with ``Q^{-1}`` the squared norm weights by ``Q^{-2}``, not the ``Q^{-1}`` of (2.27), so the
+    printed form appears to have lost the exponent ½).
     """
     if weighting not in ("whitened", "inverse"):
         raise ModelError(f"weighting must be 'whitened' (Q^-1/2, R^-1/2) or 'inverse' (Q^-1, R^-1), got {weighting!r}")
@@ -215,7 +217,8 @@ def rls_weight_step(T_prev, xi_prev, Phi, Gamma, lam: float):
     """Square-root-information RLS step with forgetting (Hallouzi 2008, (2.35)–(2.36)).
 
     ``[[T_k, ξ_k], [0, ε_k]] = U_3 [[√λ T_{k−1}, √λ ξ_{k−1}], [Φ, Γ]]`` (QR), ``μ̂_k = T_k^{-1} ξ_k``.
-    After k steps ``μ̂_k`` minimises ``λ^k‖T_0μ − ξ_0‖² + Σ_j λ^{k−j} ‖Φ_j μ − Γ_j‖²`` (checklist item 3).
+    After k steps ``μ̂_k`` minimises ``λ^k‖T_0μ − ξ_0‖² + Σ_j λ^{k−j} ‖Φ_j μ − Γ_j‖²`` (checked against batch
+    weighted least squares in ``tests/multimodel/test_convex.py``).
 
     Returns ``(T_k, ξ_k, μ̂_k)``.
 

@@ -8,7 +8,8 @@ estimated jointly with the state on ``z = [x; μ]`` (2.40)–(2.41):
 The Jacobians (2.52)–(2.53) are ``Ā = [[A_μ, [A^(i)x + B^(i)u]_i], [0, I]]`` and
 ``C̄ = [C_μ, [C^(i)x + D^(i)u]_i]``, where a matrix shared by all models is a constant (zero derivative;
 see :class:`~fdikit.multimodel.convex.ConvexModelSet`).  When only B (and D) vary the model is linear
-in z, and the EKF is exactly a linear Kalman filter on ``[x; μ]`` (§2.4.2; checklist item 4).  The weight
+in z, and the EKF is exactly a linear Kalman filter on ``[x; μ]`` (§2.3.3; checked in
+``tests/multimodel/test_convex.py``).  The weight
 part is projected on the simplex after each update "in the same manner as the dual CMF"; P is left
 unchanged (a thesis gap).
 """

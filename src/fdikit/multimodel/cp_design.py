@@ -110,7 +110,7 @@ def cp_model_set(models, rank: int | None = None, min_gap: float = 10.0, n_verti
     (or ``rank``), reduced coordinates ``M̄_ℓ = Σ¹V¹ᵀ``; vertices mapped back by ``U¹ v``.
 
     The thesis minimises ``J_CP`` (3.29) subject to enclosure (3.30) with Kanev's (2006) non-convex
-    QCQP, which it does not give.  Substitute (research note §2.10 [GAP]): work in the affine hull of
+    QCQP, which it does not give.  Substitute (an fdikit construction, not from the thesis): work in the affine hull of
     ``M̄_ℓ`` (dimension ``d``; models that contain constant entries such as ``I + T A`` lie in a proper
     affine subspace, ``d = n_g − 1``), pick ``d + 1`` well-separated samples by pivoted QR of the
     homogeneous coordinates ``[M̄; 1]``, and replace this base simplex by the tightest simplex with

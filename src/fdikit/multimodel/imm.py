@@ -6,9 +6,11 @@ Hallouzi 2008, §2.3.1, Table 2.1 (after Li & Jilkov 2005), for the JMLS (2.3)�
     y_k     = C^(s_k) x_k + D^(s_k) u_k + v_k,   v_k ~ N(0, R^(s_k))
     Π_ij    = P(s_{k+1} = j | s_k = i)          (row-stochastic)
 
-with the OCR corrections of the research note (§2.4, §5.2 item 1): the mixing covariance uses
-``P^(i)`` (printed ``P^(j)``) and the residual covariance is ``Σ = C P_{k|k−1} Cᵀ + R`` (printed
-without ``P_{k|k−1}``).  Noise means are zero (they are zero in every example of the thesis).
+with two corrections to the printed table: the mixing covariance sums the mixed models' own
+``P^(i)`` (printed ``P^(j)``, which would not depend on ``i``), and the residual covariance is
+``Σ = C P_{k|k−1} Cᵀ + R`` (printed ``C Cᵀ + R``; only with ``P_{k|k−1}`` is it the innovation
+covariance that the gain ``K = P Cᵀ Σ⁻¹`` and the likelihood (2.12) need).  Noise means are zero (they are zero in
+every example of the thesis).
 
 The mode probabilities are propagated **in log space** (log-sum-exp in the Π prediction and in
 the Bayes update) so that they neither underflow nor give 0/0 when every likelihood (2.12) is
@@ -95,7 +97,7 @@ class IMMFilter:
     x0, P0 : prior state mean and covariance of the first sample, shared ``(n,)``/``(n, n)``
         or per mode ``(M, n)``/``(M, n, n)`` (default zero and identity).
     nominal : index of the nominal (fault-free) mode, for the diagnosis.
-    min_probability : floor on the predicted probabilities ``μ_{k|k−1}`` (research note §2.4: a Π
+    min_probability : floor on the predicted probabilities ``μ_{k|k−1}`` (a Π
         with zeros can lock a mode out); 0 disables it.
 
     Example
@@ -269,7 +271,7 @@ class IMMStepper:
         xp, Pp = self.x_pred, self.P_pred
         ok = bool(np.all(np.isfinite(y)))
         if ok:
-            # step 2 (measurement update) with Σ = C P_{k|k-1} Cᵀ + R  [Table 2.1 OCR drops P_{k|k-1}]
+            # step 2 (measurement update) with Σ = C P_{k|k-1} Cᵀ + R  [Table 2.1 prints C Cᵀ + R]
             PCt = Pp @ self._Ct                                        # (M, n, p)
             S = self._C @ PCt + self._R
             S = 0.5 * (S + S.transpose(0, 2, 1))
@@ -303,7 +305,7 @@ class IMMStepper:
         Wm = np.where(reach[None, :], np.exp(G - np.where(reach, lp, 0.0)[None, :]), mu[:, None])  # μ^{i|j}
         xbar = Wm.T @ xf                                               # (j, n)
         dd = xf[None, :, :] - xbar[:, None, :]                         # (j, i, n)
-        Pbar = (Wm.T @ Pf.reshape(len(mu), -1)).reshape(Pf.shape)     # Σ_i μ^{i|j} P^(i)  [OCR: P^(j)]
+        Pbar = (Wm.T @ Pf.reshape(len(mu), -1)).reshape(Pf.shape)     # Σ_i μ^{i|j} P^(i)  [Table 2.1 prints P^(j)]
         Pbar += (dd.transpose(0, 2, 1) * Wm.T[:, None, :]) @ dd        # + Σ_i μ^{i|j} (x̄ − x̂^(i))(x̄ − x̂^(i))ᵀ
         if self._logfloor > -np.inf:
             lp = np.maximum(lp, self._logfloor)

@@ -11,7 +11,7 @@ with ``T_f = 0.2``, the groups rudder {1, 2}, elevator {3, 5, 6}, aileron {4, 7}
 (Table 4.5) and model 8 the nominal model.  The table caption says "F_0, …, F_4" but only
 F_0 … F_3 exist (thesis slip).
 
-The thesis leaves two points open (research note §2.12 [GAP]); the choices made here:
+Table 4.7 leaves two points open; the choices made here:
 
 * several F_g true at once → the group with the largest weight sum is isolated (first group on an
   exact tie);
@@ -46,8 +46,8 @@ class GroupThresholdLogic:
     threshold : the fault threshold ``T_f`` (Table 4.7: 0.2).
     latch : keep the first isolated fault for the rest of a run.
     tol : comparisons are made as ``≥ T_f − tol`` / ``< T_f − tol`` so that decimal boundary cases
-        come out as written: in doubles ``1 − 0.8 = 0.19999999999999996 < 0.2``, yet Table 4.7
-        (note §4.1 item 16) wants μ^(8) = 0.8 to be *not* nominal.
+        come out as written: in doubles ``1 − 0.8 = 0.19999999999999996 < 0.2``, yet in exact arithmetic
+        ``|1 − 0.8| = 0.2`` is not ``< T_f``, so Table 4.7 makes μ^(8) = 0.8 *not* nominal.
 
     Example
     -------

@@ -134,7 +134,7 @@ def taylor_remainder_bound(A, dt: float, order: int = 1) -> float:
 def gap_rank(values, min_gap: float = 10.0) -> int:
     """Numerical rank as the position of the largest gap in non-increasing values (σ or |diag R|).
 
-    Hallouzi 2008, §3.3.2 picks "the first significant gap" by eye (research note §5.1 [GAP]).
+    Hallouzi 2008, §3.3.2 asks for "the first significant gap" without a rule for it.
     Here: values at or below ``max · len · eps`` count as zero (the rank is then at most the number
     of nonzero values); the rank is the index of the largest ratio ``v_i / v_{i+1}`` if that ratio is
     at least ``min_gap``, else all values count.
@@ -508,7 +508,8 @@ def pair_observability(first, second, C, states, weights, u) -> float:
     """Mean condition number (3.9) of the observability matrix of a 2-model MM along a state realization.
 
     The MM is ``x⁺ = μ (A₁x + B₁u) + (1 − μ)(A₂x + B₂u)``, ``y = C x``, with the weight appended to the state as a
-    constant (``z = [x; μ]``, one free weight: research note §5 [GAP]); ``first``, ``second`` are ``(A, B)``;
+    constant (``z = [x; μ]``, one free weight; the thesis does not say how the weights enter (3.8)); ``first``,
+    ``second`` are ``(A, B)``;
     ``states`` (K, n) and ``weights`` (K,) are the points ``(x_k, μ_k)`` where the matrix is evaluated; the
     input ``u`` (m,) is held constant over the ``n`` steps of (3.8).  Used for Example 3.1 and Table 3.4.
     """

@@ -24,7 +24,8 @@ def project_to_simplex(mu, ordering: str = "michelot") -> np.ndarray:
     Equality projection ``μ^c = μ̂ − 1(1ᵀμ̂ − 1)/N`` then an active-set loop fixing negative weights at 0.
     ``ordering="michelot"`` (default) checks the signs *after* each equality projection (Michelot 1986): the
     result is the Euclidean projection on the simplex.  ``"thesis"`` first zeroes the negatives of the
-    unconstrained μ̂, as §2.3.2 words it; it can differ when ``1ᵀμ̂ < 1`` (research note §2.5).
+    unconstrained μ̂, as §2.3.2 words it; it can differ when ``1ᵀμ̂ < 1`` (``tests/multimodel/test_convex.py``
+    shows a case).
 
     Example
     -------
@@ -139,7 +140,7 @@ def _weights(mu) -> np.ndarray:
 
 
 def constrain_weights(mu, constrain, W=None, ordering: str = "michelot") -> np.ndarray:
-    """Apply a weight constraint of the convex-model filters (Hallouzi 2008, (2.37)–(2.38), §2.6 of the note).
+    """Apply a weight constraint of the convex-model filters (Hallouzi 2008, §2.3.2, (2.37)–(2.38)).
 
     ``constrain``: ``True`` or ``"simplex"`` (μ ≥ 0, 1ᵀμ = 1; with ``W`` the weighted projection, else the
     Euclidean one with the given ``ordering``), ``"affine"`` (1ᵀμ = 1 only, for OD sets), ``"box"``

@@ -4,7 +4,7 @@ Operating point: altitude 600 m, 133.8 m/s.  States ``x = [q, V_TAS, α, θ, h]`
 angle; the thesis calls it "roll angle"), inputs ``[δ_c, δ_s, T_n1 … T_n4]`` (column and stabiliser
 deflection [rad], engine thrust [N]), outputs ``q, V_TAS, α, h``.
 
-Erratum (research note §3.1): the printed ``A(3, 5) = 6.83e-1`` gives a 9.6 rad/s short period;
+Erratum (Hallouzi 2008, (2.56)): the printed ``A(3, 5) = 6.83e-1`` gives a 9.6 rad/s short period;
 ``6.83e-7`` (exponent misread) gives the plausible modes −0.634 ± 1.154j (short period),
 −0.00234 ± 0.0929j (phugoid) and +0.00065 (height mode).  ``a35="corrected"`` (default) uses 6.83e-7,
 ``a35="printed"`` the printed value.
@@ -41,7 +41,7 @@ _CONTROLS = ("delta_c", "delta_s", "T_n1", "T_n2", "T_n3", "T_n4")
 #: Table 2.5, in model order.
 B747_MODEL_NAMES = ("nominal", "delta_c_loss", "delta_s_loss", "V_TAS_sensor", "alpha_sensor")
 #: Table 2.6: (first sample, last sample, true convex weights over the 5 models); T_s = 0.01 s.
-#: The 4th interval is missing in the seed; 800–900 by the pattern (research note §3.1, [OCR]).
+#: The 4th interval (20 % V_TAS-sensor fault) has no samples in Table 2.6 as printed; 800–900 by the pattern.
 B747_FAULT_SCHEDULE: tuple[tuple[int, int, tuple[float, ...]], ...] = (
     (200, 300, (0.7, 0.0, 0.0, 0.0, 0.3)),
     (400, 500, (0.6, 0.0, 0.4, 0.0, 0.0)),
@@ -92,10 +92,20 @@ def b747_longitudinal(model: str = "nominal", a35: str = "corrected", dt: float 
     dt : float, optional
         ZOH sample time (the thesis uses 0.01 s); continuous if ``None``.
 
+    Returns
+    -------
+    FaultModel
+        5 states ``q, V_TAS, alpha, theta, h``, 6 controls ``delta_c, delta_s, T_n1 … T_n4``, 4 outputs
+        ``q, V_TAS, alpha, h``; the fault of ``model`` is built into ``Bu`` or ``C`` (no fault inputs).
+
     Raises
     ------
-    ModelError
-        On an unknown model name or ``a35``.
+    ParameterError
+        On an unknown model name or ``a35``, or a ``dt`` that is not positive.
+
+    References
+    ----------
+    Hallouzi 2008, §2.4.1, (2.54)–(2.61), Table 2.5.
 
     Examples
     --------
@@ -121,7 +131,35 @@ def b747_longitudinal(model: str = "nominal", a35: str = "corrected", dt: float 
 
 
 def b747_model_set(a35: str = "corrected", dt: float | None = 0.01) -> tuple[FaultModel, ...]:
-    """The five models of Table 2.5 in order (ZOH at ``dt = 0.01`` s by default, §2.4.1)."""
+    """The five models of Table 2.5 in order (ZOH at ``dt = 0.01`` s by default, §2.4.1).
+
+    Parameters
+    ----------
+    a35 : {"corrected", "printed"}
+        Value of ``A(3, 5)`` (see the module erratum).
+    dt : float or None, default 0.01
+        ZOH sample time [s]; ``None`` gives the continuous models.
+
+    Returns
+    -------
+    tuple of FaultModel
+        The models of :data:`B747_MODEL_NAMES`, in that order, built by :func:`b747_longitudinal`.
+
+    Raises
+    ------
+    ParameterError
+        On an unknown ``a35`` or a ``dt`` that is not positive.
+
+    References
+    ----------
+    Hallouzi 2008, §2.4.1, Table 2.5.
+
+    Examples
+    --------
+    >>> models = b747_model_set()
+    >>> len(models), models[0].dt
+    (5, 0.01)
+    """
     if dt is not None:
         dt = validate.positive("dt", dt)
     return tuple(b747_longitudinal(name, a35=a35, dt=dt) for name in B747_MODEL_NAMES)

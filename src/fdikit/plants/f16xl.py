@@ -3,12 +3,12 @@
 :func:`f16xl_longitudinal` is Murray 2012, §6.1 (Example 1, from Chen & Speyer 2002):
 four states, every state measured (``C = I``), the elevon as control and the wind gust
 as a disturbance.  The numbers are as printed; two consistency checks pin them (the gust
-column equals column 2 of ``A``, and ``−A e_4`` is the printed magnitude column of
-``F_θ``; Murray note §8.1).
+column equals column 2 of ``A``, checked in ``tests/plants/test_f16xl.py``, and ``−A e_4`` is
+the printed magnitude column of ``F_θ``).
 
 :func:`f16xl_gust` is the five-state version of Douglas et al. 1996, App. C.5 (the H∞
 detection-filter example): the same airframe with a Dryden gust state and the sensors
-q, α, A_z, A_x; its OCR-damaged data are reconstructed as documented there.
+q, α, A_z, A_x; its damaged printed data are reconstructed as documented there.
 """
 
 from __future__ import annotations
@@ -45,6 +45,10 @@ def f16xl_longitudinal() -> FaultModel:
         the example are named by :func:`fdikit.design.resolve_faults`: ``'y_theta'`` (the
         pitch-angle sensor, ``[e_4, A e_4]``), ``'elevon'`` (``F_δ = B_δ``) and the gust as a
         fault map ``{'gust': model.Bd}``.
+
+    References
+    ----------
+    Murray 2012, §6.1 (Example 1).
 
     Examples
     --------
@@ -89,7 +93,8 @@ def f16xl_gust(
     ``'y_Az'`` (the normal accelerometer, ``[F¹, A F¹]`` with ``C F¹ = e_3``) and ``'elevon'``
     (``F_δ = B_δ``).  ``A[:4, :4]`` and ``B_δ[:4]`` are Murray's §6.1 model (:data:`F16XL_A`).
 
-    The printed data (L4918–4939) are OCR-damaged; the reconstruction (research note §3.6):
+    The printed data (Douglas et al. 1996, App. C.5) are damaged in the transcription; the
+    reconstruction:
 
     * ``A(1,5) = 0.0430`` (printed "0.04 130"): the gust column equals the ``w`` column in rows
       1–3, as ``w_g`` enters like ``w`` (and as Murray's gust input is column 2 of ``A``).
@@ -105,6 +110,32 @@ def f16xl_gust(
       pole scales like 1/d_q).  ``D Dᵀ`` must be invertible, so ``d_q > 0``.
     * ``B_ω(5)`` = ``gust_gain``: printed 1.57; :data:`F16XL_DRYDEN_GAIN` (1.5459) is the
       alternative that makes the printed γ = 1.2 feasible.
+
+    Parameters
+    ----------
+    gust_gain : float, default 1.57
+        ``B_ω(5)``, the gain from the unit-PSD ``wind`` noise to the gust state [ft/s per unit noise];
+        1.57 as printed, :data:`F16XL_DRYDEN_GAIN` for a unit gust variance.
+    pitch_rate_noise : float, default 0.01
+        ``d_q = D(1,1)``, the pitch-rate sensor noise gain [deg/s]; finite and ``>= 0`` (``> 0`` for
+        designs that need ``D Dᵀ`` invertible).
+    az_w_coefficient : float, default -1.0517
+        ``C(3,2)``, the ``w`` entry of the normal-acceleration output row.
+
+    Returns
+    -------
+    FaultModel
+        Continuous model with 5 states, 4 outputs, the control ``elevon`` and 5 noise inputs
+        ``wind, nu_q, nu_alpha, nu_Az, nu_Ax`` (no disturbance or fault inputs).
+
+    Raises
+    ------
+    ParameterError
+        If a coefficient is not a finite number, or ``pitch_rate_noise`` is negative or not finite.
+
+    References
+    ----------
+    Douglas et al. 1996, App. C.5; Murray 2012, §6.1 (the airframe ``A[:4, :4]``, ``B_δ``).
 
     Examples
     --------

@@ -6,7 +6,7 @@ States ``x = [x1, x2, x3, v1, v2, v3]`` (positions, velocities), controls ``u1``
 actuator 1) and ``f2`` (gain of sensor 2), both in ``[0, 1]`` with 1 = healthy.  Fixed (3.43):
 ``m1 = m2 = 1``, ``b1 = … = b4 = 0.01``, ``k2 = 0.15``, ``k3 = 1``, ``k4 = 0.2``.
 
-Erratum applied (research note §3.5, seed §3.6.1): the printed (3.41) has ``m2`` in row 4 and
+Erratum applied (Hallouzi 2008, §3.6.1): the printed (3.41) has ``m2`` in row 4 and
 merges rows 5 and 6, and (3.42) prints ``1/m2`` for input 2.  The rows used here follow the
 topology implied by the LV matrices (3.46)–(3.49) and relation (3.55): spring/damper 1 between
 m1 and m2, 2 from m2 to ground, 3 between m1 and m3, 4 between m2 and m3; input 2 acts on m3.
@@ -139,7 +139,7 @@ def msd(k1: float = 1.0, m3: float = 1.0, f1: float = 1.0, f2: float = 1.0, dt: 
 def msd_parameter_grid(k1_values=None, m3_values=None, fault_values=None) -> np.ndarray:
     """Parameter tuples ``(k1, m3, f1, f2)`` of the large model set of §3.6.1 (single faults only).
 
-    The thesis does not give the grids (research note §5.1 [GAP]); the defaults are
+    The thesis does not give the grids; the defaults (an fdikit choice) are
     ``k1 ∈ 0.25:0.125:1.75`` (13), ``m3 ∈ linspace(0.2, 1.8, 13)`` and fault levels
     ``{0, 0.1, …, 1}``.  The (k1, m3) grid is crossed with ``f1 ∈ fault_values, f2 = 1`` and with
     ``f1 = 1, f2 ∈ fault_values \\ {1}`` (each healthy model appears once).

@@ -2,15 +2,15 @@
 
 The nonlinear PATH vehicle linearised on a straight road at 25 m/s and reduced (spectral
 separation + balanced realisation) to 7 states, 7 outputs and 2 inputs (throttle deg, brake
-torque N·m); the states are balanced coordinates without physical meaning (report §9.6,
-(9.84)–(9.87), data at L3953–4077 of the seed text)::
+torque N·m); the states are balanced coordinates without physical meaning (Douglas et al. 1996,
+§9.6, (9.84)–(9.89))::
 
     x' = A x + F̂ μ̂,        y = C x + v
 
 Only ``A``, ``C`` and the two sensor-fault maps are printed; ``B`` and ``D`` are not ("for
 simplicity, the inputs u will be disregarded"), so the model has **no controls**.
 
-Two corrections to the printed data (PATH research note §6.2), both derived from the printed
+Two corrections to the printed data (Douglas et al. 1996, §9.6, (9.86)–(9.89)), both derived from the printed
 fault maps ``F = [f, A f]`` (9.88)–(9.89), which are internally consistent:
 
 1. **A(2,3) = +19.0734** (printed −19.0734).  With the printed sign ``A f − F(:, 2)`` has a
@@ -29,14 +29,16 @@ fault maps ``F = [f, A f]`` (9.88)–(9.89), which are internally consistent:
    only if the design's C had the ẍ row third.  So :data:`PATH7_C` is the printed C with rows
    1 and 3 exchanged; with it ``C f_ω ≈ e_2`` and ``C f_ẍ ≈ e_3`` to 1.3e−3.
 
-Outputs, in the order of (9.84) (whose OCR shows "heave acceleration" twice; the symbol list
+Outputs, in the order of (9.84) (whose text as transcribed shows "heave acceleration" twice; the symbol list
 gives ``y_m, y_ω, y_ẍ, y_z̈, y_θ̇, y_ωfs, y_ωrs``): ``air_mass`` (kg), ``engine_speed``
 (rad/s), ``accel_x`` (longitudinal, m/s²), ``accel_z`` (heave, m/s²), ``pitch_rate`` (rad/s),
 ``wheel_speed_front`` and ``wheel_speed_rear`` (symmetric wheel speeds, rad/s).
 
 C has condition number ≈ 706 and 4-decimal entries, so quantities that invert it (the
 projector of (9.90), the Riccati solutions) are sensitive to the rounding: the printed
-projector, Π (9.91), S (9.44) and Γ (9.93) are not reproducible from these data (note §6.2).
+projector, Π (9.91), S (9.44) and Γ (9.93) are not reproducible from these data (recomputing them from the printed
+A, C differs
+beyond the printed digits).
 """
 
 from __future__ import annotations

@@ -16,14 +16,13 @@ Both have 12 measured outputs and 3 controls::
 
 Provenance
 ----------
-The matrices are **reconstructed** from an OCR'd copy of the report.  The printed data
+The matrices are **reconstructed** from a text transcription of App. D of the report.  The printed data
 are MATLAB ``format bank`` listings: every entry is **rounded to 2 decimals**, exact
 zeros print as ``0`` and tiny nonzero entries as ``0.00`` / ``-0.00`` (stored here as 0).
 The true matrices are therefore only known to ±0.005 per printed entry;
 :func:`rounding_intervals` gives those intervals.  Eigenvalues of the rounded data
 agree with the report's Table 2.1 only to within the effect of that rounding, and the
-rounded data are not accurate enough to re-derive the report's App. E filter gains
-(research note §3.3, §6.3, gap G3).
+rounded data are not accurate enough to re-derive the report's App. E filter gains.
 
 The transcription below follows the 12-state listing (d.2a–d), the cleaner of the two
 copies, and was checked entry by entry against the 14-state listing (d.1a–c).  Choices
@@ -34,8 +33,8 @@ where the seed is garbled or the two listings differ:
    ``0.00``), while the rear-wheel rows print 0.04 / 0.03 in both listings.  Engine speed
    reaches a wheel speed only through driveline torque; a coupling on the rear wheels
    alone is a rear-wheel-drive vehicle, for which the undriven front wheels have an
-   exactly zero coefficient.  (The research note used 0.03 for its own checks; that
-   value is not printed anywhere for the front wheels.)
+   exactly zero coefficient.  (0.03, the rear-wheel value, is not printed anywhere for the
+   front wheels.)
 2. **Lost minus signs in column 8** (``phi_dot``) of the 14-state ``A`` listing (rows
    3, 4, 5, 8, 10, 11 print ``0.00, 1.83, 0.00, 6.05, 0.01, 0.01``): the 12-state signs
    are used (``-0.00, -1.83, -0.00, -6.05, -0.01, -0.01``).  The tab split of that column
@@ -51,7 +50,7 @@ where the seed is garbled or the two listings differ:
    the 12 x 3 zero matrix (the accelerometers see the steering only through the
    ``beta`` state, column 14 of ``C``).
 
-The states are ordered as App. D's matrix structure implies (research note §1.2.7):
+The states are ordered as App. D's matrix structure implies:
 ``A[5, 4] = 1`` (z' = v_z), ``A[6, 7] = 1``, ``A[8, 9] = 1``, actuator diagonals
 −90.91 / −1.25 / −80, and the gyro rows of ``C`` pick phi_dot, theta_dot, eps_dot.
 
@@ -244,7 +243,7 @@ def _with_tiny(m: dict, tiny: str) -> dict[str, np.ndarray]:
     weakly observable", §4.1).  With them at zero ``C`` of the 12-state model has rank 11
     and no sensor fault can be written as a state fault (``C F¹ = e_i`` has no solution);
     the midpoint of each rounding interval (half the last printed digit, with the printed
-    sign) restores full rank.  This is an assumption, not report data (research note G3).
+    sign) restores full rank.  This is an assumption, not report data.
     """
     if not isinstance(tiny, str) or tiny not in ("zero", "midpoint"):
         raise ParameterError(f"tiny must be 'zero' or 'midpoint', got {tiny!r}")
@@ -271,7 +270,7 @@ def path_vehicle_12(tiny: str = "zero") -> FaultModel:
     ``tiny='midpoint'`` restores the entries printed ``±0.00`` as ``±0.0025`` (an
     assumption; needed for sensor-fault detection filters, see :func:`_with_tiny`).
 
-    Data are reconstructed from the OCR'd report and **rounded to 2 decimals** in the
+    Data are reconstructed from the transcribed App. D and **rounded to 2 decimals** in the
     original; see the module docstring for the transcription choices and
     :func:`rounding_intervals` for the uncertainty of each entry.  Eigenvalues:
     Table 2.1 without −90.91 and −80 (:data:`TABLE_2_1_EIGENVALUES_12`), to within the

@@ -22,8 +22,8 @@ printed is the standard, stable bicycle model.
 
 Provenance: (B.8)–(B.11) of the thesis; (B.12) itself is garbled in the seed (``B``
 printed with 5 entries and without ``/I_z``, ``B_d`` missing a zero, ``C`` printed 4 x 4
-with a repeated row).  The matrices above are the reconstruction of research note
-§3.9, which agrees with (B.8)–(B.11): heading error ``psi_e' = V_x kappa - r`` (B.9),
+with a repeated row).  The matrices above are a reconstruction (fdikit's) that agrees with (B.8)–(B.11): heading
+error ``psi_e' = V_x kappa - r`` (B.9),
 lateral error ``y_e' = -V_y + V_x psi_e`` (B.10), bank force ``m g sin(phi)`` in the
 lateral force balance (B.11).  Steering faults ``delta = f_m delta_set + f_a`` enter along
 ``B`` (add them with :meth:`FaultModel.with_actuator_faults`).
@@ -121,7 +121,7 @@ def understeer_gradient(params: SingleTrackParameters = PRIUS_2010) -> float:
 
     ``m_f = m l_r / L`` and ``m_r = m l_f / L`` are the static axle loads (kg).  ``K_u > 0``
     is understeer (stable at every speed; no critical speed).  For :data:`PRIUS_2010`
-    ``K_u = 0.003526`` rad/(m/s²) (research note §5.1; not printed in the thesis).
+    ``K_u = 0.003526`` rad/(m/s²) (computed from Table 4-1; not printed in the thesis).
     """
     if not isinstance(params, SingleTrackParameters):
         raise ParameterError(f"params must be a SingleTrackParameters, got {type(params).__name__}")
@@ -190,7 +190,8 @@ def _speed(speed) -> float:
 
 
 def _continuous_matrices(v, p: SingleTrackParameters) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """``A, B, B_d, C`` of (B.12) (research note §3.9) at speed ``v`` (m/s; a float, or an array for stacks)."""
+    """``A, B, B_d, C`` of (B.12) (reconstructed from (B.8)–(B.11), see the module docstring) at speed ``v`` (m/s;
+    a float, or an array for stacks)."""
     v = np.asarray(v, dtype=float)
     A = np.zeros(v.shape + (4, 4))
     A[..., 0, 0] = (p.C_f + p.C_r) / (p.m * v)

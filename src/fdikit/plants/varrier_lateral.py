@@ -8,13 +8,14 @@ outputs lateral acceleration ``a_y`` and ``r``, (47)::
     a_y = −(c_V + c_H)/m β + (l_H c_H − l_V c_V)/(m v) r + c_V/m u_L
 
 Two typos of the printed (47) are corrected, as (48) and the identity ``a_y = v (β' + r)``
-require (research note M19, G17): the ``r'``-row ``r``-entry carries a minus sign, and the
+require: the ``r'``-row ``r``-entry carries a minus sign, and the
 ``a_y``-row ``r``-entry has ``1/v``, not ``1/v²``.
 
 The discrete model (48) is the forward-Euler ("rectangular") discretisation at ``T_d``,
 ``A₀ = I + T_d A``, ``B₀ = T_d B``, ``C₀ = C``, ``D₀ = D``, polynomial in ``ρ = 1/v`` with
 ``ρ₂ = 1/v² = ρ²`` substituted (§5.1).  ``T_d`` is not printed; 0.02 s follows from "s = 3
-samples (60 ms)" (§5.3, note G1).  Euler is unstable below about 1.3 m/s at 0.02 s (note §4.5).
+samples (60 ms)" (§5.3).  Euler is unstable below about 1.3 m/s at 0.02 s (spectral radius
+of ``A₀`` above 1).
 
 The paper's uncertainty and unknown input (§5.3): ``A₁ = 0.2 A₀(ρ*)``, ``B_d = 0.2 B₀(ρ*)``,
 ``D_d = [0; 2.064]`` with ``ρ* = 1/20.83 = 0.048``; the fault is an additive bias on the
@@ -200,7 +201,7 @@ def varrier_uncertainty(dt: float = T_D, params: VarrierParameters = SCENIC, *, 
     ----------
     mode : ``"literal"`` — ``A₁ = 0.2 A₀(ρ*)`` as printed (it contains ``0.2 I``, a ±20 %
         per-step scaling of the state); ``"continuous"`` — ``A₁ = 0.2 (A₀(ρ*) − I) = 0.2 T_d A(ρ*)``,
-        20 % of the continuous dynamics (research note G4).
+        20 % of the continuous dynamics (an fdikit reading, not the paper's).
     scale : the 20 % of §5.3.
     """
     scale = validate.number("scale", scale)

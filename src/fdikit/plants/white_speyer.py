@@ -2,8 +2,8 @@
 
 An unstable plant (eigenvalues 6.6944, 1.1867, −0.8811) with two outputs and two fault
 directions.  ``F_1 = [1, −0.5, 0.5]ᵀ`` is common to the four cases; ``F_2`` sets the
-invariant-zero structure that the game filter has to cope with (Murray note §8.2.5,
-checked exactly):
+invariant-zero structure that the game filter has to cope with (invariant zeros
+of ``(C, A, F_2)``; ``tests/test_linalg.py`` checks them):
 
 =======================  ================  ==============================================
 case                     ``F_2``            zeros
@@ -39,10 +39,25 @@ def white_speyer(case: str = "stable-zero") -> FaultModel:
     ``A = [[0, 3, 4], [1, 2, 3], [0, 2, 5]]``, ``C = [[0, 1, 0], [0, 0, 1]]``, ``B = 0``;
     ``F_1 = [1, −0.5, 0.5]ᵀ`` and ``F_2`` from :data:`WHITE_SPEYER_CASES`.
 
+    Parameters
+    ----------
+    case : {"stable-zero", "unstable-zero", "stable-extra-zero", "unstable-extra-zero"}, default "stable-zero"
+        Which ``F_2`` of :data:`WHITE_SPEYER_CASES` (Murray 2012, §6.2.1–6.2.4).
+
+    Returns
+    -------
+    FaultModel
+        Continuous model with 3 states ``x1 … x3``, outputs ``y1, y2``, no controls and the fault
+        inputs ``f1``, ``f2`` (columns ``F_1``, ``F_2`` of ``Bf``).
+
     Raises
     ------
-    ModelError
+    ParameterError
         If ``case`` is not one of the four cases.
+
+    References
+    ----------
+    Murray 2012, §6.2 (Example 2), §6.2.1–6.2.4.
 
     Examples
     --------

@@ -48,8 +48,9 @@ from fdikit.design.game.riccati import (
 from fdikit.design.game.setup import GameProblem, game_problem, weight
 from fdikit.design.observers.full_order import observer_generator
 from fdikit.errors import DesignError, ParameterError
-from fdikit.linalg import resolve_faults
+from fdikit.linalg import resolve_nuisance
 from fdikit.model import FaultModel
+from fdikit.protocols import joined_form
 from fdikit.residuals import ResidualGenerator, stack_generators
 
 __all__ = [
@@ -113,11 +114,25 @@ class SingleFaultGameDesign:
     problem: GameProblem
     solver: str
 
+    def internal_form(self) -> FaultModel:
+        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
+
+        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
+        model the design was made for (the model of ``problem``).
+        """
+        return joined_form(self, self.problem.model)
+
+    def report(self) -> dict:
+        """``target``, ``gain`` (``L``), ``poles`` (of ``A − L C``), ``covariance`` (``P``), ``projector`` (``Ĥ``)
+        and ``solver`` (which Riccati solver gave ``P``)."""
+        return {"target": self.target, "gain": self.gain, "poles": self.poles, "covariance": self.covariance,
+                "projector": self.projector, "solver": self.solver}
+
 
 def single_fault_game_filter(
     model: FaultModel,
-    target: str | Mapping[str, np.ndarray],
-    nuisance: Sequence[str] | Mapping[str, np.ndarray] = (),
+    targets: str | Sequence[str] | Mapping[str, np.ndarray],
+    nuisance: Sequence[str] | Mapping[str, np.ndarray] | str = (),
     *,
     gamma: float = 1e-6,
     V=1.0,
@@ -127,8 +142,8 @@ def single_fault_game_filter(
 ) -> SingleFaultGameDesign:
     """Single-fault game-theoretic detection filter, steady state (Murray 2012, (3.29)–(3.30)).
 
-    Solves, in the covariance form ``P = Γ⁻¹`` (Murray note §5.6; the steady state of (3.32)
-    at ``L = P Cᵀ V⁻¹``)::
+    Solves, in the covariance form ``P = Γ⁻¹`` (Murray 2012, §3.3: (3.32) is (3.16) written in
+    ``P_i = Π_i⁻¹``; here its steady state at ``L = P Cᵀ V⁻¹``)::
 
         0 = A P + P Aᵀ + F̂ M F̂ᵀ/γ − P Cᵀ S C P,   S = V⁻¹ − Ĥ Q Ĥ + γ (I − Ĥ) R (I − Ĥ)
         L = P Cᵀ V⁻¹
@@ -149,10 +164,11 @@ def single_fault_game_filter(
     Parameters
     ----------
     model : continuous FaultModel.
-    target : the fault to detect — a name resolved by :func:`fdikit.design.resolve_faults`
-        (output name = sensor fault ``[F¹, A F¹]``, control name = actuator fault, fault input), or
-        a mapping ``{name: F}``.
-    nuisance : faults to block (names or mapping), forming ``F̂``.  May be empty.
+    targets : the one fault to detect — a fault name resolved by :func:`fdikit.linalg.resolve_faults`
+        (``'<output>_sensor'`` = sensor fault ``[F¹, A F¹]``, ``'<control>_actuator'`` = actuator fault,
+        a fault input of the model), a one-element sequence of it, or a mapping ``{name: F}``.
+    nuisance : faults to block (names or mapping), forming ``F̂``: ``()`` (default) none, ``'others'``
+        every other fault input of the model.
     gamma : attenuation bound γ > 0 (small = strong blocking).
     V : Murray's ``V = V̄/γ`` (p x p or scalar), positive definite.
     Q : output weight (p x p or scalar) on ``Ĥ C e``.
@@ -182,7 +198,6 @@ def single_fault_game_filter(
     """
     require_continuous(model)
     g = checked_gamma(gamma)
-    targets = [target] if isinstance(target, str) else target
     prob = game_problem(model, targets, nuisance)
     if len(prob.names) != 1:
         raise DesignError(f"single_fault_game_filter takes one target, got {list(prob.names)}; use game_filter")
@@ -247,11 +262,24 @@ class GameBankDesign:
     def poles(self) -> dict[str, np.ndarray]:
         return {k: d.poles for k, d in self.filters.items()}
 
+    def internal_form(self) -> FaultModel:
+        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
+
+        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
+        model the design was made for (the model of the filters' problems).
+        """
+        return joined_form(self, next(iter(self.filters.values())).problem.model)
+
+    def report(self) -> dict:
+        """By target fault: ``gains``, ``poles`` and ``projectors`` (``Ĥ_i``) of the single-fault filters."""
+        return {"gains": self.gains, "poles": self.poles,
+                "projectors": {k: d.projector for k, d in self.filters.items()}}
+
 
 def game_filter_bank(
     model: FaultModel,
-    faults: Sequence[str] | Mapping[str, np.ndarray],
-    nuisance: Sequence[str] | Mapping[str, np.ndarray] = (),
+    targets: Sequence[str] | Mapping[str, np.ndarray],
+    nuisance: Sequence[str] | Mapping[str, np.ndarray] | str = (),
     *,
     gamma: float = 1e-6,
     V=1.0,
@@ -260,10 +288,11 @@ def game_filter_bank(
 ) -> GameBankDesign:
     """One single-fault game filter per fault, each blocking all the others (Murray 2012, §6.1.1).
 
-    Filter ``i`` has target ``F_i`` and ``F̂_i = [F_j]_{j≠i}`` plus the ``nuisance`` faults
-    (blocked by every filter).  ``Q`` and ``M`` may be one value or a mapping fault → value
-    (``M`` is sized to each ``F̂_i``).  A bank does not need mutual detectability (Murray 2012,
-    Remark 2.4): each filter forms only one detection space.
+    Filter ``i`` has target ``F_i`` (``targets``: fault names or a mapping name → F) and
+    ``F̂_i = [F_j]_{j≠i}`` plus the ``nuisance`` faults (blocked by every filter; ``()`` none,
+    ``'others'`` every fault input of the model that is not a target).  ``Q`` and ``M`` may be one
+    value or a mapping fault → value (``M`` is sized to each ``F̂_i``).  A bank does not need mutual
+    detectability (Murray 2012, Remark 2.4): each filter forms only one detection space.
 
     Examples
     --------
@@ -273,10 +302,10 @@ def game_filter_bank(
     ('f1[0]', 'f2[0]')
     """
     require_continuous(model)
-    prob = game_problem(model, faults, ())
-    given = _given_names(faults)
+    prob = game_problem(model, targets, ())
+    given = _given_names(targets)
     Qs, Ms = per_target("Q", Q, prob, given), per_target("M", M, prob, given)
-    extra = resolve_faults(model, nuisance) if (isinstance(nuisance, Mapping) or len(nuisance)) else {}
+    extra = resolve_nuisance(model, nuisance, list(prob.names))
     designs = {}
     for name in prob.names:
         others = {k: F for k, F in prob.targets.items() if k != name} | extra
@@ -319,6 +348,22 @@ class GameDesign:
     nit: int
     problem: GameProblem
 
+    def internal_form(self) -> FaultModel:
+        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
+
+        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
+        model the design was made for (the model of ``problem``).
+        """
+        return joined_form(self, self.problem.model)
+
+    def report(self) -> dict:
+        """``gain`` (``L``), ``poles``, ``riccati`` (``Π_i``) and ``hamiltonian_margins`` by target, ``projectors``
+        (``Ĥ_i``), ``cost`` and ``initial_cost`` (``J`` of (3.27)) and the optimiser's ``success``, ``message``,
+        ``nit``."""
+        return {"gain": self.gain, "poles": self.poles, "riccati": self.riccati,
+                "hamiltonian_margins": self.hamiltonian_margins, "projectors": self.projectors, "cost": self.cost,
+                "initial_cost": self.initial_cost, "success": self.success, "message": self.message, "nit": self.nit}
+
 
 def _barrier(s: np.ndarray, width: np.ndarray) -> float:
     """C¹ log-barrier: ``−log z + z − 1`` for ``z = s/width < 1``, 0 beyond (inactive far from the bound)."""
@@ -356,7 +401,7 @@ def _initial_gain(prob, tg, given, g, Vw, Q, M, eps) -> np.ndarray:
 def game_filter(
     model: FaultModel,
     targets: Sequence[str] | Mapping[str, np.ndarray],
-    nuisance: Sequence[str] | Mapping[str, np.ndarray] = (),
+    nuisance: Sequence[str] | Mapping[str, np.ndarray] | str = (),
     *,
     gamma: float = 1e-6,
     V=1.0,
@@ -380,7 +425,8 @@ def game_filter(
 
     **Optimiser.**  :func:`scipy.optimize.minimize` (``method``, default ``'L-BFGS-B'``; any method
     that uses a gradient) on ``J(L)/|J(L0)| + barrier · Σ_j b(s_j/w_j)`` with the analytic gradient
-    of ``J`` (note §5.5) and eigenvalue-perturbation gradients of the margins.  The slacks are
+    of ``J`` (:func:`~fdikit.design.game.riccati.game_cost`) and eigenvalue-perturbation gradients of the margins.
+    The slacks are
     ``s_0 = −max Re λ(A − LC) − eps_stab`` and ``s_i = min |Re λ(H_i)| − eps_ham``;
     ``b(z) = −log z + z − 1`` for ``z < 1`` and 0 otherwise is a C¹ log-barrier that acts only when
     a margin has fallen below its value at ``L0`` (``w_j = s_j(L0)``); points outside the
@@ -389,7 +435,7 @@ def game_filter(
     with unstated margins and tolerances.
 
     .. warning:: The cost is **unbounded below** as a Hamiltonian eigenvalue approaches the
-       imaginary axis (``Π_i`` grows and ``−tr N F Π F → −∞``; note §5.5, §8.2.8), and it has many
+       imaginary axis (``Π_i`` grows and ``−tr N F Π F → −∞``), and it has many
        local minima.  The result therefore depends on ``L0``, the margins, ``barrier`` and the
        stopping rules; check the isolation of the design (e.g. DC gains of ``Ĥ_i C (sI − A + LC)⁻¹ F_j``)
        rather than trusting the optimum.
@@ -397,8 +443,10 @@ def game_filter(
     Parameters
     ----------
     model : continuous FaultModel.
-    targets : target faults (names resolved by :func:`fdikit.design.resolve_faults`, or a mapping
-        name → F); ``F̂_i`` = the other targets plus the ``nuisance`` faults.
+    targets : target faults (fault names resolved by :func:`fdikit.linalg.resolve_faults`, or a
+        mapping name → F); ``F̂_i`` = the other targets plus the ``nuisance`` faults.
+    nuisance : faults every residual must block: ``()`` (default) none, ``'others'`` every fault
+        input of the model that is not a target, or names / a mapping name → F.
     gamma : attenuation bound (Murray's examples: 1e−6).
     V : ``V̄/γ`` (p x p or scalar).
     Q, M, K, N : Riccati and cost weights, one value or a mapping target → value (``Q`` p x p,

@@ -7,9 +7,15 @@ Observer (5.3) on a *discrete* model (``Φ = model.A``); the residual uses the a
 
 i.e. the predictor ``x̄(k+1) = Φ x̄ + Bu u + ΦL (y − C x̄ − Du u)`` (``observer_generator`` with gain ``ΦL``).
 
+**Gain convention.**  Murray's ``L`` is the *filtered-form* gain of the a-posteriori update; the designs
+keep it as ``filter_gain`` (and :func:`discrete_game_riccati`, :func:`secondary_cost`, :func:`gain_update`,
+:func:`discrete_game_generator` and ``dgtmfdf(L0=…)`` take it in that form, as the text writes every
+equation).  Their ``gain`` is fdikit's observer (predictor) gain ``ΦL``: the generator's state matrix is
+``Φ − (ΦL) C = Φ(I − LC)``, the sign and form of python-control's ``dlqe`` and of every other design.
+
 Target ``i`` (``F̂_i``, ``Ĥ_i`` from :func:`~fdikit.design.game.setup.game_problem`) meets its
 disturbance-attenuation problem (5.8) when the DARI (5.23) ≡ (5.29) ≡ (5.30) has ``Π_i ≥ 0``.  With
-equality and ``P = Π⁻¹`` (research note §7.3; the same as (5.29) and (5.44b))::
+equality and ``P = Π⁻¹`` ((5.29) and (5.44b) rewritten in ``P``; for ``L = Λ⁻¹CᵀV⁻¹`` it is (5.42))::
 
     P(k+1) = Φ [(I − LC)(P⁻¹ − CᵀĤQĤC)⁻¹(I − LC)ᵀ + L V Lᵀ] Φᵀ + F̂MF̂ᵀ/γ,     P(k0) = P0/γ
 
@@ -26,14 +32,15 @@ avoids inverting ``P``.  Φ and ``I − LC`` must be invertible (Ch. 5 assumptio
   run backward by (5.35) from ``Δ(k1) = 0`` (the forward form (5.38) is not the inverse of (5.35) —
   erratum — and is not used).  (5.41) equals stationarity only through the factors
   ``(I − LC)ᵀ·½∇J̄·V⁻¹(I − CL)``: its fixed-point iteration can converge where ``I − LC`` is singular and
-  ``∇J̄ ≠ 0`` (research note §7.4).  So every (5.41) step must keep ``σ_min(I − LC)`` above a guard,
+  ``∇J̄ ≠ 0``.  So every (5.41) step must keep ``σ_min(I − LC)`` above a guard,
   stay feasible and lower ``J̄``; otherwise a trust-region quasi-Newton method continues on the true
   cost.  The finite-horizon cost does not enforce stability and, unconstrained, drives a filter
   pole to the unit circle (measured on the F-16XL); accepted gains keep ``ρ(Φ(I − LC)) ≤ max_radius``
   (the stability constraint of the text's ``fmincon`` runs, Remarks 6.1–6.2), and the optimum then
   sits on that bound.  Remark 5.1: no steady-state theory exists; everything is finite-horizon.
 
-Other errata applied (research note §10): (5.2a) reads ``Φx_i``; (5.23), (5.26), (5.27) need ``F̂_iᵀ`` where the
+Other errata applied: (5.2a) prints ``Φ x(k)`` for the state ``x_i``, read ``Φ x_i(k)``; (5.23), (5.26), (5.27)
+need ``F̂_iᵀ`` where the
 text prints ``F̂_iΓ̂_iΦL``; (3.32)/(5.9) start from ``P0/γ``, not ``γP0``.
 """
 
@@ -41,7 +48,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg
@@ -52,6 +59,7 @@ from fdikit.design.game.setup import GameProblem, game_problem, weight
 from fdikit.design.observers.full_order import observer_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
+from fdikit.protocols import joined_form
 from fdikit.residuals import ResidualGenerator
 
 __all__ = [
@@ -226,16 +234,16 @@ def _infeasible(setup: DiscreteGameSetup, name: str, k: int, P: np.ndarray, leve
 def discrete_game_riccati(setup: DiscreteGameSetup, L) -> GameRiccatiSolution:
     """Propagate the DARI with equality (Murray 2012, (5.17), (5.29)–(5.30)) for a given gain, all targets at once.
 
-    ``L`` is n x p (constant) or a (steps, n, p) sequence.  Raises :class:`DesignError` naming the
-    target, the step and the smallest eigenvalue of ``P⁻¹ − CᵀĤQĤC`` when positivity is lost, or
-    when ``I − L(k)C`` is singular.
+    ``L`` (Murray's filtered form, a design's ``filter_gain``) is n x p (constant) or a (steps, n, p)
+    sequence.  Raises :class:`DesignError` naming the target, the step and the smallest eigenvalue of
+    ``P⁻¹ − CᵀĤQĤC`` when positivity is lost, or when ``I − L(k)C`` is singular.
 
     Examples
     --------
     >>> from fdikit.plants.white_speyer import white_speyer
     >>> m = white_speyer().discretize(0.01)
     >>> st = discrete_game_setup(m, ["f1"], ["f2"], gamma=1e-2, Vbar=1e-2 / 0.01, Q=1e-3, M=5.0, P0=1e-2, steps=50)
-    >>> bool(discrete_game_riccati(st, dgtfdf(st).gain).levels["f1"].max() < 1)
+    >>> bool(discrete_game_riccati(st, dgtfdf(st).filter_gain).levels["f1"].max() < 1)
     True
     """
     m, steps, names = setup.model, setup.steps, setup.names
@@ -358,7 +366,9 @@ class DiscreteGtfdfDesign:
     Attributes
     ----------
     generator : observer (5.3) at the final gain, projected residual of ``target``.
-    gain : ``L(k1 − 1)``; gains : ``L(k) = Σ(k)⁻¹CᵀV⁻¹``, shape (steps, n, p).
+    gain : the observer (predictor) gain ``Φ L(k1 − 1)``: the generator's state matrix is ``Φ − gain·C``.
+    filter_gain : Murray's filtered-form ``L(k1 − 1)`` (``gain = Φ @ filter_gain``).
+    filter_gains : ``L(k) = Σ(k)⁻¹CᵀV⁻¹``, shape (steps, n, p), filtered form.
     covariances : ``P(k) = Θ(k)⁻¹``, shape (steps + 1, n, n).  levels : ``λ_max(Q^½ĤCP(k)CᵀĤQ^½)`` (< 1).
     poles : eigenvalues of ``Φ(I − LC)`` at the final gain.
     settled : the gain's last relative change is below ``settle_rtol``; settling_step : first k after
@@ -368,7 +378,8 @@ class DiscreteGtfdfDesign:
     generator: ResidualGenerator
     target: str
     gain: np.ndarray
-    gains: np.ndarray
+    filter_gain: np.ndarray
+    filter_gains: np.ndarray
     covariances: np.ndarray
     levels: np.ndarray
     poles: np.ndarray
@@ -380,14 +391,33 @@ class DiscreteGtfdfDesign:
         Pi = np.linalg.inv(self.covariances[k])
         return (Pi + Pi.T) / 2
 
+    model: FaultModel | None = field(default=None, repr=False, kw_only=True)  # set by the design function
 
-def dgtfdf(setup: DiscreteGameSetup, target: str | None = None, settle_rtol: float = 1e-8) -> DiscreteGtfdfDesign:
+    def internal_form(self) -> FaultModel:
+        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
+
+        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
+        model the design was made for (field ``model``, set by the design function).
+        """
+        return joined_form(self, self.model)
+
+    def report(self) -> dict:
+        """``target``, ``gain`` (observer gain ``Φ L`` at the final ``L``), ``poles`` (of ``Φ(I − LC)``),
+        ``levels`` (``< 1`` ⇔ the game bound holds), ``settled`` and ``settling_step``."""
+        return {"target": self.target, "gain": self.gain, "poles": self.poles, "levels": self.levels,
+                "settled": self.settled, "settling_step": self.settling_step}
+
+
+def dgtfdf(setup: DiscreteGameSetup, targets: str | Sequence[str] | None = None,
+           settle_rtol: float = 1e-8) -> DiscreteGtfdfDesign:
     """Discrete single-fault game-theoretic detection filter (Murray 2012, (5.42)–(5.43)), time-varying gain.
 
     From ``Θ(k0) = Π_0``: ``Σ = Θ − Cᵀ(ĤQĤ − V⁻¹)C``, ``Θ̃ = [ΦΣ⁻¹Φᵀ + F̂MF̂ᵀ/γ]⁻¹``, ``L(k) = Σ⁻¹CᵀV⁻¹``,
     computed as ``Σ⁻¹ = Γ⁻¹ − L CΓ⁻¹``, ``L = Γ⁻¹Cᵀ(V + CΓ⁻¹Cᵀ)⁻¹`` with ``Γ = Θ − CᵀĤQĤC > 0`` checked at
-    every step.  ``target`` (default: the only one) is blocked from its ``F̂_i``; a bank of these is
-    the "UIO" of Murray §6.1.1.  The generator uses the last gain.
+    every step.  ``targets`` names the one target of the setup to detect (a fault name or a
+    one-element sequence; default: the setup's only target); it is blocked from its ``F̂_i``.  A bank
+    of these is the "UIO" of Murray §6.1.1.  The generator uses the last gain.  ``filter_gain(s)`` hold
+    Murray's ``L``; ``gain = Φ @ filter_gain`` is the observer gain (module docstring).
 
     Examples
     --------
@@ -399,9 +429,12 @@ def dgtfdf(setup: DiscreteGameSetup, target: str | None = None, settle_rtol: flo
     (True, True)
     """
     validate.instance("setup", setup, DiscreteGameSetup, "build it with discrete_game_setup(...)")
-    if target is None and len(setup.names) > 1:
+    if targets is None and len(setup.names) > 1:
         raise DesignError(f"the setup has targets {list(setup.names)}; name the one the single-fault filter detects")
-    target = setup.names[0] if target is None else target
+    given = [setup.names[0]] if targets is None else [targets] if isinstance(targets, str) else list(targets)
+    if len(given) != 1:
+        raise ParameterError(f"dgtfdf detects one target, got {given}; use dgtmfdf for several")
+    target = str(given[0]).partition(":")[0]
     if target not in setup.names:
         raise DesignError(f"{target!r} is not a target of the setup; targets are {list(setup.names)}")
     m = setup.model
@@ -426,9 +459,9 @@ def dgtfdf(setup: DiscreteGameSetup, target: str | None = None, settle_rtol: flo
     settled = bool(change.size and change[-1] < settle_rtol)
     L = gains[-1]
     return DiscreteGtfdfDesign(
-        discrete_game_generator(setup, L, [target]), target, L, gains, P, levels,
+        discrete_game_generator(setup, L, [target]), target, Phi @ L, L, gains, P, levels,
         scipy.linalg.eigvals(Phi @ (np.eye(m.n) - L @ C)), settled,
-        (int(above[-1]) + 2 if above.size else 1) if settled else None,
+        (int(above[-1]) + 2 if above.size else 1) if settled else None, model=setup.model,
     )
 
 
@@ -439,7 +472,8 @@ class DiscreteGtmfdfDesign:
     Attributes
     ----------
     generator : observer (5.3) with the projected residuals of every target.
-    gain : ``L``; poles : eigenvalues of ``Φ(I − LC)``; sigma_min : ``σ_min(I − LC)``.
+    gain : the observer (predictor) gain ``Φ L`` (state matrix ``Φ − gain·C``); filter_gain : Murray's ``L``.
+    poles : eigenvalues of ``Φ(I − LC)``; sigma_min : ``σ_min(I − LC)``.
     cost, initial_cost : ``J̄`` at the final and the initial gain; gradient : ``∂J̄/∂L`` at the end.
     method : stages run (``'fixed-point'``, ``'gradient'`` or both); iterations : accepted (5.41)
         steps, optimiser iterations.  riccati : the DARI solution at the final gain.
@@ -448,6 +482,7 @@ class DiscreteGtmfdfDesign:
 
     generator: ResidualGenerator
     gain: np.ndarray
+    filter_gain: np.ndarray
     poles: np.ndarray
     sigma_min: float
     cost: float
@@ -457,6 +492,23 @@ class DiscreteGtmfdfDesign:
     iterations: tuple[int, int]
     riccati: GameRiccatiSolution
     notes: tuple[str, ...]
+
+    model: FaultModel | None = field(default=None, repr=False, kw_only=True)  # set by the design function
+
+    def internal_form(self) -> FaultModel:
+        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
+
+        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
+        model the design was made for (field ``model``, set by the design function).
+        """
+        return joined_form(self, self.model)
+
+    def report(self) -> dict:
+        """``gain`` (observer gain ``Φ L``), ``poles`` (of ``Φ(I − LC)``), ``sigma_min`` (``σ_min(I − LC)``),
+        ``cost`` and ``initial_cost`` (``J̄``), ``method``, ``iterations`` and ``notes`` (how each stage stopped)."""
+        return {"gain": self.gain, "poles": self.poles, "sigma_min": self.sigma_min, "cost": self.cost,
+                "initial_cost": self.initial_cost, "method": self.method, "iterations": self.iterations,
+                "notes": self.notes}
 
 
 def _try_cost(setup: DiscreteGameSetup, L: np.ndarray, floor: float, max_radius: float):
@@ -486,8 +538,9 @@ def dgtmfdf(
     Parameters
     ----------
     setup : from :func:`discrete_game_setup`, with nonzero ``K_i``/``N_i``.
-    L0 : initial gain; default the mean of the targets' :func:`dgtfdf` gains or the one of them with
-        the lowest cost (the first acceptable).  A Beard–Jones gain is a good start at small γ.
+    L0 : initial gain in Murray's filtered form (``filter_gain``; an observer gain ``G`` is ``Φ⁻¹G``);
+        default the mean of the targets' :func:`dgtfdf` filter gains or the one of them with the lowest
+        cost (the first acceptable).  A Beard–Jones gain is a good start at small γ.
     method : ``'fixed-point'`` iterates (5.41), accepting a (halved up to 4 times) step only if
         ``σ_min(I − LC) ≥ min_sigma``, the DARI stays feasible and ``J̄`` does not rise;
         ``'gradient'`` runs ``scipy.optimize.minimize(method='trust-constr')`` with a BFGS Hessian
@@ -515,7 +568,7 @@ def dgtmfdf(
                           "gives no gain (Murray 2012, §5.2.2); set K (complementary) and N (target) weights")
     m = setup.model
     if L0 is None:
-        singles = [dgtfdf(setup, t).gain for t in setup.names]
+        singles = [dgtfdf(setup, t).filter_gain for t in setup.names]
         scored = [(c, r) for c in [np.mean(singles, axis=0)] + singles
                   if (r := _try_cost(setup, c, 1e-10, max_radius)) is not None]
         if not scored:
@@ -570,7 +623,7 @@ def dgtmfdf(
         it_gd = int(opt.nit)
         notes.append(f"gradient: {opt.message} ({opt.nit} iterations)")
     return DiscreteGtmfdfDesign(
-        discrete_game_generator(setup, L), L, scipy.linalg.eigvals(m.A @ (np.eye(m.n) - L @ m.C)),
+        discrete_game_generator(setup, L), m.A @ L, L, scipy.linalg.eigvals(m.A @ (np.eye(m.n) - L @ m.C)),
         float(np.linalg.svd(np.eye(m.n) - L @ m.C, compute_uv=False)[-1]), J, J_init, g, "+".join(stages),
-        (it_fp, it_gd), discrete_game_riccati(setup, L), tuple(notes),
+        (it_fp, it_gd), discrete_game_riccati(setup, L), tuple(notes), model=setup.model,
     )

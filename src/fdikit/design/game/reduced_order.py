@@ -20,7 +20,8 @@ whose ``C F̂`` has full column rank this is PATH's (9.63): ``L₁ = S̄⁻¹ C�
 ``A₁₁ − A₁₂KC₁ − S̄⁻¹C₁ᵀV̄⁻¹(I − C₂K)C₁`` (Theorem 9.5).  ``A₁₂ = L₁ C₂`` (4.70) holds exactly, so the
 estimation error ``e₁ = η₁ − η̂₁`` obeys ``e₁' = (A₁₁ − L₁C₁) e₁ − L₁ v`` (9.68): no nuisance term.
 
-**Residual.**  PATH leaves the reduced detector's output unwritten (research note §1.9).  Here the
+**Residual.**  Douglas et al. 1996, §9.5 gives the reduced-order filter ((9.62)–(9.68)) but no formula for its
+residual (Figs. 9.6–9.7 plot one).  Here the
 residual of target ``i`` is the projected output error ``Ĥᵢ (y − C₁η̂₁ − D u)``, in the coordinates of
 an orthonormal basis of ``Im Ĥᵢ`` (named ``"<target>[k]"``, as the full-order game filters).  Since
 ``y − C₁η̂₁ = C₁e₁ + C₂η₂ + v`` and ``Ĥᵢ C₂ = 0``, it is blind to the nuisance; for one target and a
@@ -45,6 +46,7 @@ from fdikit.design.game.goh import GohRiccatiSolution, goh_riccati
 from fdikit.design.game.setup import GameProblem, game_problem
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
+from fdikit.protocols import joined_form
 from fdikit.residuals import ResidualGenerator
 
 __all__ = ["GohFilterDesign", "goh_filter", "goh_detector"]
@@ -97,6 +99,23 @@ class GohFilterDesign:
         return {"A11": At[:k, :k], "A12": At[:k, k:], "A21": At[k:, :k], "A22": At[k:, k:],
                 "C1": Ct[:, :k], "C2": Ct[:, k:]}
 
+    def internal_form(self) -> FaultModel:
+        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
+
+        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
+        model the design was made for (the model of ``problem``).
+        """
+        return joined_form(self, self.problem.model)
+
+    def report(self) -> dict:
+        """``gain`` (``L₁``), ``poles`` (of ``A₁₁ − L₁C₁``), ``order`` (``n₁``), ``transformation`` (``Γ``),
+        ``reduced_riccati`` (``S̄ᵢ``) and ``projectors`` (``Ĥᵢ``) by target, ``static_gain``, ``separation``
+        (defect of (4.85)) and ``structure_residual`` (of (4.70))."""
+        return {"gain": self.gain, "poles": self.poles, "order": self.order, "transformation": self.transformation,
+                "reduced_riccati": self.reduced_riccati, "projectors": self.projectors,
+                "static_gain": self.static_gain, "separation": self.separation,
+                "structure_residual": self.structure_residual}
+
 
 def _per_target(value, names: Sequence[str], given: Sequence[str]) -> dict[str, object]:
     if not isinstance(value, Mapping):
@@ -130,8 +149,10 @@ def goh_filter(
     Parameters
     ----------
     model : continuous FaultModel.
-    targets : fault names (resolved by :func:`fdikit.design.resolve_faults`) or a mapping name → F.
-    nuisance : faults blocked from every residual (names or mapping).
+    targets : fault names (resolved by :func:`fdikit.linalg.resolve_faults`: ``'<output>_sensor'``,
+        ``'<control>_actuator'``, fault inputs of the model) or a mapping name → F.
+    nuisance : faults blocked from every residual (names or mapping; ``()`` none, ``'others'`` every
+        fault input of the model that is not a target).
     V : ``V = V̄/γ`` held fixed as γ → 0 (PATH's ``V̄``; p x p positive definite or scalar).
     Q : weight on ``Ĥᵢ C e`` (scalar, p x p, or a mapping target → weight).  ``Q < 1/V`` keeps the
         Goh Riccati equation of standard (LQ) type.
@@ -151,7 +172,7 @@ def goh_filter(
     >>> from fdikit.linalg import resolve_faults
     >>> from fdikit.plants.f16xl import f16xl_longitudinal
     >>> m = f16xl_longitudinal()
-    >>> faults = resolve_faults(m, ["y_theta", "elevon"]) | {"gust": m.Bd}
+    >>> faults = resolve_faults(m, ["y_theta_sensor", "elevon_actuator"]) | {"gust": m.Bd}
     >>> d = goh_filter(m, faults, V=1.0, Q=0.5)
     >>> d.order, d.separation < 1e-9
     (4, True)
@@ -163,7 +184,7 @@ def goh_filter(
         )
     prob = game_problem(model, targets, nuisance, rtol)
     names = prob.names
-    given = list(targets) if not isinstance(targets, Mapping) else list(targets)
+    given = [targets] if isinstance(targets, str) else list(targets)
     Qs = _per_target(Q, names, [str(g) for g in given])
     A, C, n, p = model.A, model.C, model.n, model.p
     sols = {t: goh_riccati(A, C, prob.complementary[t], V=V, Q=Qs[t], projector=prob.projectors[t], rtol=rtol)
@@ -231,8 +252,8 @@ def goh_filter(
 
 def goh_detector(
     model: FaultModel,
-    target: str | Mapping[str, np.ndarray],
-    nuisance: Sequence[str] | Mapping[str, np.ndarray] = (),
+    targets: str | Sequence[str] | Mapping[str, np.ndarray],
+    nuisance: Sequence[str] | Mapping[str, np.ndarray] | str = (),
     *,
     V=1.0,
     Q=1e-4,
@@ -246,8 +267,9 @@ def goh_detector(
     Parameters
     ----------
     model : continuous FaultModel.
-    target : the fault to detect (a name or ``{name: F}``).
-    nuisance : the faults to block exactly (names or mapping); ``F̂`` is their side-by-side map.
+    targets : the one fault to detect (a fault name, a one-element sequence, or ``{name: F}``).
+    nuisance : the faults to block exactly (names or mapping; ``'others'`` every other fault input of
+        the model); ``F̂`` is their side-by-side map.
     V : PATH's ``V̄`` (``ν/γ``; 0.8 in §9.6), p x p or scalar.
     Q : PATH's ``Q₁`` (1 in §9.6).
     rtol : rank tolerance.
@@ -258,8 +280,11 @@ def goh_detector(
 
     >>> from fdikit.plants.path_longitudinal import path_longitudinal_7, path_longitudinal_7_fault_maps
     >>> m = path_longitudinal_7()
-    >>> d = goh_detector(m, "air_mass", path_longitudinal_7_fault_maps(), V=0.8, Q=1.0)
+    >>> d = goh_detector(m, "air_mass_sensor", path_longitudinal_7_fault_maps(), V=0.8, Q=1.0)
     >>> d.order, d.generator.residuals
     (3, ('air_mass_sensor[0]', 'air_mass_sensor[1]', 'air_mass_sensor[2]'))
     """
-    return goh_filter(model, target if isinstance(target, Mapping) else [target], nuisance, V=V, Q=Q, rtol=rtol)
+    prob_targets = targets if not isinstance(targets, str) else [targets]
+    if len(prob_targets) != 1:
+        raise ParameterError(f"goh_detector detects one target fault, got {list(prob_targets)}; use goh_filter")
+    return goh_filter(model, prob_targets, nuisance, V=V, Q=Q, rtol=rtol)

@@ -279,7 +279,8 @@ def game_riccati(
 
     ``0 = Π(A − LC) + (A − LC)ᵀΠ + Π R Π + Q̄``, ``R = F̂ M F̂ᵀ/γ + L V Lᵀ``, ``Q̄ = Cᵀ Ĥ Q Ĥ C``,
     solved through the Hamiltonian (3.36) by :func:`~fdikit.design.game.riccati.solve_game_are`.
-    By Theorem 3.1 (with "≤ 0" read as Hurwitz, note §10), when ``A − LC`` is Hurwitz and the
+    By Theorem 3.1 (its "``A − LC + RΠ ≤ 0``" read as Hurwitz, the property its proof in §3.4.1 uses),
+    when ``A − LC`` is Hurwitz and the
     Hamiltonian has no imaginary-axis eigenvalue, ``Π ≥ 0``, ``A − LC + RΠ`` is Hurwitz and
     ``Ker Π`` is the unobservable subspace of ``(ĤC, A − LC)``.  Returned ``X`` is ``Π``.
 
@@ -303,7 +304,7 @@ def game_riccati(
 
 
 def stacked_cost(problem: GameProblem, L: np.ndarray, targets: list[TargetTerms], V: np.ndarray):
-    """J, ∂J/∂L, Π_i, Hamiltonian margins (note §5.5)."""
+    """J, ∂J/∂L, Π_i, Hamiltonian margins (the gradient of (3.27) under (3.28): see :func:`game_cost`)."""
     C = problem.model.C
     J, grad, pis, margins = 0.0, np.zeros_like(L), {}, {}
     for t in targets:
@@ -328,7 +329,7 @@ def game_cost(
     K=0.01,
     N=1.0,
 ) -> tuple[float, np.ndarray]:
-    """Steady-state GTMFDF cost and its gradient (Murray 2012, (3.27) with (3.28); note §5.5).
+    """Steady-state GTMFDF cost and its gradient (Murray 2012, §3.2.3, (3.27) with (3.28)).
 
     ``J(L) = Σ_i tr(W_i Π_i(L))``, ``W_i = F̂_i K_i F̂_iᵀ/γ − F_i N_i F_iᵀ`` and
 

@@ -17,7 +17,8 @@ al. 1996, (9.17) with ``P = γΠ⁻¹``), integrated forward with :func:`scipy.i
 ``Ψ_i ≤ 0`` (3.16)–(3.18) is met iff ``P_i`` stays finite and positive definite on ``[t0, t1]``.
 
 Erratum applied: the initial condition is ``P_i(t0) = P0/γ``; the dissertation prints
-``γ P0`` under (3.32), which contradicts ``Π0 = γ P0⁻¹`` of (3.12) (research note §5.3, §10).
+``P_i(t0) = γ P0`` under (3.32) (§3.3), which contradicts ``Π0 ≜ γ P0⁻¹`` defined with (3.12)
+(``P_i = Π_i⁻¹`` gives ``P_i(t0) = P0/γ``).
 Weights follow Murray: ``γ`` is the attenuation bound (small γ = strong blocking), ``M`` the
 complementary-fault weight, ``Q`` the projected-output weight, ``V = V̄/γ`` the noise weight
 and ``P0`` the initial-error weight of the DAP (3.11).
@@ -38,6 +39,7 @@ from fdikit import validate
 from fdikit.design.game.setup import weight
 from fdikit.errors import DataError, DesignError, ModelError, ParameterError
 from fdikit.ltv import LTVModel, MatrixFunction, invariant_generators, ltv_projector
+from fdikit.protocols import no_internal_form
 from fdikit.residuals import Residuals
 
 __all__ = [
@@ -187,12 +189,24 @@ def _expm_batch(A: np.ndarray) -> np.ndarray:
     return E
 
 
-def _complements(model: LTVModel, targets: Sequence[str], nuisance: Sequence[str]) -> dict[str, tuple[str, ...]]:
-    targets, nuisance = [str(k) for k in targets], [str(k) for k in nuisance]
+def _complements(model: LTVModel, targets: Sequence[str] | str,
+                 nuisance: Sequence[str] | str) -> dict[str, tuple[str, ...]]:
+    """Complementary faults by target; ``nuisance='others'`` is every other fault of the LTV model."""
+    targets = [targets] if isinstance(targets, str) else [str(k) for k in targets]
+    if nuisance is None:
+        raise ParameterError("nuisance=None is not a fault set; use () for none or 'others' for every other fault")
+    if isinstance(nuisance, str):
+        nuisance = [k for k in model.faults if k not in targets] if nuisance == "others" else [nuisance]
+    nuisance = [str(k) for k in nuisance]
     if not targets:
         raise ParameterError("no target fault given; name at least one fault to detect")
     for k in targets + nuisance:
         if k not in model.faults:
+            if k in model.outputs or k in model.controls:
+                kind, fault = ("output", f"{k}_sensor") if k in model.outputs else ("control", f"{k}_actuator")
+                what = "sensor" if kind == "output" else "actuator"
+                raise ParameterError(f"{k!r} is an {kind}; its {what} fault is {fault!r}; faults are named by fault "
+                                     f"name, not by signal name (the LTV model has {list(model.faults)})")
             raise ModelError(f"no fault named {k!r}; the LTV model has {list(model.faults)}")
     both = set(targets) & set(nuisance)
     if both:
@@ -327,10 +341,30 @@ class LTVGameDesign:
         m = self.filter.model
         return scipy.linalg.eigvals(m.matrix("A", self.t[k]) - self.gains[k] @ m.matrix("C", self.t[k]))
 
+    @property
+    def generator(self) -> LTVDetectionFilter:
+        """The time-varying filter (:attr:`filter`; run it with ``run`` / ``run_trace``)."""
+        return self.filter
 
-def ltv_game_filter(model: LTVModel, target: str, nuisance: Sequence[str], t, *, gamma: float, M=1.0, Q=1e-3,
-                    V=1.0, P0=1.0, rtol: float = 1e-8, atol: float | None = None, method: str = "BDF",
-                    escape: float = 1e4, geometry_rtol: float = 1e-6) -> LTVGameDesign:
+    def internal_form(self):
+        """Not available: raises :class:`~fdikit.errors.DesignError`.
+
+        The gain ``L(t)`` and projector ``Ĥ(t)`` vary with time, so plant and filter in series are not an
+        LTI :class:`~fdikit.model.FaultModel`.
+        """
+        no_internal_form(self, "the finite-horizon filter is time-varying (gain L(t), projector Ĥ(t)), so plant "
+                               "and filter in series are not an LTI FaultModel; run it with generator.run(...)")
+
+    def report(self) -> dict:
+        """``target``, ``gamma``, the grid ``t`` and on it ``gains`` (``L(t_k)``), ``covariance`` (``P(t_k)``),
+        ``projector`` (``Ĥ(t_k)``), and ``poles`` (frozen-time eigenvalues at the final time)."""
+        return {"target": self.target, "gamma": self.gamma, "t": self.t, "gains": self.gains,
+                "covariance": self.covariance, "projector": self.projector, "poles": self.poles()}
+
+
+def ltv_game_filter(model: LTVModel, targets: str | Sequence[str], nuisance: Sequence[str] | str, t, *,
+                    gamma: float, M=1.0, Q=1e-3, V=1.0, P0=1.0, rtol: float = 1e-8, atol: float | None = None,
+                    method: str = "BDF", escape: float = 1e4, geometry_rtol: float = 1e-6) -> LTVGameDesign:
     """Finite-horizon time-varying single-fault game-theoretic detection filter (GTFDF).
 
     Integrates ``Ṗ = A P + P Aᵀ + F̂MF̂ᵀ/γ − P Cᵀ(V⁻¹ − ĤQĤ)C P`` forward from
@@ -341,7 +375,10 @@ def ltv_game_filter(model: LTVModel, target: str, nuisance: Sequence[str], t, *,
 
     Parameters
     ----------
-    model : LTVModel; target : the fault to detect; nuisance : faults to block.
+    model : LTVModel.
+    targets : the one fault of the model to detect (a fault name or a one-element sequence).
+    nuisance : faults to block: a sequence of fault names, ``()`` none, or ``'others'`` every
+        other fault of the model.
     t : time grid, ``t[0] = t0`` and ``t[-1] = t1``.
     gamma : attenuation bound (3.11); M, Q, V, P0 : weights (scalar = multiple of I).
     rtol, atol, method : ``solve_ivp`` settings.
@@ -364,6 +401,11 @@ def ltv_game_filter(model: LTVModel, target: str, nuisance: Sequence[str], t, *,
     array([-316.27+0.j  ,   -3.53-1.79j,   -3.53+1.79j])
     """
     validate.choice("integration method", method, _IVP_METHODS)
+    given = [targets] if isinstance(targets, str) else list(targets)
+    if len(given) != 1:
+        raise ParameterError(f"ltv_game_filter detects one target fault, got {given}; check several with "
+                             "ltv_feasibility")
+    target = str(given[0])
     comp = _complements(model, [target], nuisance)[target]
     t = _grid(t)
     for s in (t[0], t[len(t) // 2], t[-1]):
@@ -433,7 +475,7 @@ def ltv_feasibility(model: LTVModel, targets: Sequence[str], nuisance: Sequence[
     >>> from fdikit.ltv import LTVModel
     >>> from fdikit.plants.white_speyer import white_speyer
     >>> m = LTVModel.from_lti(white_speyer(), ["f1", "f2"])
-    >>> L = np.array([[38.179, 40.535], [13.995, 16.317], [2.0, 5.678]])  # Beard–Jones structure (note §8.2.7)
+    >>> L = np.array([[38.179, 40.535], [13.995, 16.317], [2.0, 5.678]])  # a Beard–Jones gain, Murray 2012, §6.2
     >>> res = ltv_feasibility(m, ["f1", "f2"], [], lambda t: L, [0.0, 5.0], gamma=1.0, M=0.05, Q=0.1, P0=1.0)
     >>> res.feasible, round(res.escape_time["f1"], 3)
     ({'f1': False, 'f2': True}, 1.06)

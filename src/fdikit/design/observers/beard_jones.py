@@ -15,26 +15,36 @@ faults ``F̂_i = [T_j]_{j≠i}`` (``F̂_0`` = all of them), i.e. it lies in the 
     [Aᵀ − λ_ij I   Cᵀ] [v_ij]
     [F̂_iᵀ          0 ] [w_ij] = 0,
 
-and the gain solves (b.12) ``𝒱ᵀ L = 𝒲ᵀ``, so that ``v_ijᵀ (A + LC) = λ_ij v_ijᵀ``.  Per G7 of
-the research note, ``F̂_i`` holds bases of the *detection spaces* of the other faults (not
-only their fault maps).
+and the gain solves (b.12) ``𝒱ᵀ L = 𝒲ᵀ``, so that ``v_ijᵀ (A + LC) = λ_ij v_ijᵀ``.  The
+printed (b.9) lists the fault maps ``F_j``, but the derivation it summarises ((b.2)–(b.6),
+App. B) asks the left eigenvectors to annihilate the detection spaces ``T_j*``; so here
+``F̂_i`` holds bases of the *detection spaces* of the other faults.  The two differ when
+``dim T_j > rank F_j`` (a sensor fault's ``[F¹, A F¹]``), and with the maps alone ``T_j``
+would not be invariant under ``A + LC``.
 
-The report does not give its eigenvector selection ("greatest degree of linear
-independence", from Douglas & Speyer 1996, lost in the OCR; research note G8).  fdikit
+The report states the selection criterion — the left eigenvectors are "the set with the
+greatest degree of linear independence", measured by the smallest singular value of the
+eigenvector matrix (Douglas et al. 1996, §4.2.1, after Douglas & Speyer 1995b) — but not
+the search.  fdikit
 picks each ``v_ij ∈ Im V_ij`` to maximise the smallest singular value of ``𝒱`` by the
 rank-one sweep of Kautsky, Nichols & Van Dooren (1985, method 0): each vector in turn is
 replaced by the unit vector of its admissible subspace farthest from the span of the
 others, until σ_min(𝒱) stops growing.  The design reports σ(𝒱) next to the upper bounds
 σ([V_ij]) as in the report's (4.3) and (4.8).
 
-Sign convention: the report's residual is ``C x̂ + D u − y``; fdikit's is its negative,
-``y − C x̂ − D u`` (the innovation), so a positive bias gives a positive residual.
+Sign conventions: the report writes the filter with ``A + LC`` and the residual ``C x̂ + D u − y``.
+fdikit's :attr:`BeardJonesDesign.gain` is the observer gain of
+``x̂' = A x̂ + Bu u + L (y − C x̂ − Du u)`` (state matrix ``A − L C``, python-control's
+``lqe`` sign), i.e. the *negative* of the report's matrix, which stays available as
+:attr:`BeardJonesDesign.report_gain` (``A + report_gain C = A − gain C``); the equations above
+are in the report's sign.  The residual is ``y − C x̂ − D u`` (the innovation), the negative of
+the report's, so a positive bias gives a positive residual.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg
@@ -44,6 +54,7 @@ from fdikit.design.observers.full_order import observer_generator
 from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.linalg import resolve_faults
 from fdikit.model import FaultModel
+from fdikit.protocols import joined_form
 from fdikit.residuals import ResidualGenerator, stack_generators
 
 __all__ = ["BeardJonesDesign", "beard_jones", "restricted_diagonal", "RestrictedDiagonalDesign"]
@@ -57,9 +68,11 @@ class BeardJonesDesign:
     ----------
     generator : residual generator; residuals ``<fault>[k]`` = coordinates of ``Ĥ_i r`` in
         ``Ĥ_i C T_i`` (``dim C T_i`` per fault), each tied to its fault.
-    gain : ``L`` of ``A + L C`` (the report's sign).
-    eigenvalues : assigned sets by fault, plus ``'complement'`` (Ξ_0).
-    poles : eigenvalues of ``A + L C`` actually obtained.
+    gain : observer gain ``L`` of ``x̂' = A x̂ + Bu u + L (y − C x̂ − Du u)``: the generator's state
+        matrix is ``A − L C``.  The report prints the negative (its filter is ``A + L C``); see
+        :attr:`report_gain`.
+    assigned_poles : assigned sets by fault, plus ``'complement'`` (Ξ_0).
+    poles : eigenvalues of ``A − L C`` actually obtained.
     detection_spaces : orthonormal bases of ``T_i``.
     projectors : ``Ĥ_i`` (p x p, symmetric, idempotent, kernel ``Σ_{j≠i} C T_j``).
     left_eigenvectors : ``𝒱`` (n x n, complex in general), columns in the order of ``order``.
@@ -69,7 +82,7 @@ class BeardJonesDesign:
 
     generator: ResidualGenerator
     gain: np.ndarray
-    eigenvalues: dict[str, np.ndarray]
+    assigned_poles: dict[str, np.ndarray]
     poles: np.ndarray
     detection_spaces: dict[str, np.ndarray]
     projectors: dict[str, np.ndarray]
@@ -79,9 +92,33 @@ class BeardJonesDesign:
     sigma_bound: np.ndarray
 
     @property
+    def report_gain(self) -> np.ndarray:
+        """The gain as Douglas et al. 1996 print it: ``L`` of ``A + L C`` (``= −gain``), the solution of (b.12)."""
+        return -self.gain
+
+    @property
     def condition_number(self) -> float:
         """``σ_max(𝒱) / σ_min(𝒱)`` of the unit-norm left eigenvectors."""
         return float(self.sigma[0] / self.sigma[-1])
+
+    model: FaultModel | None = field(default=None, repr=False, kw_only=True)  # set by the design function
+
+    def internal_form(self) -> FaultModel:
+        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
+
+        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
+        model the design was made for (field ``model``, set by the design function).
+        """
+        return joined_form(self, self.model)
+
+    def report(self) -> dict:
+        """``gain`` (the attribute ``gain``), ``assigned_poles`` (by fault), ``poles`` (obtained),
+        ``detection_spaces`` (``T_i``), ``projectors`` (``Ĥ_i``), ``left_eigenvectors`` (``𝒱``), ``sigma`` and
+        ``sigma_bound`` (singular values of ``𝒱`` and their bounds) and ``condition_number`` (of ``𝒱``)."""
+        return {"gain": self.gain, "assigned_poles": self.assigned_poles, "poles": self.poles,
+                "detection_spaces": self.detection_spaces, "projectors": self.projectors,
+                "left_eigenvectors": self.left_eigenvectors, "sigma": self.sigma, "sigma_bound": self.sigma_bound,
+                "condition_number": self.condition_number}
 
 
 def _is_stable(lam: np.ndarray, discrete: bool) -> np.ndarray:
@@ -149,7 +186,10 @@ def _select(V_blocks: list[np.ndarray], pair: list[bool], sweeps: int, rng: np.r
 
 
 def _assign(model, spaces, sets, sweeps, seed, rtol):
-    """Algorithm B.1 steps 2–4: admissible bases, selection, gain.  ``sets`` maps group → eigenvalues."""
+    """Algorithm B.1 steps 2–4: admissible bases, selection, gain.  ``sets`` maps group → poles.
+
+    Returns the report's gain (b.12), ``L`` of ``A + L C``; callers negate it into the observer gain.
+    """
     A, C = model.A, model.C
     n = model.n
     names = [k for k in sets if k != "complement"]
@@ -195,23 +235,23 @@ def _assign(model, spaces, sets, sweeps, seed, rtol):
     return L.real, Vm, np.array(order), sigma, bound
 
 
-def _check_sets(model, dims, eigenvalues, complement):
+def _check_sets(model, dims, poles, complement_poles):
     n, discrete = model.n, model.is_discrete
     scale = max(np.linalg.norm(model.A, 2), 1.0)
-    if not isinstance(eigenvalues, Mapping):
-        raise ParameterError("eigenvalues must be a mapping fault name -> eigenvalues, got "
-                             f"{type(eigenvalues).__name__}; e.g. {{{next(iter(dims), 'fault')!r}: [-1.0]}}")
+    if not isinstance(poles, Mapping):
+        raise ParameterError("poles must be a mapping fault name -> poles (eigenvalues), got "
+                             f"{type(poles).__name__}; e.g. {{{next(iter(dims), 'fault')!r}: [-1.0]}}")
     sets = {}
     for name, nu in dims.items():
-        if name not in eigenvalues:
-            raise DesignError(f"no eigenvalues given for fault {name!r}; it needs {nu} (its detection-space dimension)")
-        sets[name] = validate.as_complex_vector(f"eigenvalues[{name!r}]", eigenvalues[name])
-    unknown = set(eigenvalues) - set(dims)
+        if name not in poles:
+            raise DesignError(f"no poles given for fault {name!r}; it needs {nu} (its detection-space dimension)")
+        sets[name] = validate.as_complex_vector(f"poles[{name!r}]", poles[name])
+    unknown = set(poles) - set(dims)
     if unknown:
-        raise ModelError(f"eigenvalues given for unknown fault(s) {sorted(unknown)}; faults are {list(dims)}")
+        raise ModelError(f"poles given for unknown fault(s) {sorted(unknown)}; faults are {list(dims)}")
     nu0 = n - sum(dims.values())
-    sets["complement"] = (validate.as_complex_vector("complement", complement) if complement is not None
-                          else np.zeros(0, dtype=complex))
+    sets["complement"] = (validate.as_complex_vector("complement_poles", complement_poles)
+                          if complement_poles is not None else np.zeros(0, dtype=complex))
     wanted = dict(dims, complement=nu0)
     for name, lam in sets.items():
         if lam.size != wanted[name]:
@@ -228,7 +268,7 @@ def _check_sets(model, dims, eigenvalues, complement):
 
 
 def _residual_generator(model, L, names, spaces, rtol):
-    """Observer with gain L (A + LC) and per-fault projected residual coordinates."""
+    """Observer with gain L (state matrix A − LC) and per-fault projected residual coordinates."""
     C = model.C
     projectors, blocks, res_names, isolates = {}, [], [], []
     for name in names:
@@ -243,16 +283,16 @@ def _residual_generator(model, L, names, spaces, rtol):
         res_names += [f"{name}[{k}]" for k in range(Q.shape[1])]
         isolates += [name] * Q.shape[1]
     Q = np.hstack(blocks)
-    # the report's A + LC is an observer with gain −L: r = y − C x̂ − Du u, x̂' = (A + LC) x̂ + (Bu + L Du) u − L y
-    gen = observer_generator(model, -L, res_names, Q, isolates)
+    # L is the observer gain (the report's matrix negated): r = y − C x̂ − Du u, x̂' = (A − LC) x̂ + (Bu − L Du) u + L y
+    gen = observer_generator(model, L, res_names, Q, isolates)
     return gen, projectors
 
 
 def beard_jones(
     model: FaultModel,
-    faults: Mapping[str, np.ndarray] | Sequence[str],
-    eigenvalues: Mapping[str, Sequence[complex]],
-    complement: Sequence[complex] | None = None,
+    targets: Mapping[str, np.ndarray] | Sequence[str] | str,
+    poles: Mapping[str, Sequence[complex]],
+    complement_poles: Sequence[complex] | None = None,
     *,
     sweeps: int = 100,
     seed: int = 0,
@@ -263,10 +303,18 @@ def beard_jones(
     Parameters
     ----------
     model : FaultModel (continuous or discrete; ``D`` of the controls is handled).
-    faults : fault maps by name, or names resolved by :func:`resolve_faults`.
-    eigenvalues : for each fault, ``ν_i = dim T_i`` distinct eigenvalues (Ξ_i).
-    complement : the ``ν_0 = n − Σ ν_i`` remaining eigenvalues (Ξ_0).
+    targets : the faults to detect and isolate: fault names (``'<output>_sensor'``,
+        ``'<output>_sensor:magnitude'``, ``'<control>_actuator'``, fault inputs of the model; see
+        :func:`resolve_faults`) or a mapping name → fault map ``F``.  A bare signal name raises
+        :class:`ParameterError`.
+    poles : for each fault, ``ν_i = dim T_i`` distinct eigenvalues of ``A − L C`` (Ξ_i).
+    complement_poles : the ``ν_0 = n − Σ ν_i`` remaining eigenvalues (Ξ_0).
     sweeps, seed : eigenvector selection (sweep limit, seeded start).
+
+    Returns
+    -------
+    BeardJonesDesign
+        ``gain`` is the observer gain (``A − L C``); ``report_gain`` the report's ``L`` of ``A + L C``.
 
     Raises
     ------
@@ -276,13 +324,13 @@ def beard_jones(
         its set; a set of the wrong size, unstable, not self-conjugate or repeated; an
         eigenvalue that admits no left eigenvector.
     ParameterError
-        A bad argument: not a FaultModel, eigenvalues that are not finite numbers, negative sweeps.
+        A bad argument: not a FaultModel, poles that are not finite numbers, negative sweeps.
     """
     validate.integer("sweeps", sweeps, minimum=0)
     validate.integer("seed", seed, minimum=0)
     if rtol is not None:
         validate.non_negative("rtol", rtol)
-    maps = resolve_faults(model, faults)
+    maps = resolve_faults(model, targets)
     A, C = model.A, model.C
     spaces = {k: linalg.detection_space(A, C, F, rtol) for k, F in maps.items()}
     dims = {k: T.shape[1] for k, T in spaces.items()}
@@ -297,7 +345,7 @@ def beard_jones(
         what = ", ".join(f"({keys[i]}, {keys[j]})" for i, j in pairs) or f"the set {keys} (no pair alone)"
         raise DesignError(
             f"faults not output separable: {what}; their output images C T_i are dependent. Keep only the "
-            "magnitude direction of a sensor fault ('<output>:magnitude'), or put them in different filters"
+            "magnitude direction of a sensor fault ('<output>_sensor:magnitude'), or put them in different filters"
         )
     mutual, joint, union = linalg.mutually_detectable(A, C, list(maps.values()))
     if not mutual:
@@ -306,7 +354,7 @@ def beard_jones(
             f"the union of the single-fault zeros {np.round(union, 6).tolist()}; the extra zeros would be fixed "
             "filter eigenvalues. Use restricted_diagonal() or a UIO bank"
         )
-    sets = _check_sets(model, dims, eigenvalues, complement)
+    sets = _check_sets(model, dims, poles, complement_poles)
     scale = max(np.linalg.norm(A, 2), 1.0)
     for k, F in maps.items():
         zeros, _ = linalg.invariant_zeros(A, C, F)
@@ -316,10 +364,11 @@ def beard_jones(
                     f"fault {k!r} has the invariant zero {z:.6g}, a fixed eigenvalue of its detection space; "
                     f"include it in its set (given {sets[k].tolist()})"
                 )
-    L, Vm, order, sigma, bound = _assign(model, spaces, sets, sweeps, seed, rtol)
-    poles = scipy.linalg.eigvals(A + L @ C)
+    L_report, Vm, order, sigma, bound = _assign(model, spaces, sets, sweeps, seed, rtol)
+    L = -L_report  # the observer gain: A + L_report C = A − L C
+    achieved = scipy.linalg.eigvals(A - L @ C)
     gen, projectors = _residual_generator(model, L, list(spaces), spaces, rtol)
-    return BeardJonesDesign(gen, L, sets, poles, spaces, projectors, Vm, order, sigma, bound)
+    return BeardJonesDesign(gen, L, sets, achieved, spaces, projectors, Vm, order, sigma, bound, model=model)
 
 
 @dataclass(frozen=True, eq=False)
@@ -333,11 +382,29 @@ class RestrictedDiagonalDesign:
     generator: ResidualGenerator
     filters: dict[str, BeardJonesDesign]
     nuisance_spaces: dict[str, np.ndarray]
+    model: FaultModel | None = field(default=None, repr=False, kw_only=True)  # set by the design function
+
+    def internal_form(self) -> FaultModel:
+        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
+
+        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
+        model the design was made for (field ``model``, set by the design function).
+        """
+        return joined_form(self, self.model)
+
+    def report(self) -> dict:
+        """By target fault: ``gains`` (each filter's ``gain``), ``poles``, ``nuisance_spaces`` (``T̂_i``),
+        ``projectors`` (``Ĥ_i``) and ``condition_numbers`` (of each filter's left eigenvectors)."""
+        f = self.filters
+        return {"gains": {k: d.gain for k, d in f.items()}, "poles": {k: d.poles for k, d in f.items()},
+                "nuisance_spaces": self.nuisance_spaces,
+                "projectors": {k: d.projectors[k] for k, d in f.items()},
+                "condition_numbers": {k: d.condition_number for k, d in f.items()}}
 
 
 def restricted_diagonal(
     model: FaultModel,
-    faults: Mapping[str, np.ndarray] | Sequence[str],
+    targets: Mapping[str, np.ndarray] | Sequence[str],
     poles: Sequence[complex],
     *,
     sweeps: int = 100,
@@ -353,10 +420,14 @@ def restricted_diagonal(
     ``F_i``.  Unlike :func:`beard_jones` this needs neither mutual detectability nor
     ``Σ ν_i ≤ n`` — only that each target stays visible: ``C T_i ⊄ C T̂_i``.
 
-    ``poles``: n stable, distinct, self-conjugate eigenvalues used by every filter; the
-    first ``dim T̂_i`` go to the nuisance space (keep conjugate pairs adjacent).
+    ``targets``: at least two fault names (as in :func:`beard_jones`) or a mapping name → ``F``;
+    each is the target of one filter and a complementary (nuisance) fault of all the others.
+
+    ``poles``: n stable, distinct, self-conjugate eigenvalues of ``A − L C`` used by every filter;
+    the first ``dim T̂_i`` go to the nuisance space (keep conjugate pairs adjacent).  Each filter's
+    ``gain`` is the observer gain (``A − L C``), as in :func:`beard_jones`.
     """
-    maps = resolve_faults(model, faults)
+    maps = resolve_faults(model, targets)
     if len(maps) < 2:
         raise DesignError("a restricted-diagonal bank needs at least two faults")
     poles = validate.as_complex_vector("poles", poles)
@@ -381,14 +452,15 @@ def restricted_diagonal(
         nuis_name = f"not_{target}"
         sets = {nuis_name: poles[:nu]}
         sub = _check_sets(model, {nuis_name: nu}, sets, poles[nu:])
-        L, Vm, order, sigma, bound = _assign(model, {nuis_name: T_hat}, sub, sweeps, seed, rtol)
+        L_report, Vm, order, sigma, bound = _assign(model, {nuis_name: T_hat}, sub, sweeps, seed, rtol)
+        L = -L_report  # the observer gain (A − L C)
         # residual: every output direction outside C T̂ (a.11), tied to the target
         H = np.eye(model.p) - image_hat @ image_hat.T
         Q = linalg.orth(H, rtol)
         names = [f"{target}[{k}]" for k in range(Q.shape[1])]
-        gen = observer_generator(model, -L, names, Q, [target] * len(names))
-        filters[target] = BeardJonesDesign(gen, L, sub, scipy.linalg.eigvals(A + L @ C), {nuis_name: T_hat},
-                                           {target: H}, Vm, order, sigma, bound)
+        gen = observer_generator(model, L, names, Q, [target] * len(names))
+        filters[target] = BeardJonesDesign(gen, L, sub, scipy.linalg.eigvals(A - L @ C), {nuis_name: T_hat},
+                                           {target: H}, Vm, order, sigma, bound, model=model)
         spaces[target] = T_hat
         gens.append(gen)
-    return RestrictedDiagonalDesign(stack_generators(gens), filters, spaces)
+    return RestrictedDiagonalDesign(stack_generators(gens), filters, spaces, model=model)

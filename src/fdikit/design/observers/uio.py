@@ -12,7 +12,7 @@ needs ``(C, A1)`` detectable — the unobservable modes of ``(C, A1)`` are the i
 zeros of ``(A, E, C)``, so those must be stable (Chen & Patton 1999, §3.2; Darouach,
 Zasadzinski & Xu 1994).  The residual ``r = ȳ − C x̂`` is then blind to ``v`` and to ``u``
 and sees the one fault left out of ``E``: the single-fault filter of Massoumnia, Verghese &
-Willsky (1989) that Murray (2012, §1.1, Remark 2.4; research note §3.6–§4) uses as the
+Willsky (1989) that Murray 2012, §1.1.1 and Remark 2.4 uses as the
 baseline — all faults but one in an unobservable subspace, and a bank of them needs no
 mutual detectability.
 
@@ -52,14 +52,15 @@ must be stable); the design's ``fixed_modes`` and ``notes`` report them.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg
 
 from fdikit import linalg, validate
-from fdikit.errors import DesignError, ModelError
+from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.model import FaultModel
+from fdikit.protocols import joined_form
 from fdikit.residuals import ResidualGenerator
 
 __all__ = ["UIODesign", "uio", "uio_bank", "unknown_input_matrix"]
@@ -109,6 +110,25 @@ class UIODesign:
     target_gain: float
     decoupling: dict[str, float]
     notes: tuple[str, ...] = ()
+    model: FaultModel | None = field(default=None, repr=False, kw_only=True)  # set by the design function
+
+    def internal_form(self) -> FaultModel:
+        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
+
+        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
+        model the design was made for (field ``model``, set by the design function).
+        """
+        return joined_form(self, self.model)
+
+    def report(self) -> dict:
+        """``target``, ``decoupled`` (inputs the residual is blind to), the UIO matrices ``H``, ``T``, ``K``,
+        ``K1``, ``N``, ``poles`` (of ``N``), ``fixed_modes``, ``visibility`` (``σ_min(C E₀) / ‖C‖``),
+        ``target_gain`` (peak fault-to-residual gain) and ``decoupling`` (peak gain of each decoupled input
+        relative to ``target_gain``), ``notes``."""
+        return {"target": self.target, "decoupled": self.decoupled, "H": self.H, "T": self.T, "K": self.K,
+                "K1": self.K1, "N": self.N, "poles": self.poles, "fixed_modes": self.fixed_modes,
+                "visibility": self.visibility, "target_gain": self.target_gain, "decoupling": self.decoupling,
+                "notes": self.notes}
 
 
 # ---------------------------------------------------------------------- unknown-input directions
@@ -244,16 +264,20 @@ def _freqresp(A, B, C, D, omega, dt) -> np.ndarray:
 
 # ---------------------------------------------------------------------- design
 def uio(
-    model: FaultModel, target: str, nuisance: Sequence[str] | None = None, poles: Sequence[complex] | None = None
+    model: FaultModel, targets: str | Sequence[str], nuisance: Sequence[str] | str = (),
+    poles: Sequence[complex] | None = None
 ) -> UIODesign:
     """Unknown-input observer residual generator for one target fault (Chen & Patton 1999, §3.2).
 
     Parameters
     ----------
     model : FaultModel (continuous or discrete) with fault inputs (group ``f``).
-    target : name of the fault the residual must respond to.
-    nuisance : names of the faults to decouple; default every other fault.  Disturbances
-        (group ``d``) are always decoupled; noise ``w`` is not.
+    targets : the fault the residual must respond to: the name of a fault input of the model
+        (``'<output>_sensor'`` after :meth:`~fdikit.FaultModel.with_sensor_faults`, ``'<control>_actuator'``,
+        …), or a one-element sequence of it.  A bare signal name raises :class:`ParameterError`.
+    nuisance : fault inputs to decouple: ``()`` (default) none, ``'others'`` every other fault input
+        of the model, or a sequence of names.  Disturbances (group ``d``) are always decoupled;
+        noise ``w`` is not.
     poles : the assignable poles of ``N`` — ``n − len(fixed_modes)`` stable values (conjugate
         pairs), placed with :func:`control.place` on the observable part of ``(C, T A)``.  Default
         (``None``): ``K1`` is the gain of the unit-weight steady-state Kalman filter of that part
@@ -267,6 +291,8 @@ def uio(
 
     Raises
     ------
+    ParameterError
+        A signal name instead of a fault name, or more than one target (use :func:`uio_bank`).
     ModelError
         Unknown fault names, or the target among the nuisance faults.
     DesignError
@@ -281,7 +307,7 @@ def uio(
     >>> from fdikit.design.observers.uio import uio
     >>> m = FaultModel(A=np.diag([-1.0, -2.0, -3.0]), C=[[1, 0, 0], [0, 1, 0], [0, 0, 1]],
     ...                Bu=[[1.0], [1.0], [0.0]], controls=["u"]).with_sensor_faults(["y0", "y2"])
-    >>> d = uio(m, "y2_sensor", poles=[-4.0, -5.0, -6.0])
+    >>> d = uio(m, "y2_sensor", nuisance="others", poles=[-4.0, -5.0, -6.0])
     >>> d.generator.residuals, d.decoupling["y0_sensor"] < 1e-12, d.decoupling["u"] < 1e-12
     (('y2_sensor[0]', 'y2_sensor[1]'), True, True)
     """
@@ -289,13 +315,17 @@ def uio(
 
     if not isinstance(model, FaultModel):
         raise ModelError(f"uio needs a FaultModel, got {type(model).__name__}")
-    target = str(target)
+    given = linalg.check_fault_inputs(model, targets, "target")
+    if len(given) != 1:
+        raise ParameterError(f"uio detects one target fault, got {list(given)}; use uio_bank for several")
+    target = given[0]
     jt = model.index("f", target)[0]
     if nuisance is None:
+        raise ParameterError("nuisance=None is not a fault set; use () for none or 'others' for every other fault")
+    if isinstance(nuisance, str) and nuisance == "others":
         nuisance = tuple(f for f in model.faults if f != target)
     else:
-        nuisance = (nuisance,) if isinstance(nuisance, str) else tuple(dict.fromkeys(str(f) for f in nuisance))
-        model.index("f", list(nuisance))
+        nuisance = tuple(dict.fromkeys(linalg.check_fault_inputs(model, nuisance, "nuisance")))
         if target in nuisance:
             raise ModelError(f"the target {target!r} is also listed as a nuisance fault; remove it from nuisance")
     A, C, Bu, Du = model.A, model.C, model.Bu, model.Du
@@ -413,36 +443,41 @@ def uio(
     return UIODesign(
         generator=gen, target=target, decoupled=decoupled, E=E, H=H, T=T, K=K, K1=K1, N=N, poles=achieved,
         fixed_modes=fixed, residual_basis=Uperp, visibility=visibility, omega=omega, target_gain=target_gain,
-        decoupling=decoupling, notes=tuple(notes),
+        decoupling=decoupling, notes=tuple(notes), model=model,
     )
 
 
 def uio_bank(
     model: FaultModel,
-    faults: Sequence[str] | None = None,
+    targets: Sequence[str] | str | None = None,
+    nuisance: Sequence[str] | str = (),
     *,
     poles: Sequence[complex] | None = None,
-    also_decouple: Sequence[str] = (),
 ) -> list[UIODesign]:
     """A bank of UIOs (generalised observer scheme): one per fault, each decoupled from the others.
 
     Parameters
     ----------
     model : FaultModel
-    faults : the faults to isolate (default all of the model's).  UIO ``i`` targets ``faults[i]``
-        and decouples every other fault of ``faults`` plus ``also_decouple`` (and the disturbances);
-        faults of the model outside both lists are neither targeted nor decoupled.
+    targets : the fault inputs to isolate (default all of the model's).  UIO ``i`` targets
+        ``targets[i]`` and decouples every other target plus ``nuisance`` (and the disturbances).
+    nuisance : fault inputs decoupled by every member: ``()`` (default) none, ``'others'`` every
+        fault input of the model that is not a target, or a sequence of names.  Faults of the model
+        that are neither targets nor nuisance are neither targeted nor decoupled.
     poles : passed to every :func:`uio` (``None``: each design's default).
 
     Stack the bank into one generator with ``stack_generators([d.generator for d in bank])``.
     Unlike a Beard–Jones bank, no mutual detectability is needed (Murray 2012, §1.1): each
     UIO only needs its own rank and zero conditions.
     """
-    faults = tuple(model.faults if faults is None else ([faults] if isinstance(faults, str) else faults))
+    faults = model.faults if targets is None else linalg.check_fault_inputs(model, targets, "target")
     if not faults:
         raise ModelError("uio_bank needs at least one fault; the model has none (add faults with with_*_faults)")
-    model.index("f", list(faults) + list(also_decouple))
-    extra = tuple(f for f in also_decouple if f not in faults)
+    if nuisance is None:
+        raise ParameterError("nuisance=None is not a fault set; use () for none or 'others' for every other fault")
+    if isinstance(nuisance, str) and nuisance == "others":
+        nuisance = model.faults
+    extra = tuple(f for f in linalg.check_fault_inputs(model, nuisance, "nuisance") if f not in faults)
     bank = []
     for f in faults:
         try:

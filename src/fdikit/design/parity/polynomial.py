@@ -16,10 +16,10 @@ residual generator (2.6) ``r = d⁻¹(q) N(q) L(q)[z]``, whose fault map is (2.7
 matrix ``H̄`` (block row ``i`` holds ``H_0 … H_dH`` from block column ``i``), and fixes the
 DC gain by (2.8b)/(2.9) ``Σ N̄ F̄ / Σ d̄ = −1`` so that ``G(1) = 1``.
 
-Choices and errata (research note §3.2, §3.4, §4 A5–A7, §8):
+Choices and errata (van der Ploeg 2018, Lemma 2-1.2, Sec. 4-3-1):
 
 * the sign of the DC condition is that of (2.8b)/(2.9), ``−1``; the case-study LP (4.8) prints
-  ``+1``, which gives ``G(1) = −1`` under (2.7) (note §8 item 10);
+  ``+1``, which gives ``G(1) = −1`` under (2.7), contradicting the unit DC gain the text asks for;
 * the thesis solves the LP (2.9) with GUROBI.  With the minimal degree the left null space is
   one-dimensional and the solution is unique; otherwise fdikit takes the least-norm ``N̄`` in
   the null space that meets the DC condition (an orthogonal projection, no LP solver);
@@ -38,7 +38,7 @@ Choices and errata (research note §3.2, §3.4, §4 A5–A7, §8):
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -46,6 +46,7 @@ from fdikit import linalg
 from fdikit.dae import DAEModel, dae_form
 from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.model import FaultModel
+from fdikit.protocols import joined_form, no_internal_form
 from fdikit.residuals import ResidualGenerator
 
 __all__ = [
@@ -283,6 +284,29 @@ class PolynomialParityDesign:
             nf = nf[:-1]
         return np.roots(nf[::-1])
 
+    model: FaultModel | None = field(default=None, repr=False, kw_only=True)  # set by the design function
+
+    def internal_form(self) -> FaultModel:
+        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
+
+        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
+        discrete FaultModel the design was made from (field ``model``).  A design made directly on a
+        :class:`~fdikit.dae.DAEModel` has no state-space model to join and raises
+        :class:`~fdikit.errors.DesignError`.
+        """
+        if self.model is None:
+            no_internal_form(self, "it was designed on a DAEModel, which has no state-space form to join with the "
+                                   "filter; design it from the discrete FaultModel (parity_filter converts it)")
+        return joined_form(self, self.model)
+
+    def report(self) -> dict:
+        """``fault``, ``degree`` (``d_N``), ``null_dimension``, ``N`` (coefficients ``N_i``), ``denominator`` and
+        ``poles`` (of ``d(q)``), ``decoupling`` (``‖N̄ H̄‖ / (‖N̄‖ ‖H̄‖)``), ``dc_gain`` (``G(1)``, 1 by design)
+        and ``fault_zeros``."""
+        return {"fault": self.fault, "degree": self.degree, "null_dimension": self.null_dimension, "N": self.N,
+                "denominator": self.denominator, "poles": self.poles, "decoupling": self.decoupling,
+                "dc_gain": self.dc_gain, "fault_zeros": self.fault_zeros}
+
 
 def parity_filter(
     model: DAEModel | FaultModel,
@@ -366,4 +390,5 @@ def parity_filter(
     return PolynomialParityDesign(
         generator=gen, dae=dae, fault=fault, degree=dN, null_dimension=V.shape[0], N=Nb.reshape(dN + 1, -1),
         NL=NL, NF=NF, denominator=den, poles=p, decoupling=decoupling,
+        model=model if isinstance(model, FaultModel) else None,
     )

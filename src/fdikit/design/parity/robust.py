@@ -20,7 +20,7 @@ maps ``G = [H̃_os, H̃_us, H_ds, H̃_ds]`` (18) against the fault map ``H_fs``:
 * LPV (32)–(46), :func:`robust_lpv_parity`: ``W₂(ρ) = Σ_j α̃_j(ρ) W_j`` from the polytopic
   machinery of :mod:`fdikit.design.parity.polytope` (adjugate polynomial of ``Γ_κ(ρ)``, Property 1
   vertices, vertex repair (41)–(42), one vertex LMI (39)–(40) with ``cᵀW_j = 1``).
-* ``method="adjugate"`` (beyond the paper, note G24): ``W_j = Γ̃_j c`` unrepaired, so
+* ``method="adjugate"`` (beyond the paper, an fdikit option): ``W_j = Γ̃_j c`` unrepaired, so
   ``W₂(ρ) = adj Γ_κ(ρ) c ∝ Γ_κ(ρ)⁻¹ c``, the pointwise optimum of 𝒫₂ with ``cᵀW₂ = 1``.
 
 The stacked and δ-expanded matrices (14) come from :mod:`fdikit.lpv`, the parity matrix
@@ -49,6 +49,7 @@ from fdikit.design.parity.polytope import (
 from fdikit.design.parity.state_space import lpv_parity_residuals, parity_matrix, regular_rows
 from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.lpv import LPVModel, Uncertainty, lpv_stacked_matrices, uncertain_stacked_matrices
+from fdikit.protocols import no_internal_form
 from fdikit.residuals import Residuals
 from fdikit.trace import Trace
 
@@ -86,7 +87,7 @@ def robust_criteria(lpv: LPVModel, uncertainties: Sequence[Uncertainty], rho, s:
     ----------
     fault_model : ``"sequence"`` (the paper: ``H_F = H_fs``, the fault an arbitrary sequence over
         the window) or ``"constant"`` (``H_F = H_fs (𝟙 ⊗ I)``, a fault constant over the window,
-        note G25; Γ₂ then has rank ≤ #faults).
+        an fdikit option; Γ₂ then has rank ≤ #faults).
     weights : per-block weights of G, keys ``"os", "us", "ds", "ds_tilde"`` (default 1, as printed).
     nuisance_faults : faults moved into the unknown inputs (§2.4, (4)); the others are targets.
         (The paper's sentence after (4) swaps f₁ and f₂; the construction is followed.)
@@ -377,6 +378,25 @@ class RobustParityDesign:
         """The U-LPV residual (16) of a trace (see :func:`lpv_parity_residuals`)."""
         return lpv_parity_residuals(self.lpv, trace, rho, self.s, W2=self.w2, mode=mode, rows=self.rows,
                                     names=[name])
+
+    @property
+    def generator(self) -> RobustParityDesign:
+        """The design itself: a ρ-scheduled parity vector, run with :meth:`residuals` ``(trace, rho)``."""
+        return self
+
+    def internal_form(self):
+        """Not available: raises :class:`~fdikit.errors.DesignError` (the parity vector varies with ρ)."""
+        no_internal_form(self, "the parity vector W2(rho) is scheduled on the LPV parameter, so plant and filter "
+                               "in series are not an LTI FaultModel; use residuals(trace, rho) and criterion(rho)")
+
+    def report(self) -> dict:
+        """``method``, ``s``, ``rows``, ``order``, ``kappa`` and ``kappa_max`` (κ and its largest valid value),
+        ``gamma`` (LMI bounds or None), ``W_vertices``, ``n_repaired`` (replaced eigenvalues per vertex),
+        ``degrees`` (ρ-degrees), ``box_vertices`` and ``truncation_error``."""
+        return {"method": self.method, "s": self.s, "rows": self.rows, "order": self.order, "kappa": self.kappa,
+                "kappa_max": self.kappa_max, "gamma": self.gamma, "W_vertices": self.W_vertices,
+                "n_repaired": self.n_repaired, "degrees": self.degrees, "box_vertices": self.box_vertices,
+                "truncation_error": self.truncation_error}
 
 
 def robust_lpv_parity(

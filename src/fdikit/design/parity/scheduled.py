@@ -9,7 +9,7 @@ takes the parity row of Theorem 3-3.4::
     N̄_k*(γ) = ½ F̄_{k,j}ᵀ (I + γ H̄_k H̄_kᵀ)⁻¹                                    (3.17)
 
 or its exact limit ``γ → ∞``, ``N̄_k = ½ (P_k F̄_{k,j})ᵀ`` with ``P_k`` the orthogonal projector
-onto the left null space of ``H̄_k`` (``gamma=None``; research note §3.3).  ``N̄_k`` is then
+onto the left null space of ``H̄_k`` (``gamma=None``).  ``N̄_k`` is then
 scaled so that ``Σ N̄_k F̄_k = −d(1)`` ((4.18)–(4.19): the fault-to-residual DC gain is 1),
 and the residual follows the input-output form of Corollary 3-3.5::
 
@@ -17,7 +17,7 @@ and the residual follows the input-output form of Corollary 3-3.5::
 
 so ``r(k)`` uses ``z`` and ``ρ`` up to ``k − 1`` only (strictly proper).
 
-Errata and reconstruction choices (research note §3.3, §4 A13, §8 item 13):
+Errata and reconstruction choices (van der Ploeg 2018, Lemma 3-3.2, Thm 3-3.4, Sec. 4-3-4):
 
 * the windows are time-consistent: block row ``i`` of ``H̄_k`` holds ``H_j(ρ(τ_i))`` at block
   column ``i + j`` (columns ``x(τ_0) … x(τ_{d_N} + d_H)``), ``F̄_k``, ``L̄_k`` likewise.  The
@@ -56,6 +56,7 @@ from fdikit.design.parity.polynomial import time_varying_bar as _bar
 from fdikit.errors import DataError, DesignError, ModelError, ParameterError
 from fdikit.linalg import rank
 from fdikit.model import FaultModel
+from fdikit.protocols import no_internal_form
 from fdikit.residuals import Residuals, check_signals
 from fdikit.trace import Trace
 
@@ -323,6 +324,26 @@ class ScheduledResidualGenerator:
     def online(self, *, recovery_tol: float = 0.1) -> ScheduledStepper:
         """A stepper with zero initial history (like ``run``) and the same gap rule."""
         return ScheduledStepper(self, recovery_tol=recovery_tol)
+
+    @property
+    def generator(self) -> ScheduledResidualGenerator:
+        """The scheduled filter itself (what :func:`scheduled_parity_filter` returns is its own generator)."""
+        return self
+
+    def internal_form(self):
+        """Not available: raises :class:`~fdikit.errors.DesignError` (the parity row follows ρ).
+
+        ``reference.internal_form()`` gives the LTI internal form at the design point.
+        """
+        no_internal_form(self, "the parity row follows the measured schedule rho, so plant and filter in series "
+                               "are not an LTI FaultModel; reference.internal_form() gives it at the design point")
+
+    def report(self) -> dict:
+        """``fault``, ``degree``, ``poles``, ``gamma`` (None: exact projection), ``column``, ``schedule`` (the trace
+        column of ρ), ``window`` (past samples read) and ``reference`` (the design-point report)."""
+        return {"fault": self.fault, "degree": self.degree, "poles": self.poles, "gamma": self.gamma,
+                "column": self.column, "schedule": self.schedule, "window": self.window,
+                "reference": self.reference.report()}
 
 
 class ScheduledStepper:

@@ -9,7 +9,7 @@ independent rows, in order) and the ``q = (s+1)p − n`` others ``H_os2``, and s
 
 so that ``r = W₂ᵀ P (Y_s − H_us U_s)`` (9), (12) is zero on healthy, noise-free data for any
 ``W₂``.  fdikit runs the window backwards, ``Y_s(k) = [y(k−s); …; y(k)]``, so the residual
-at sample ``k`` is causal (research note G14); in the frozen mode ρ is frozen at the
+at sample ``k`` is causal (uses samples up to ``k`` only); in the frozen mode ρ is frozen at the
 newest sample ``ρ_k``.  :func:`parity_design` builds the LTI residual generator (an FIR
 :class:`~fdikit.residuals.ResidualGenerator`); :func:`lpv_parity_residuals` recomputes ``P(ρ)``
 at every sample of a trace (16).  The robust choice of ``W₂`` is in
@@ -19,7 +19,7 @@ at every sample of a trace (16).  The robust choice of ``W₂`` is in
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -27,6 +27,7 @@ from fdikit import validate
 from fdikit.errors import DataError, DesignError, ModelError, ParameterError
 from fdikit.lpv import LPVModel, StackedMatrices, check_horizon, lpv_stacked_matrices, stacked_matrices
 from fdikit.model import FaultModel
+from fdikit.protocols import joined_form
 from fdikit.residuals import ResidualGenerator, Residuals
 from fdikit.trace import Trace
 
@@ -147,6 +148,21 @@ class ParityDesign:
         """Dimension of the parity space, ``(s+1)p − n``."""
         return self.P.shape[0]
 
+    model: FaultModel | None = field(default=None, repr=False, kw_only=True)  # set by the design function
+
+    def internal_form(self) -> FaultModel:
+        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
+
+        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
+        model the design was made for (field ``model``, set by the design function).
+        """
+        return joined_form(self, self.model)
+
+    def report(self) -> dict:
+        """``s`` (horizon), ``q`` (parity-space dimension), ``rows`` (of ``H_os1``), ``P`` (parity basis),
+        ``W2`` (free parameter) and ``W`` (parity matrix ``Pᵀ W₂``)."""
+        return {"s": self.s, "q": self.q, "rows": self.rows, "P": self.P, "W2": self.W2, "W": self.W}
+
 
 def _as_w2(W2, q: int) -> np.ndarray:
     W2 = np.eye(q) if W2 is None else validate.as_array("W2", W2, finite=False)
@@ -213,7 +229,7 @@ def parity_design(model: FaultModel, s: int | None = None, *, W2=None, rows: Seq
     names = tuple(f"parity_{i}" for i in range(k)) if names is None else tuple(names)
     gen = ResidualGenerator(A, B, C, M[s], model.controls, model.outputs, names, model.dt,
                             tuple(isolates) if isolates is not None else ())
-    return ParityDesign(gen, P, W2, W, st, tuple(rows), s)
+    return ParityDesign(gen, P, W2, W, st, tuple(rows), s, model=model)
 
 
 # ---------------------------------------------------------------------------------------------- LPV runner

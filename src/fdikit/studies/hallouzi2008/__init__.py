@@ -12,7 +12,7 @@ methods, Table 3.1 and the model-set comparison (Table 3.3), and the report comm
 * :mod:`fdikit.studies.hallouzi2008.example_3_1` — Example 3.1: basis conditioning vs degree of observability of
   model pairs (Hallouzi 2008, §3.3.1, Table 3.1).
 * :mod:`fdikit.studies.hallouzi2008.report` — One command for the multiple-model reproductions of Hallouzi 2008
-  (research note §4.2, items 17–20).
+  (§2.4, §3.3.1, §3.6).
 """
 
 import lazy_loader as lazy

@@ -48,7 +48,7 @@ class Example31Result:
     basis: np.ndarray
 
     def frequency(self) -> dict[str, float]:
-        """Fraction of model sets with each qualitative pattern of Table 3.1 (research note §3.3)."""
+        """Fraction of model sets with each qualitative pattern of Table 3.1 (Hallouzi 2008, §3.3.1)."""
         o, b = self.observability, self.basis
         i = {p: k for k, p in enumerate(PAIRS)}
         return {

@@ -8,7 +8,7 @@ augmented EKF (Table 2.3; the thesis filter for Table 3.3) or the dual CMF (Tabl
 weights.  Faults are reconstructed as ``f1 = 1 − Σ_{f1^(i)=0} μ̂^(i)`` (thesis: ``1 − (μ̂^2 + μ̂^4)``) and
 likewise for ``f2`` (§3.6.2, Fig. 3.9); state estimates are scored by the VAF (3.53).
 
-Thesis gaps filled here (research note §3.5 / §5 [GAP]; all are assumptions):
+Thesis gaps filled here (Hallouzi 2008, §3.6 leaves them open; all are assumptions):
 
 - trajectory (Fig. 3.6 has no numbers): ``k1(t) = 1 + 0.7 sin(2π t/100)``, ``m3(t) = 1 + 0.7 sin(2π t/60 + π/4)``
   (a Lissajous covering most of ``[0.3, 1.7]²``), parameters frozen over each sample (ZOH, exact ``expm``);
@@ -319,8 +319,9 @@ def msd_observability_comparison(realizations: int = 5, seed: int | None = 0, *,
     (``μ2 = 1 − μ1``) is averaged over the last ``samples`` samples of each of ``realizations`` random sequences.
 
     Thesis gaps filled (assumptions): ``m3`` is drawn i.i.d. from the prior, clipped to [0.2, 1.8], and held per
-    sample; ``n_steps = 2000`` samples (5 s) from ``x = 0``; the augmentation with one free weight (research note
-    §5).  The absolute numbers depend on these choices; the ratio does not (measured 16.17 in every realization,
+    sample; ``n_steps = 2000`` samples (5 s) from ``x = 0``; the augmentation with one free weight (the thesis does not
+    say how the weights enter).  The absolute numbers depend on these choices; the ratio does not (measured 16.17
+    in every realization,
     the thesis's 16.1–16.15).
     """
     if realizations < 1 or samples < 1 or n_steps < samples:

@@ -1,12 +1,12 @@
-"""One command for the multiple-model reproductions of Hallouzi 2008 (research note §4.2, items 17–20).
+"""One command for the multiple-model reproductions of Hallouzi 2008 (§2.4, §3.3.1, §3.6).
 
 :func:`multiple_model_report` runs, in turn,
 
-1. the target-tracking Monte Carlo (§2.4.2, item 17),
-2. the B747 linear FDI Monte Carlo (§2.4.1, item 18),
-3. Example 3.1 / Table 3.1 (§3.3.1, item 19),
+1. the target-tracking Monte Carlo (§2.4.2, Figs. 2.4–2.5),
+2. the B747 linear FDI Monte Carlo (§2.4.1, Table 2.6),
+3. Example 3.1 / Table 3.1 (§3.3.1),
 4. the MSD runs of the OD, CP and LV model sets (§3.6.2, Table 3.3) and the OD vs minimum-mismatch
-   conditioning (§3.6.4, Table 3.4) (item 20),
+   conditioning (§3.6.4, Table 3.4),
 
 and writes ``summary.md`` and one PNG plot per part into ``out``.  Each finished part is kept (atomically) in
 ``out/parts-*/`` at once, so a killed run resumes where it stopped; ``summary.md`` is assembled from the parts

@@ -9,7 +9,8 @@ Interval ends are inclusive.
 with Π of (2.68)) on the same runs and returns the Monte-Carlo RMSE per sample (2.64) of position,
 velocity and reconstructed B (``B̂ = Σ μ̂^(i) B^(i)``) and the mean weights.
 
-Thesis gaps filled here (research note §3.2): the filters start from ``x̂_0 = x_0 + e``, ``e ~ N(0, R)``,
+Thesis gaps filled here (Hallouzi 2008, §2.4.2 leaves them open): the filters start from
+``x̂_0 = x_0 + e``, ``e ~ N(0, R)``,
 ``P_0 = R``, uniform weights; the EKF weight covariance starts at ``I/12``.  The weights estimated at
 sample k are compared with ``B_k``; both CM filters' μ̂_k are driven by the transition k−1 → k, a
 one-sample lag that is negligible against the 51-sample maneuvers.

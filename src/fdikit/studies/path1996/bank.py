@@ -26,7 +26,7 @@ assumption, documented here and in ``docs/methods/beard_jones.md``):
 * Eigenvalue sets: filter 4 as printed (§4.2.2: throttle {−4, −9}, brake {−5, −8},
   steering {−6}, air mass {−7}; Ξ_0 not printed); filter 3's wheel speed fl {−3, −10}
   as printed, the other sets chosen in the report's range ("reasonable response time but
-  not unrealistically fast"), research note G6.
+  not unrealistically fast", §4.2); these are fdikit's choices.
 * Residual scaling (§5.1.1): each fault's residual is divided by the steady-state
   magnitude a nominal fault produces in the linear model, so a nominal fault gives 1.
 """
@@ -50,12 +50,12 @@ __all__ = [
     "PathBank", "path_bank", "path_runs", "FILTER_GROUPS", "EIGENVALUES", "nominal_fault_sizes", "path_fault_model",
 ]
 
-#: Fault specs per filter (output names = sensor faults, controls = actuator faults).
+#: Fault names per filter (``<output>_sensor``, ``<control>_actuator``; ``:magnitude`` keeps ``A F¹`` only).
 FILTER_GROUPS: dict[str, list[str]] = {
-    "filter1": ["engine_speed", "accel_y", "accel_z", "pitch_rate"],
-    "filter2": ["accel_x", "roll_rate", "yaw_rate", "engine_speed"],
-    "filter3": ["wheel_speed_fl", "wheel_speed_fr", "wheel_speed_rl", "wheel_speed_rr"],
-    "filter4": ["throttle", "brake", "steering", "air_mass:magnitude"],
+    "filter1": ["engine_speed_sensor", "accel_y_sensor", "accel_z_sensor", "pitch_rate_sensor"],
+    "filter2": ["accel_x_sensor", "roll_rate_sensor", "yaw_rate_sensor", "engine_speed_sensor"],
+    "filter3": ["wheel_speed_fl_sensor", "wheel_speed_fr_sensor", "wheel_speed_rl_sensor", "wheel_speed_rr_sensor"],
+    "filter4": ["throttle_actuator", "brake_actuator", "steering_actuator", "air_mass_sensor:magnitude"],
 }
 
 _SENSOR_SETS = ([-3.0, -10.0], [-4.0, -9.0], [-5.0, -8.0], [-6.0, -7.0])
@@ -66,11 +66,6 @@ EIGENVALUES: dict[str, tuple[list[list[float]], list[float]]] = {
     "filter3": (list(_SENSOR_SETS), [-1.5, -2.0, -11.0, -12.0]),
     "filter4": ([[-4.0, -9.0], [-5.0, -8.0], [-6.0], [-7.0]], [-1.5, -2.0, -2.5, -3.0, -10.0, -11.0, -12.0, -13.0]),
 }
-
-
-def _fault_name(spec: str) -> str:
-    signal = spec.partition(":")[0]
-    return sensor_fault_name(signal) if signal in OUTPUTS else actuator_fault_name(signal)
 
 
 def nominal_fault_sizes() -> dict[str, float]:
@@ -172,7 +167,7 @@ def path_bank(dt: float | None = None, eigenvalues: dict | None = None) -> PathB
             lam = np.asarray(lam, dtype=complex)
             return lam if _dt is None else np.exp(lam * _dt)
 
-        faults = [_fault_name(s) for s in specs]
+        faults = [s.partition(":")[0] for s in specs]
         maps = resolve_faults(model, specs)
         if name == "filter4":  # the brake's detection space taken 2-D, Im [F, A F] (§4.1)
             F = maps["brake_actuator"]
@@ -257,6 +252,6 @@ def path_runs(
         if fault is not None:
             signal, loc = fault.rsplit("_", 1)
             faults = [Bias(signal, size * bank.nominal[fault], onset=onset, location=loc)]
-        trace = simulate(plant, FaultScenario(faults), duration=duration, measurement_noise=noise, rng=int(s))
+        trace = simulate(plant, FaultScenario(faults), duration=duration, measurement_noise_std=noise, rng=int(s))
         out.append((trace, gen.run(trace)))
     return out

@@ -5,7 +5,7 @@ sampled with a zero-order hold at ``h = 0.01`` s ((4.5)); it is simulated **open
 lane-keeping set-point of (4.2), ``δ_set = 2.3·10⁻³ sin(0.3·2π t)`` rad (Sec. 4-1).  The steering
 actually applied is ``δ = f_m δ_set + f_a`` (1.3): ``f_a`` an offset, ``f_m`` a gain (1 when healthy).
 
-Catalogue (research note §5.3; the thesis does not number its cases):
+Catalogue (fdikit's labels S1–S8; the thesis does not number its cases):
 
 =====  ========================================  ====================================================
 case   thesis                                    data
@@ -19,10 +19,10 @@ S8     Sec. 4-4, Figs. 4-18–4-20                 steady cornering at ``a_y`` (
 
 Pairs (S2/S3, S4/S5, S6/S7) share the data and differ in the filter (window, poles, LPV).
 All cases: curvature ``κ`` and bank ``φ`` steps at 15 s (Sec. 4-3-1), by default the first row of
-Table 4-2 at 70 km/h (R = 350 m, 1.43°) — the thesis does not give their size (note §8 item 4);
+Table 4-2 at 70 km/h (R = 350 m, 1.43°) — the thesis does not give their size;
 in open loop they make ``y_e`` and ``ψ_e`` drift, which the exact LTI parity filter rejects but an
-approximate (finite-γ LPV) filter may not (note §5.6).  Pass ``disturbance_end`` for a pulse.
-The speed profile of S6 is not given either ("a slowly varying sinusoid", note §8 item 5);
+approximate (finite-γ LPV) filter may not.  Pass ``disturbance_end`` for a pulse.
+The speed profile of S6 is not given either (Sec. 4-3-4, Fig. 4-15: "a time-varying longitudinal velocity");
 fdikit sweeps ``V_x(t) = 95 − 25 cos(π t/T)`` km/h, 70 km/h at ``t = 0`` to 120 km/h at ``t = T``.
 
 Trace layout: control ``steering`` = ``δ_set`` (as commanded, what the isolation filter knows);
@@ -111,7 +111,7 @@ def steering_setpoint(t: ArrayLike, amplitude: float = 2.3e-3, frequency: float 
 def cosine_speed_sweep(t: ArrayLike, duration: float, start_kmh: float = 70.0, end_kmh: float = 120.0) -> np.ndarray:
     """Speed ``start + (end − start)(1 − cos(π t/T))/2`` in km/h: monotone, zero acceleration at both ends.
 
-    The S6/S7 profile (Sec. 4-3-4 gives none; note §8 item 5).  Its largest acceleration is
+    The S6/S7 profile (Sec. 4-3-4 gives none).  Its largest acceleration is
     ``π (end − start)/(2 T)``: 0.31 m/s² for 70 → 120 km/h over 70 s, so ``a_x ≈ 0`` (4.1) holds.
 
     Examples
@@ -205,7 +205,7 @@ def lateral_run(
     x0: ArrayLike | None = None,
     params: SingleTrackParameters = PRIUS_2010,
     dt: float = 0.01,
-    measurement_noise: float | Sequence[float] | None = None,
+    measurement_noise_std: float | Sequence[float] | None = None,
     rng: np.random.Generator | int | None = None,
     label: str = "custom",
     source: str = "",
@@ -234,7 +234,7 @@ def lateral_run(
         The *true* vehicle (perturb it for the sensitivity study of Sec. 4-4).
     dt : float
         Sample time ``h`` (0.01 s in the thesis).
-    measurement_noise : float or 3 floats, optional
+    measurement_noise_std : float or 3 floats, optional
         Standard deviations of white Gaussian noise on ``yaw_rate, lateral_error, heading_error``
         (none in the thesis' Ch. 4); the ``speed`` output is noise free.
     rng : numpy.random.Generator or int seed, optional
@@ -278,10 +278,11 @@ def lateral_run(
     run = simulate_scheduled(single_track_lpv(params, dt, steering_fault=False), speed / 3.6, u=applied, d=d, x0=x0_arr)
     x, y = run.x, run.y[:, :3]
     seed = int(rng) if isinstance(rng, int | np.integer) else None
-    if measurement_noise is not None:
-        std = np.broadcast_to(np.asarray(measurement_noise, dtype=float), (3,))
+    if measurement_noise_std is not None:
+        std = np.broadcast_to(np.asarray(measurement_noise_std, dtype=float), (3,))
         if not np.all(np.isfinite(std) & (std >= 0)):
-            raise DataError(f"measurement_noise must be 1 or 3 standard deviations >= 0, got {measurement_noise!r}")
+            raise DataError(f"measurement_noise_std must be 1 or 3 standard deviations >= 0, "
+                            f"got {measurement_noise_std!r}")
         y = y + np.random.default_rng(rng).standard_normal((N, 3)) * std
     y = np.column_stack([y, speed / 3.6])
     meta = {
@@ -300,7 +301,8 @@ def lateral_run(
         "params": asdict(params),
         "dt": float(dt),
         "seed": seed,
-        "measurement_noise": None if measurement_noise is None else np.atleast_1d(measurement_noise).tolist(),
+        "measurement_noise_std": (None if measurement_noise_std is None
+                                  else np.atleast_1d(measurement_noise_std).tolist()),
     }
     return Trace(
         t=t, u=command, y=y, x=x, d=d, controls=("steering",), outputs=OUTPUTS, states=_STATES,
@@ -340,7 +342,7 @@ def cornering_run(
 
     The curve has ``κ = a_y / V_x²`` and, unless given, the bank of Table 4-2 for its radius
     (:func:`design_bank_angle`; 4° at 3 m/s², the thesis' extrapolation), banked into the curve.
-    The thesis does not say how the steady state is produced (note §8 item 8): here the set-point
+    The thesis does not say how the steady state is produced: here the set-point
     carries the feedforward steering ``δ_ss`` that holds the **true** vehicle (``params``) on the
     curve, and the run starts in that steady state (``ψ̇ = V_x κ``, ``ψ_e = V_y/V_x``, so ``y_e``
     stays constant), with (4.2) on top when ``excitation`` is true.  The curve is present from

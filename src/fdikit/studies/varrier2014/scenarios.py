@@ -9,9 +9,9 @@ uncertainty class of the robust design (§5.3):
   paper's 75 km/h mean), ρ = 1/v;
 * road-wheel steering ``u(t) = 0.02 sin(2π 0.2 t) + 0.01 sin(2π 0.05 t + 1)`` rad;
 * stiffness uncertainty ``Ā = A₀(ρ) + δ(t) A₁`` with a slow ``δ(t) = δ̄ cos(2πt/90)`` (nearly
-  constant over the 60 ms window, note G22), by default δ̄ = 1 with the "continuous" reading
+  constant over the 60 ms window, as (14) assumes), by default δ̄ = 1 with the "continuous" reading
   ``A₁ = 0.2 (A₀(ρ*) − I)`` (±20 % of the continuous dynamics; the literal ``0.2 A₀(ρ*)`` scales
-  the state by 1 ± 0.2 δ per step and is unstable at δ = 1, note G4);
+  the state by 1 ± 0.2 δ per step and is unstable at δ = 1);
 * the unknown input ``d`` (``B_d``, ``D_d`` of §5.3) a first-order low-pass (0.5 s) Gaussian
   signal with standard deviation ``disturbance`` (default 0.003: 6 mrad/s on the yaw rate via
   ``D_d = [0; 2.064]``);
@@ -19,7 +19,7 @@ uncertainty class of the robust design (§5.3):
 
 The score of §5.5 is ϖ = min |r_n| over the faulty time / max |r_n| over the healthy time,
 ``r_n = r / mean(r over the faulty time)`` (Remark 8).  Windows straddling a fault edge
-belong to neither set (note G15).
+belong to neither set (an fdikit rule; §5.5 does not say).
 """
 
 from __future__ import annotations
