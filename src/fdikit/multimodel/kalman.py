@@ -47,7 +47,34 @@ __all__ = ["KalmanResult", "KalmanStep", "KalmanFilter", "kalman_filter"]
 # ---------------------------------------------------------------------------------------- model + results
 @dataclass(frozen=True)
 class KalmanStep:
-    """One online step: filtered and next predicted estimates, innovation, validity."""
+    """One online step: filtered and next predicted estimates, innovation, validity.
+
+    Attributes
+    ----------
+    x_filt, P_filt : ndarray
+        ``x̂(k|k)`` (n) and ``P(k|k)`` (n x n).
+    x_pred, P_pred : ndarray
+        ``x̂(k+1|k)`` (n) and ``P(k+1|k)`` (n x n).
+    innovation : ndarray
+        ``e(k) = y(k) − C x̂(k|k−1) − D u(k)`` (p); NaN when the sample is invalid.
+    S : ndarray
+        Innovation covariance ``C P(k|k−1) Cᵀ + R`` (p x p); NaN when the sample is invalid.
+    log_likelihood : float
+        ``log N(e(k); 0, S)``; NaN when the sample is invalid.
+    valid : bool
+        False when the measurement had a NaN entry and the update was skipped.
+
+    Examples
+    --------
+    >>> mdl = LinearGaussianModel(A=[[0.9]], C=[[1.0]], Q=[[0.1]], R=[[1.0]])
+    >>> s = KalmanFilter(mdl, x0=[0.0], P0=[[1.0]]).step(None, [1.0])
+    >>> s.x_filt.tolist(), s.x_pred.tolist(), s.valid
+    ([0.5], [0.45], True)
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.1, Table 2.1 step 2, (2.12).
+    """
 
     x_filt: np.ndarray
     P_filt: np.ndarray
@@ -80,6 +107,17 @@ class KalmanResult:
         ``log N(e(k); 0, S(k))`` (N); NaN on invalid samples.
     valid : ndarray of bool
         False where the measurement was missing and the update skipped.
+
+    Examples
+    --------
+    >>> mdl = LinearGaussianModel(A=[[0.9]], C=[[1.0]], Q=[[0.1]], R=[[1.0]])
+    >>> res = kalman_filter(mdl, None, [[1.0], [0.5]], x0=[0.0], P0=[[1.0]])
+    >>> res.innovations.round(6).tolist(), res.P_pred.shape
+    ([[1.0], [0.05]], (2, 1, 1))
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.1, Table 2.1 step 2, (2.12).
     """
 
     x_filt: np.ndarray
@@ -118,11 +156,31 @@ class KalmanFilter:
     Q, R : array_like, optional
         Covariances when ``model`` is a ``FaultModel``.
 
+    Raises
+    ------
+    ParameterError
+        On an unknown ``form``, ``Q``/``R`` missing for a ``FaultModel`` or given twice for a
+        ``LinearGaussianModel``, or a prior of the wrong size.
+
     Notes
     -----
     A measurement with a NaN entry skips the measurement update (``x̂(k|k) = x̂(k|k−1)``),
     the time update still runs, and the sample is marked invalid (innovation and
     log-likelihood NaN).  NaN in ``u`` raises :class:`~fdikit.errors.DataError`.
+
+    Examples
+    --------
+    >>> mdl = LinearGaussianModel(A=[[0.9]], C=[[1.0]], Q=[[0.1]], R=[[1.0]])
+    >>> kf = KalmanFilter(mdl, x0=[0.0], P0=[[1.0]])
+    >>> kf.step(None, [1.0]).x_filt.tolist()
+    [0.5]
+    >>> s = kf.step(None, [float("nan")])        # missing measurement: prediction only
+    >>> s.valid, s.x_filt.tolist(), s.x_pred.round(6).tolist()
+    (False, [0.45], [0.405])
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.1, Table 2.1 step 2; §2.3.2, (2.29)–(2.31) for the square-root form.
     """
 
     def __init__(self, model, x0, P0, *, form: str = "covariance", Q=None, R=None) -> None:
@@ -244,11 +302,14 @@ def kalman_filter(model, u, y, x0, P0, *, form: str = "covariance", Q=None, R=No
     x0, P0 : array_like
         Prior ``x̂(0|−1)``, ``P(0|−1)``.
     form : {"covariance", "square_root"}
-        Filter implementation.
+        Filter implementation (default ``"covariance"``).
+    Q, R : array_like, optional
+        Process (n x n) and measurement (p x p) noise covariances when ``model`` is a ``FaultModel``.
 
     Returns
     -------
     KalmanResult
+        The filtered record; see :class:`KalmanResult`.
 
     Examples
     --------
@@ -256,6 +317,10 @@ def kalman_filter(model, u, y, x0, P0, *, form: str = "covariance", Q=None, R=No
     >>> res = kalman_filter(mdl, None, [[1.0], [0.5]], x0=[0.0], P0=[[1.0]])
     >>> res.x_filt.shape, res.valid.tolist()
     ((2, 1), [True, True])
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.1, Table 2.1 step 2, (2.12).
     """
     kf = KalmanFilter(model, x0, P0, form=form, Q=Q, R=R)
     u, y = check_record(u, y, kf.model.m, kf.model.p)
