@@ -80,10 +80,23 @@ def msd_matrices(k1: float = 1.0, m3: float = 1.0, f1: float = 1.0, f2: float = 
     allow_outside : bool
         Accept values outside :data:`MSD_RANGES` (``m3`` must still be positive).
 
+    Returns
+    -------
+    A : numpy.ndarray
+        (6, 6) state matrix for ``x = [x1, x2, x3, v1, v2, v3]``.
+    B : numpy.ndarray
+        (6, 2) input matrix for ``u1`` (force on m1, scaled by ``f1``) and ``u2`` (force on m3).
+    C : numpy.ndarray
+        (3, 6) output matrix (the three positions, sensor 2 scaled by ``f2``).
+
     Raises
     ------
-    ModelError
-        If a parameter is non-finite, outside its range, or ``m3 <= 0``.
+    ParameterError
+        If a parameter is not a finite number, outside its range, or ``m3 <= 0``.
+
+    References
+    ----------
+    Hallouzi 2008, §3.6, (3.41)–(3.43).
 
     Examples
     --------
@@ -121,10 +134,37 @@ def msd(k1: float = 1.0, m3: float = 1.0, f1: float = 1.0, f2: float = 1.0, dt: 
     ``u1_actuator`` and ``y2_sensor`` are attached for residual design; the multiplicative faults of
     the thesis are the parameters ``f1``, ``f2``.
 
+    Parameters
+    ----------
+    k1, m3 : float, default 1.0
+        Varying spring constant and mass (ranges in :data:`MSD_RANGES`).
+    f1, f2 : float, default 1.0
+        Actuator-1 effectiveness and sensor-2 gain (1 = healthy, 0 = total fault).
+    dt : float or None, default None
+        Sample time [s] of the first-order discretisation; ``None`` gives the continuous model.
+    allow_outside : bool, default False
+        Accept parameter values outside :data:`MSD_RANGES`.
+
+    Returns
+    -------
+    FaultModel
+        6 states, controls ``u1, u2``, outputs ``y1 … y3`` and the fault inputs ``u1_actuator``,
+        ``y2_sensor``; discrete with ``dt`` if given.
+
     Raises
     ------
-    ModelError
-        On a bad parameter (see :func:`msd_matrices`) or ``dt <= 0``.
+    ParameterError
+        On a bad parameter (see :func:`msd_matrices`) or a ``dt`` that is not a finite positive number.
+
+    References
+    ----------
+    Hallouzi 2008, §3.6, (3.41)–(3.43); App. B, (B.8)–(B.9).
+
+    Examples
+    --------
+    >>> m = msd(k1=1.75, f2=0.5, dt=MSD_SAMPLE_TIME)
+    >>> m.dt, m.faults
+    (0.0025, ('u1_actuator', 'y2_sensor'))
     """
     A, B, C = msd_matrices(k1, m3, f1, f2, allow_outside=allow_outside)
     if dt is not None:
@@ -144,10 +184,33 @@ def msd_parameter_grid(k1_values=None, m3_values=None, fault_values=None) -> np.
     ``{0, 0.1, …, 1}``.  The (k1, m3) grid is crossed with ``f1 ∈ fault_values, f2 = 1`` and with
     ``f1 = 1, f2 ∈ fault_values \\ {1}`` (each healthy model appears once).
 
+    Parameters
+    ----------
+    k1_values, m3_values : array_like, optional
+        Grid values of the spring ``k1`` and the mass ``m3`` (defaults above).
+    fault_values : array_like, optional
+        Fault levels used for ``f1`` and ``f2`` in turn (default ``{0, 0.1, …, 1}``).
+
     Returns
     -------
     numpy.ndarray
         ``(N_ℓ, 4)`` array, columns ``k1, m3, f1, f2``.
+
+    Raises
+    ------
+    ModelError
+        If one of the grids is empty.
+
+    References
+    ----------
+    Hallouzi 2008, §3.6.1; the large model set ``M_ℓ``, (3.15).
+
+    Examples
+    --------
+    >>> msd_parameter_grid().shape
+    (3549, 4)
+    >>> msd_parameter_grid([1.0], [1.0], [0.0, 1.0]).tolist()
+    [[1.0, 1.0, 0.0, 1.0], [1.0, 1.0, 1.0, 1.0], [1.0, 1.0, 1.0, 0.0]]
     """
     k1_values = np.linspace(0.25, 1.75, 13) if k1_values is None else np.asarray(k1_values, float).ravel()
     m3_values = np.linspace(0.2, 1.8, 13) if m3_values is None else np.asarray(m3_values, float).ravel()
@@ -166,6 +229,35 @@ def msd_model_vectors(parameters, dt: float | None = MSD_SAMPLE_TIME) -> np.ndar
 
     ``vec`` stacks columns (Fortran order); ``A_d = I + dt A``, ``B_d = dt B`` (App. B, first
     order) or the continuous matrices if ``dt is None``.  Shape ``(72, N_ℓ)``.
+
+    Parameters
+    ----------
+    parameters : array_like
+        ``(N_ℓ, 4)`` tuples ``(k1, m3, f1, f2)`` (one tuple may be given as a 4-vector), each within
+        :data:`MSD_RANGES`, e.g. from :func:`msd_parameter_grid`.
+    dt : float or None, default MSD_SAMPLE_TIME
+        Sample time [s] of the first-order discretisation; ``None`` for the continuous matrices.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(72, N_ℓ)`` array, one column ``vec([A_d B_d; C 0])`` (a 9 × 8 block) per tuple.
+
+    Raises
+    ------
+    ModelError
+        If ``parameters`` does not have 4 columns.
+    ParameterError
+        If a parameter is not finite or outside its range (see :func:`msd_matrices`).
+
+    References
+    ----------
+    Hallouzi 2008, §3.3.2, (3.14)–(3.15); §3.6.1.
+
+    Examples
+    --------
+    >>> msd_model_vectors([[1.0, 1.0, 1.0, 1.0], [1.0, 1.0, 0.0, 1.0]]).shape
+    (72, 2)
     """
     parameters = np.atleast_2d(np.asarray(parameters, float))
     if parameters.shape[1] != 4:
@@ -184,6 +276,27 @@ def msd_parameters_to_weights(k1: float, m3: float, f1: float, f2: float) -> np.
 
     ``μ = 0`` is the "+" limit (``k1max``, ``m3max``, healthy) and ``μ = 1`` the other limit;
     ``μ_m3`` is affine in ``1/m3``.
+
+    Parameters
+    ----------
+    k1, m3 : float
+        Spring constant and mass (``m3 > 0``).
+    f1, f2 : float
+        Actuator-1 effectiveness and sensor-2 gain (1 = healthy).
+
+    Returns
+    -------
+    numpy.ndarray
+        (4,) weights ``[μ_k1, μ_m3, μ_f1, μ_f2]`` (in ``[0, 1]`` for parameters within :data:`MSD_RANGES`).
+
+    Raises
+    ------
+    ModelError
+        If ``m3 <= 0``.
+
+    References
+    ----------
+    Hallouzi 2008, §3.6.2, (3.54)–(3.57).
 
     Examples
     --------
@@ -206,6 +319,25 @@ def msd_weights_to_parameters(weights) -> tuple[float, float, float, float]:
 
     ``k1 = k1max + μ_k1 (k1min − k1max)``, ``m3 = m3max m3min / (m3min + μ_m3 (m3max − m3min))``,
     ``f1 = 1 − μ_f1``, ``f2 = 1 − μ_f2``.
+
+    Parameters
+    ----------
+    weights : array_like
+        Four limit-value weights ``(μ_k1, μ_m3, μ_f1, μ_f2)``.
+
+    Returns
+    -------
+    tuple of float
+        ``(k1, m3, f1, f2)``.
+
+    Raises
+    ------
+    ModelError
+        If ``weights`` does not hold exactly 4 values.
+
+    References
+    ----------
+    Hallouzi 2008, §3.6.2, (3.54)–(3.57).
 
     Examples
     --------

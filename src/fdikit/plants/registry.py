@@ -51,10 +51,26 @@ def get_plant(name: str, **params) -> FaultModel:
         Passed to the plant's constructor, e.g. ``speed=19.44, dt=0.01`` for
         ``"single-track"``.
 
+    Returns
+    -------
+    FaultModel
+        What the constructor in :data:`PLANTS` returns for these parameters.
+
     Raises
     ------
     ParameterError
         If ``name`` is not a known plant, or the parameters do not fit its constructor.
+
+    References
+    ----------
+    The plant modules of :mod:`fdikit.plants` cite their sources (e.g. Douglas et al. 1996, App. D for ``"path12"``).
+
+    Examples
+    --------
+    >>> get_plant("msd").n
+    6
+    >>> get_plant("b747", dt=0.01).dt
+    0.01
     """
     try:
         factory = PLANTS[name]

@@ -48,8 +48,27 @@ TRACKING_MODES = ("straight", "left_turn", "right_turn")
 def tracking_A(dt: float = TS) -> np.ndarray:
     """The constant-velocity transition matrix (Hallouzi 2008, (2.65)).
 
-    Example
+    Parameters
+    ----------
+    dt : float, default TS (1.0)
+        Sample time ``T_s`` [s].
+
+    Returns
     -------
+    numpy.ndarray
+        (4, 4) transition matrix for ``x = [p_x, v_x, p_y, v_y]``.
+
+    Raises
+    ------
+    ParameterError
+        If ``dt`` is not a finite positive number.
+
+    References
+    ----------
+    Hallouzi 2008, §2.4.2, (2.65).
+
+    Examples
+    --------
     >>> tracking_A(0.5)[0].tolist()
     [1.0, 0.5, 0.0, 0.0]
     """
@@ -64,8 +83,27 @@ def tracking_A(dt: float = TS) -> np.ndarray:
 def tracking_B(model: str) -> np.ndarray:
     """Input matrix (4, 1) of ``"straight"``, ``"left_turn"`` or ``"right_turn"`` (Hallouzi 2008, (2.66)).
 
-    Example
+    Parameters
+    ----------
+    model : {"straight", "left_turn", "right_turn"}
+        One of :data:`TRACKING_MODES`.
+
+    Returns
     -------
+    numpy.ndarray
+        (4, 1) input matrix ``B^(i)`` for the scalar input ``u ≡ 1`` [m/s²].
+
+    Raises
+    ------
+    ModelError
+        If ``model`` is not one of the three modes.
+
+    References
+    ----------
+    Hallouzi 2008, §2.4.2, (2.66).
+
+    Examples
+    --------
     >>> (tracking_B("left_turn").ravel() / np.sqrt(2)).tolist()
     [-0.25, -0.5, 0.25, 0.5]
     """
