@@ -129,7 +129,7 @@ def test_dgtfdf_is_5_42_and_the_recursion_at_its_gain_reproduces_it():
     d = dgtfdf(st)
     assert d.settled and d.settling_step is not None and d.settling_step < 400
     # recursion (5.29)/(5.30) driven by the time-varying DGTFDF gain = the DGTFDF covariances
-    sol = discrete_game_riccati(st, d.gains)
+    sol = discrete_game_riccati(st, d.filter_gains)  # Murray's filtered-form L(k); d.gain = Φ L is the observer gain
     assert max(_rel(a, b) for a, b in zip(sol.covariances["f1"], d.covariances)) < 1e-10
     # independent information-form (5.42)–(5.43): Σ = Θ − Cᵀ(ĤQĤ − V⁻¹)C, Θ̃ = [ΦΣ⁻¹Φᵀ + F̂MF̂ᵀ/γ]⁻¹, L = Σ⁻¹CᵀV⁻¹
     m, H, Fh = st.model, st.problem.projectors["f1"], st.problem.complementary["f1"]
@@ -139,7 +139,7 @@ def test_dgtfdf_is_5_42_and_the_recursion_at_its_gain_reproduces_it():
     for k in range(60):
         Sigma = Theta - m.C.T @ (H @ st.Q["f1"] @ H - Vi) @ m.C
         Lk = np.linalg.solve(Sigma, m.C.T @ Vi)
-        worst_L = max(worst_L, _rel(d.gains[k], Lk))
+        worst_L = max(worst_L, _rel(d.filter_gains[k], Lk))
         Theta = np.linalg.inv(m.A @ np.linalg.solve(Sigma, m.A.T) + Fh @ st.M["f1"] @ Fh.T / st.gamma)
         worst_T = max(worst_T, _rel(d.covariances[k + 1], np.linalg.inv(Theta)))
     assert worst_L < 1e-7 and worst_T < 1e-7
@@ -164,7 +164,7 @@ def test_dgtfdf_approaches_the_continuous_gtfdf_of_remark_6_3():
         d = dgtfdf(_ws_single(dt, steps=int(3 / dt)))
         assert d.settled
         s_d = np.sort((np.log(d.poles.astype(complex)) / dt).real)
-        errors[dt] = (np.abs(s_d - s_c) / np.abs(s_c), _rel(d.gain / dt, Lc))
+        errors[dt] = (np.abs(s_d - s_c) / np.abs(s_c), _rel(d.filter_gain / dt, Lc))  # Murray's filtered-form L
     # measured: pole errors 8.2e-3, 3.8e-5, 2.9e-6 (Δt = 2 ms) → 2.1e-3, 1.9e-5, 7.1e-7 (1 ms); gain 0.20 → 0.11
     assert np.all(errors[1e-3][0] < [3e-3, 3e-5, 2e-6])
     assert np.all(errors[2e-3][0] / errors[1e-3][0] > 1.8)
@@ -197,7 +197,7 @@ def test_with_vbar_fixed_gamma_only_rescales_q():
     b = dgtfdf(discrete_game_setup(model, ["f1"], ["f2"], gamma=1.0, Q=0.3 / 1e-4, **kw))
     c = dgtfdf(discrete_game_setup(model, ["f1"], ["f2"], gamma=1.0, Q=0.0, **kw))
     assert max(_rel(pa * 1e-4, pb) for pa, pb in zip(a.covariances, b.covariances)) < 1e-12
-    assert _rel(a.gain, b.gain) < 1e-12 and _rel(a.gain, c.gain) > 0.01  # Q matters here (measured 1.8 %)
+    assert _rel(a.filter_gain, b.filter_gain) < 1e-12 and _rel(a.filter_gain, c.filter_gain) > 0.01  # Q matters (1.8 %)
     Fh = model.Bf[:, 1:]
     ratios = []
     for g in (1e-2, 1e-3, 1e-4, 1e-5):
@@ -212,7 +212,7 @@ def test_guard_names_target_step_and_eigenvalue():
         dgtfdf(_ws_single(0.01, Qc=1e3))
     # the §6.2.1 filter designed for f2 does not serve the f1 DAP: positivity is lost part-way through the horizon
     st2 = _ws_single(0.01, steps=300, target="f2")
-    L2 = dgtfdf(st2).gain
+    L2 = dgtfdf(st2).filter_gain  # the DARI takes Murray's filtered-form gain
     st1 = _ws_single(0.01, steps=300)
     with pytest.raises(DesignError, match=r"target 'f1'.*step k = (\d+)") as info:
         discrete_game_riccati(st1, L2)
@@ -253,7 +253,7 @@ def test_bad_input_raises_design_errors():
 # ---------------------------------------------------------------------- secondary optimisation (5.31)–(5.41)
 def test_gradient_5_34_matches_finite_differences():
     st = _random_problem(1)
-    L = np.mean([dgtfdf(st, t).gain for t in st.names], axis=0)
+    L = np.mean([dgtfdf(st, t).filter_gain for t in st.names], axis=0)  # (5.31)–(5.41) use the filtered form
     _, g = secondary_cost(st, L)
     fd = np.zeros_like(L)
     for idx in np.ndindex(L.shape):
@@ -264,7 +264,7 @@ def test_gradient_5_34_matches_finite_differences():
     # the badly scaled §6.2.1 setting (1/γ = 1e6): dominant entries agree to 1e-4
     st = discrete_game_setup(white_speyer("stable-zero").discretize(0.01), ["f1", "f2"], gamma=1e-6, Vbar=1e-4,
                              Q={"f1": 1e-5, "f2": 2e-5}, M=5.0, P0=1e-6, K=1e3, N={"f1": 5e4, "f2": 1e5}, steps=100)
-    L = dgtfdf(st, "f1").gain
+    L = dgtfdf(st, "f1").filter_gain
     _, g = secondary_cost(st, L)
     for idx in [np.unravel_index(np.argmax(np.abs(g)), g.shape), (2, 1)]:
         E = np.zeros_like(L)
@@ -277,7 +277,7 @@ def test_gain_iteration_5_41_reaches_a_spurious_point_and_the_guard_avoids_it():
     """Note §7.4: (5.41) is stationarity multiplied by (I − LC)ᵀ … V⁻¹(I − CL); iterated blindly it converges where
     I − LC is singular although ∇J̄ ≠ 0.  The guarded design stops there and finishes by descent on J̄."""
     st = _random_problem(0)
-    L0 = np.mean([dgtfdf(st, t).gain for t in st.names], axis=0)
+    L0 = np.mean([dgtfdf(st, t).filter_gain for t in st.names], axis=0)
     L = L0
     for _ in range(25):
         L = gain_update(st, L)
@@ -298,7 +298,7 @@ def test_gain_iteration_and_descent_agree_at_a_regular_stationary_point():
     fp = dgtmfdf(st, method="fixed-point", max_radius=0.9999)
     gd = dgtmfdf(st, method="gradient", max_radius=0.9999)
     assert fp.notes[0].startswith("fixed-point: converged")
-    assert abs(fp.cost - gd.cost) < 1e-8 * abs(fp.cost) and _rel(fp.gain, gd.gain) < 1e-4
+    assert abs(fp.cost - gd.cost) < 1e-8 * abs(fp.cost) and _rel(fp.filter_gain, gd.filter_gain) < 1e-4
     assert np.linalg.norm(fp.gradient) < 1e-7 * abs(fp.cost)  # measured 7e-6 against J̄ = −593.2
 
 

@@ -57,9 +57,10 @@ def test_random_designs_assign_spectrum_and_decouple(seed, n, q, discrete):
     sets = {f"f{i}": [base[i]] for i in range(q)}
     d = beard_jones(model, faults, sets, base[q:])
     scale = np.abs(base).max()
-    Acl = model.A + d.gain @ model.C
-    # computed eigenvalues of A + LC: 1e-8 relative, or the Bauer–Fike bound κ(𝒱) eps ‖A + LC‖ when the
-    # eigenvectors are ill-conditioned (the assignment itself is checked exactly below, by vᵀ(A + LC) = λ vᵀ)
+    Acl = model.A - d.gain @ model.C  # gain is the observer gain (A − LC); the report's A + L_report C is the same
+    np.testing.assert_array_equal(d.report_gain, -d.gain)
+    # computed eigenvalues of A − LC: 1e-8 relative, or the Bauer–Fike bound κ(𝒱) eps ‖A − LC‖ when the
+    # eigenvectors are ill-conditioned (the assignment itself is checked exactly below, by vᵀ(A − LC) = λ vᵀ)
     tol = max(1e-8 * scale, 10 * np.finfo(float).eps * np.linalg.norm(Acl, 2) * d.condition_number)
     np.testing.assert_allclose(np.sort_complex(d.poles), np.sort_complex(base.astype(complex)), atol=tol)
     for k, lam in enumerate(d.order):
@@ -78,7 +79,7 @@ def test_two_dimensional_sensor_faults_and_complex_pairs():
     model = FaultModel(A=rng.standard_normal((n, n)), C=rng.standard_normal((n, n)), Bu=rng.standard_normal((n, 1)),
                        outputs=[f"y{i}" for i in range(n)])
     d = beard_jones(model, ["y0", "y3"], {"y0_sensor": [-2 + 1j, -2 - 1j], "y3_sensor": [-3, -4]},
-                    complement=[-1, -5])
+                    complement_poles=[-1, -5])
     assert {k: T.shape[1] for k, T in d.detection_spaces.items()} == {"y0_sensor": 2, "y3_sensor": 2}
     np.testing.assert_allclose(np.sort_complex(d.poles), np.sort_complex(np.array([-5, -4, -3, -2 - 1j, -2 + 1j, -1])),
                                atol=1e-8)

@@ -70,7 +70,7 @@ def _random_model(seed, n=4, p=3, faults=2):
 # ---------------------------------------------------------------------- (c.7) gain family
 @pytest.mark.parametrize("seed", range(6))
 def test_family_keeps_every_detection_space_invariant(seed):
-    """Prop. C.4 "if": any α_i, β in (c.7) gives (A + LC) W_i ⊆ W_i (rel 1e-10), also for a fault with
+    """Prop. C.4 "if": any α_i, β in (c.7) gives (A − LC) W_i ⊆ W_i (observer gain; rel 1e-10), also for a fault with
     C f = 0 (W = [f, A f], C W of rank 1, F̂ = right singular vector) and a 2-D sensor fault."""
     rng = np.random.default_rng(100 + seed)
     n, p = 6, 4
@@ -98,7 +98,7 @@ def test_family_keeps_every_detection_space_invariant(seed):
 @pytest.mark.parametrize("seed", range(4))
 def test_family_contains_beard_jones_gains(seed):
     """Prop. C.4 "only if": a Beard–Jones gain (App. B, another algorithm) is a member of (c.7); its α_i are the
-    assigned eigenvalues (1-D spaces: (A + LC) f_i = f_i α_i) and (c.7) rebuilds it exactly."""
+    assigned eigenvalues (1-D spaces: (A − LC) f_i = f_i α_i, observer gains) and (c.7) rebuilds it exactly."""
     rng = np.random.default_rng(seed)
     n, p = 5, 3
     model = FaultModel(rng.standard_normal((n, n)), rng.standard_normal((p, n)), Bu=rng.standard_normal((n, 1)))
@@ -158,7 +158,7 @@ def test_printed_riccati_breaks_its_bound_the_corrected_one_keeps_it(printed, co
 
 
 def test_corrected_bound_holds_on_random_systems():
-    """Prop. C.7 (corrected): whenever the flow settles, Y > 0, A + LC is stable, the bounded-real equation holds
+    """Prop. C.7 (corrected): whenever the flow settles, Y > 0, A − LC is stable, the bounded-real equation holds
     and ‖T_zω‖∞ ≤ (γ² + σ²(HD))^½.  The report gives no existence conditions for (c.18): of these 12 random
     systems (n = 4, p = 3, two 1-D faults, γ = 2) 6 settle, the others escape with a DesignError."""
     settled = 0
@@ -235,11 +235,11 @@ def test_enhancement_maximises_the_gramian_ratio(printed):
     """(c.25)/(c.26) by brute force: the T = ∞ gramians by quadrature of e^{Āt}e₀ and a 3600-angle sweep of
     qᵀ(C̄X_0mC̄ᵀ)q / qᵀ(C̄X_0ωC̄ᵀ)q agree with the Lyapunov/generalised-eigenvalue solution."""
     e = enhancement_direction(printed, AZ)
-    fam, L = printed.family, printed.gain
+    fam, L = printed.family, printed.gain  # the observer gain: closed loop A − LC (the report's A + L_report C)
     Q = scipy.linalg.null_space(linalg.orth(fam.spaces[DELTA]).T)
-    Ab = Q.T @ (fam.A + L @ fam.C) @ Q
+    Ab = Q.T @ (fam.A - L @ fam.C) @ Q
     Cb = fam.residual_maps[AZ] @ fam.C @ Q
-    Bb, Fb = Q.T @ (printed.B + L @ printed.D), Q.T @ fam.fault_maps[AZ]
+    Bb, Fb = Q.T @ (printed.B - L @ printed.D), Q.T @ fam.fault_maps[AZ]
     lyap = scipy.linalg.solve_continuous_lyapunov
     O = lyap(Ab.T, -Cb.T @ Cb)
 

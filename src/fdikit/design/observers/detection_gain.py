@@ -8,8 +8,15 @@ images, ``(A + LC) W_i ⊆ W_i`` for every i iff
 with free ``α_i`` (ν_i x k_i) and ``β`` (n x k_0); ``F̂_i`` are right singular vectors of ``C W_i``
 (identity when ``C W_i`` is monic) and ``H_i`` the natural projections (k_i x p) onto the coordinates
 of ``C W_i F̂_i`` along the other images and their orthogonal complement (``Im H_0``).  The family is
-the design freedom that :func:`fdikit.design.observers.hinf.hinf_detection_filter` spends on the H∞ bound; the
-report's gain ``L`` is that of ``A + LC``.
+the design freedom that :func:`fdikit.design.observers.hinf.hinf_detection_filter` spends on the H∞ bound.
+
+Gain sign: the report's ``L`` above is that of ``A + LC``.  fdikit's gains are observer gains
+(``x̂' = A x̂ + Bu u + L (y − C x̂ − Du u)``, state matrix ``A − LC``), so
+:meth:`DetectionGainFamily.gain` returns the negative of (c.7),
+``L = Σ_i (A W_i F̂_i − W_i α_i) H_i − β H_0``, and :meth:`~DetectionGainFamily.parameters` and
+:meth:`~DetectionGainFamily.invariance_defect` take an observer gain.  The parameters ``α_i``, ``β``
+keep the report's meaning (``α_i = W_i⁺ (A − LC) W_i F̂_i`` is the restricted closed loop, the same in
+either sign).
 """
 
 from __future__ import annotations
@@ -42,7 +49,8 @@ class DetectionGainFamily:
     residual_maps : natural projections ``H_i`` (k_i x p), ``H_i C W_i F̂_i = I``, ``H_i C W_j = 0``.
     complement_map : ``H_0`` (k_0 x p), orthonormal rows spanning ``(Σ C W_i)^⊥``.
     projectors : ``C W_i F̂_i H_i`` (p x p), the (oblique) projection onto ``C W_i``.
-    base_gain : ``L̂ = −Σ A W_i F̂_i H_i`` (c.17h).
+    base_gain : the observer gain ``Σ A W_i F̂_i H_i`` (``A − base_gain C`` = the report's ``Â = A + L̂C``;
+        the report's (c.17h) ``L̂ = −Σ A W_i F̂_i H_i`` is its negative).
     """
 
     A: np.ndarray
@@ -63,7 +71,10 @@ class DetectionGainFamily:
         return np.vstack([*self.residual_maps.values(), self.complement_map])
 
     def gain(self, alphas: Mapping[str, np.ndarray], beta: np.ndarray | None = None) -> np.ndarray:
-        """``L = Σ_i (−A W_i F̂_i + W_i α_i) H_i + β H_0`` (c.7); a missing α_i or β is zero."""
+        """Observer gain ``L = Σ_i (A W_i F̂_i − W_i α_i) H_i − β H_0`` (minus (c.7)); a missing α_i or β is zero.
+
+        Every ``W_i`` is invariant under ``A − L C``, with ``W_i⁺ (A − L C) W_i F̂_i = α_i``.
+        """
         unknown = set(alphas) - set(self.spaces)
         if unknown:
             raise ModelError(f"alphas given for unknown fault(s) {sorted(unknown)}; faults are {list(self.names)}")
@@ -74,26 +85,26 @@ class DetectionGainFamily:
                 want = (W.shape[1], self.residual_maps[name].shape[0])
                 if a.shape != want:
                     raise ModelError(f"alpha of {name!r} has shape {a.shape}; it must be {want} (dim W_i x dim C W_i)")
-                L = L + W @ a @ self.residual_maps[name]
+                L = L - W @ a @ self.residual_maps[name]
         k0 = self.complement_map.shape[0]
         if beta is not None and k0:
             b = np.asarray(beta, dtype=float).reshape(self.A.shape[0], -1)
             if b.shape[1] != k0:
                 raise ModelError(f"beta has {b.shape[1]} columns; it must be n x {k0} (the dimension of Im H_0)")
-            L = L + b @ self.complement_map
+            L = L - b @ self.complement_map
         return L
 
     def parameters(self, L: np.ndarray) -> tuple[dict[str, np.ndarray], np.ndarray]:
-        """``(α_i, β)`` of a gain (Prop. C.3 "only if": ``α_i = W_i⁺ (A + LC) W_i F̂_i``, ``β = L N_0``)."""
+        """``(α_i, β)`` of an observer gain (Prop. C.3 "only if": ``α_i = W_i⁺ (A − LC) W_i F̂_i``, ``β = −L N_0``)."""
         L = np.asarray(L, dtype=float)
-        Acl = self.A + L @ self.C
+        Acl = self.A - L @ self.C
         alphas = {k: np.linalg.lstsq(W, Acl @ W @ self.row_bases[k], rcond=None)[0] for k, W in self.spaces.items()}
         N0 = np.linalg.inv(self.coordinates)[:, self.C.shape[0] - self.complement_map.shape[0]:]
-        return alphas, L @ N0
+        return alphas, -L @ N0
 
     def invariance_defect(self, L: np.ndarray) -> dict[str, float]:
-        """``‖(I − P_{W_i})(A + LC) W_i‖ / ‖(A + LC) W_i‖`` per fault (0 when ``W_i`` is invariant)."""
-        Acl = self.A + np.asarray(L, dtype=float) @ self.C
+        """``‖(I − P_{W_i})(A − LC) W_i‖ / ‖(A − LC) W_i‖`` per fault, for an observer gain (0: ``W_i`` invariant)."""
+        Acl = self.A - np.asarray(L, dtype=float) @ self.C
         out = {}
         for k, W in self.spaces.items():
             Q = linalg.orth(W)
@@ -113,15 +124,16 @@ def _space(A, C, F, name, rtol):
 
 
 def detection_gain_family(
-    model: FaultModel, faults: Mapping[str, np.ndarray] | Sequence[str], rtol: float | None = None
+    model: FaultModel, targets: Mapping[str, np.ndarray] | Sequence[str] | str, rtol: float | None = None
 ) -> DetectionGainFamily:
     """Parameterise the gains that keep every fault's detection space invariant (Prop. C.3/C.4).
 
     Parameters
     ----------
     model : FaultModel (continuous; only ``A`` and ``C`` are used).
-    faults : fault maps by name, or names resolved by :func:`fdikit.design.resolve_faults`
-        (an output name is the sensor fault ``[F¹, A F¹]`` with ``C F¹ = e_i``).
+    targets : fault names resolved by :func:`fdikit.linalg.resolve_faults` (``'<output>_sensor'`` is
+        the sensor fault ``[F¹, A F¹]`` with ``C F¹ = e_i``, ``'<control>_actuator'`` a column of ``Bu``),
+        or a mapping name → fault map ``F``.
     rtol : relative rank tolerance of the subspace computations.
 
     Raises
@@ -134,17 +146,17 @@ def detection_gain_family(
     --------
     >>> import numpy as np
     >>> from fdikit.plants.f16xl import f16xl_gust
-    >>> fam = detection_gain_family(f16xl_gust(), ["y_Az", "elevon"])
+    >>> fam = detection_gain_family(f16xl_gust(), ["y_Az_sensor", "elevon_actuator"])
     >>> [W.shape[1] for W in fam.spaces.values()]
     [2, 1]
     >>> L = fam.gain({"elevon_actuator": [[-2.0]]})
     >>> np.round(np.linalg.lstsq(fam.spaces["elevon_actuator"],
-    ...          (fam.A + L @ fam.C) @ fam.spaces["elevon_actuator"], rcond=None)[0], 12)
+    ...          (fam.A - L @ fam.C) @ fam.spaces["elevon_actuator"], rcond=None)[0], 12)
     array([[-2.]])
     """
     if model.is_discrete:
         raise ModelError("the H∞ detection filter of App. C is continuous-time; pass a continuous model")
-    maps = resolve_faults(model, faults)
+    maps = resolve_faults(model, targets)
     if not maps:
         raise DesignError("no fault given; name at least one fault to detect")
     A, C = model.A, model.C
@@ -167,7 +179,8 @@ def detection_gain_family(
         _, pairs = linalg.output_separable(C, list(spaces.values()), rtol)
         keys = list(spaces)
         raise DesignError(f"faults not output separable: images C W_i of {[(keys[i], keys[j]) for i, j in pairs]} "
-                          "are dependent; use ':magnitude' for a sensor fault, or put the faults in different filters")
+                          "are dependent; use '<output>_sensor:magnitude' for a sensor fault, or put the faults in "
+                          "different filters")
     N0 = scipy.linalg.null_space(M.T) if M.shape[1] < p else np.zeros((p, 0))
     T = np.linalg.inv(np.hstack([M, N0]))
     start, residual_maps, projectors = 0, {}, {}
@@ -177,6 +190,6 @@ def detection_gain_family(
         Hk = T[start : start + kk]
         residual_maps[k] = Hk
         projectors[k] = C @ W @ row_bases[k] @ Hk
-        base -= A @ W @ row_bases[k] @ Hk
+        base += A @ W @ row_bases[k] @ Hk  # the observer gain; the report's L̂ (c.17h) is −base
         start += kk
     return DetectionGainFamily(A, C, maps, spaces, row_bases, residual_maps, T[start:], projectors, base)

@@ -35,15 +35,17 @@ is left on bounding the H∞ norm from the disturbance/noise ``ω`` to the fault
   reproduces the report's filter eigenvalues.
 * **Fault enhancement** (App. C.4, (c.19)–(c.26), ``T = ∞``): see :func:`enhancement_direction`.
 
-Sign convention: the report's gain ``L`` is that of ``A + LC`` and its residual is
-``C x̂ − y``; the generator is the fdikit observer with gain ``−L`` and residual
+Sign convention: the equations above are in the report's sign — its gain ``L`` is that of
+``A + LC`` and its residual is ``C x̂ − y``.  :attr:`HinfDesign.gain` is fdikit's observer gain
+(``x̂' = A x̂ + Bu u + L (y − C x̂ − Du u)``, state matrix ``A − LC``), the negative of the
+report's matrix, which stays available as :attr:`HinfDesign.report_gain`; the residual is
 ``z = 𝐇 (y − C x̂ − Du u)`` (the negative of the report's).
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
@@ -54,6 +56,7 @@ from fdikit.design.observers.detection_gain import DetectionGainFamily, detectio
 from fdikit.design.observers.full_order import observer_generator
 from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.model import FaultModel
+from fdikit.protocols import joined_form
 from fdikit.residuals import ResidualGenerator
 
 __all__ = [
@@ -102,8 +105,8 @@ def _riccati_data(fam: DetectionGainFamily, B, D, gamma, form) -> _Riccati:
     A, C = fam.A, fam.C
     n = A.shape[0]
     T = fam.coordinates
-    Lh = fam.base_gain
-    Ah, Bh = A + Lh @ C, B + Lh @ D
+    Lh = -fam.base_gain
+    Ah, Bh = A + Lh @ C, B + Lh @ D  # Lh: the report's L̂ (c.17h)
     C2, D21 = T @ C, T @ D
     k = sum(H.shape[0] for H in fam.residual_maps.values())
     Cz, Dz = C2[:k], D21[:k]
@@ -198,13 +201,14 @@ class HinfDesign:
     Attributes
     ----------
     generator : residuals ``<fault>[k]`` = the coordinates ``z_i = H_i r`` (c.11), each tied to its fault.
-    gain : ``L`` of ``A + LC`` (the report's sign; the observer gain is ``−L``).
+    gain : observer gain ``L``: the generator's state matrix is ``A − LC`` (:attr:`report_gain` = ``−L`` is
+        the report's matrix, of ``A + LC``).
     gamma, form : the design parameter and the Riccati form (``'corrected'`` or ``'printed'``).
     riccati : the steady-state ``Y`` of (c.18); ``initial_riccati`` the ARE solution the integration started from.
     riccati_residual : ``‖(c.18)(Y)‖_F`` relative to the size of its terms.
     settling_time : integration time of the differential Riccati equation to steady state.
     alphas : ``α_i`` (ν_i x k_i) by fault; ``alpha0`` (n x k_0).
-    poles : eigenvalues of ``A + LC``.
+    poles : eigenvalues of ``A − LC``.
     hinf_norm, peak_frequency : ``‖T_zω‖∞`` (SLICOT AB13DD via python-control) and where it peaks (rad/s).
     bound : ``(γ² + σ²_max(HD))^½``.
     family : the gain family (detection spaces ``W_i``, maps ``H_i``, projectors, ``L̂``).
@@ -233,9 +237,10 @@ class HinfDesign:
     detection_spaces = property(lambda self: self.family.spaces, doc="``W_i`` by fault.")
     residual_maps = property(lambda self: self.family.residual_maps, doc="``H_i`` (k_i x p) by fault.")
     projectors = property(lambda self: self.family.projectors, doc="``C W_i F̂_i H_i`` (p x p) by fault.")
+    report_gain = property(lambda self: -self.gain, doc="The report's gain: ``L`` of ``A + LC`` (``= −gain``).")
 
     def error_system(self):
-        """``T_zω``: ``e' = (A + LC) e + (B + LD) ω``, ``z = HC e + HD ω`` as a :class:`control.StateSpace`.
+        """``T_zω``: ``e' = (A − LC) e + (B − LD) ω``, ``z = HC e + HD ω`` as a :class:`control.StateSpace`.
 
         (ω is taken with the opposite sign of (c.10); norms are unchanged.)
         """
@@ -243,7 +248,27 @@ class HinfDesign:
 
         H = np.vstack(list(self.family.residual_maps.values()))
         A, C, L = self.family.A, self.family.C, self.gain
-        return control.ss(A + L @ C, self.B + L @ self.D, H @ C, H @ self.D)
+        return control.ss(A - L @ C, self.B - L @ self.D, H @ C, H @ self.D)
+
+    model: FaultModel | None = field(default=None, repr=False, kw_only=True)  # set by the design function
+
+    def internal_form(self) -> FaultModel:
+        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
+
+        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
+        model the design was made for (field ``model``, set by the design function).
+        """
+        return joined_form(self, self.model)
+
+    def report(self) -> dict:
+        """``gain`` (the attribute ``gain``), ``gamma``, ``form``, ``poles``, ``hinf_norm`` (attained ``‖T_zω‖∞``),
+        ``peak_frequency``, ``bound`` (``(γ² + σ²_max(HD))^½``), ``riccati`` (``Y``), ``riccati_residual``,
+        ``settling_time``, ``detection_spaces`` (``W_i``) and ``projectors``, ``disturbances`` (names of ω)."""
+        return {"gain": self.gain, "gamma": self.gamma, "form": self.form, "poles": self.poles,
+                "hinf_norm": self.hinf_norm, "peak_frequency": self.peak_frequency, "bound": self.bound,
+                "riccati": self.riccati, "riccati_residual": self.riccati_residual,
+                "settling_time": self.settling_time, "detection_spaces": self.detection_spaces,
+                "projectors": self.projectors, "disturbances": self.disturbances}
 
 
 def _omega(model: FaultModel, disturbances):
@@ -262,7 +287,7 @@ def _omega(model: FaultModel, disturbances):
 
 def hinf_detection_filter(
     model: FaultModel,
-    faults: Mapping[str, np.ndarray] | Sequence[str],
+    targets: Mapping[str, np.ndarray] | Sequence[str] | str,
     *,
     gamma: float,
     disturbances: Sequence[str] | None = None,
@@ -278,9 +303,9 @@ def hinf_detection_filter(
     ----------
     model : continuous FaultModel; ``ω`` are its disturbance and noise inputs (``x' = … + B ω``,
         ``y = … + D ω``); ``D Dᵀ`` must be invertible (every output noisy).
-    faults : fault maps by name or names (see :func:`detection_gain_family`).  Sensor faults by
-        output name give ``[F¹, A F¹]`` with ``C F¹ = e_i``: the residual coordinates are then in
-        output units, as in App. C.5.
+    targets : the faults to detect: fault names or a mapping name → ``F`` (see
+        :func:`detection_gain_family`).  Sensor faults (``'<output>_sensor'``) give ``[F¹, A F¹]``
+        with ``C F¹ = e_i``: the residual coordinates are then in output units, as in App. C.5.
     gamma : the H∞ parameter γ > 0 of (c.18).
     disturbances : names of the inputs forming ω (default: every ``d`` and ``w`` input).
     form : ``'corrected'`` (default; the bound is guaranteed) or ``'printed'`` ((c.18) as printed,
@@ -302,7 +327,7 @@ def hinf_detection_filter(
     >>> import numpy as np
     >>> from fdikit.plants.f16xl import f16xl_gust, F16XL_DRYDEN_GAIN
     >>> m = f16xl_gust(gust_gain=F16XL_DRYDEN_GAIN)
-    >>> d = hinf_detection_filter(m, ["y_Az", "elevon"], gamma=1.5)
+    >>> d = hinf_detection_filter(m, ["y_Az_sensor", "elevon_actuator"], gamma=1.5)
     >>> bool(d.hinf_norm <= d.bound), bool(np.all(d.poles.real < 0))
     (True, True)
     """
@@ -316,7 +341,7 @@ def hinf_detection_filter(
     steady_tol = validate.positive("steady_tol", steady_tol)
     import control
 
-    fam = detection_gain_family(model, faults, rtol)
+    fam = detection_gain_family(model, targets, rtol)
     names, B, D = _omega(model, disturbances)
     p = model.p
     if linalg.rank(D @ D.T) < p:
@@ -326,7 +351,7 @@ def hinf_detection_filter(
         )
     T = fam.coordinates
     C2, D21 = T @ model.C, T @ D
-    Ah, Bh = model.A + fam.base_gain @ model.C, B + fam.base_gain @ D
+    Ah, Bh = model.A - fam.base_gain @ model.C, B - fam.base_gain @ D  # the report's Â, B̂ (c.17)
     Abar = Ah - Bh @ D21.T @ np.linalg.solve(D21 @ D21.T, C2)
     ev = scipy.linalg.eigvals(Abar)
     if np.any(np.abs(ev.real) <= 1e-10 * max(np.linalg.norm(Abar, 1), 1.0)):
@@ -340,28 +365,28 @@ def hinf_detection_filter(
         raise DesignError(f"the steady state of (c.18) is not positive definite (eigenvalues {lam}); increase gamma")
     K = ric.gain(Y)
     G = K + ric.delta(Y)
-    L = fam.base_gain + G @ T
+    L = fam.base_gain - G @ T  # the observer gain; the report's L = L̂ + G 𝐓 is its negative
     alphas, start = {}, 0
     for k, W in fam.spaces.items():
         kk = fam.residual_maps[k].shape[0]
         alphas[k] = np.linalg.lstsq(W, G[:, start : start + kk], rcond=None)[0]
         start += kk
     alpha0 = G[:, start:]
-    poles = scipy.linalg.eigvals(model.A + L @ model.C)
+    poles = scipy.linalg.eigvals(model.A - L @ model.C)
     if np.any(poles.real >= 0):
         raise DesignError(f"the H∞ detection filter is unstable (poles {np.round(poles, 6).tolist()}); increase gamma")
     H = np.vstack(list(fam.residual_maps.values()))
-    sys = control.ss(model.A + L @ model.C, B + L @ D, H @ model.C, H @ D)
+    sys = control.ss(model.A - L @ model.C, B - L @ D, H @ model.C, H @ D)
     norm, peak = control.linfnorm(sys)
     bound = float(np.sqrt(gamma**2 + np.linalg.norm(H @ D, 2) ** 2))
     res_names, isolates = [], []
     for k, Hk in fam.residual_maps.items():
         res_names += [f"{k}[{j}]" for j in range(Hk.shape[0])]
         isolates += [k] * Hk.shape[0]
-    gen = observer_generator(model, -L, res_names, H.T, isolates)
+    gen = observer_generator(model, L, res_names, H.T, isolates)
     rel = float(np.linalg.norm(ric.residual(Y)) / ric.scale(Y))
     return HinfDesign(gen, L, float(gamma), form, Y, Y0, rel, t_end, alphas, alpha0, poles, float(norm),
-                      float(peak), bound, fam, names, B, D)
+                      float(peak), bound, fam, names, B, D, model=model)
 
 
 # ---------------------------------------------------------------------- (c.19)–(c.26) fault enhancement
@@ -381,14 +406,28 @@ class Enhancement:
     direction: np.ndarray
     ratio: float
     generator: ResidualGenerator
+    model: FaultModel | None = field(default=None, repr=False, kw_only=True)  # set by the design function
+
+    def internal_form(self) -> FaultModel:
+        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
+
+        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
+        model the design was made for (field ``model``, set by the design function).
+        """
+        return joined_form(self, self.model)
+
+    def report(self) -> dict:
+        """``fault``, ``direction`` (unit ``q``) and ``ratio`` (fault-to-disturbance energy ratio along ``q``)."""
+        return {"fault": self.fault, "direction": self.direction, "ratio": self.ratio}
 
 
 def enhancement_direction(design: HinfDesign, fault: str) -> Enhancement:
     """Fault-enhancing direction of a multi-dimensional residual (Douglas et al. 1996, (c.19)–(c.26), T = ∞).
 
     On the reduced realisation of ``z_i`` (the factor space ``X / Σ_{j≠i} W_j``, coordinates
-    ``Q`` orthonormal to the other spaces): ``Ā = Qᵀ(A + LC)Q``, ``F̄ = QᵀF_i``,
-    ``B̄ = Qᵀ(B + LD)``, ``C̄ = H_i C Q``.  With the observability gramian ``O``
+    ``Q`` orthonormal to the other spaces): ``Ā = Qᵀ(A − LC)Q``, ``F̄ = QᵀF_i``,
+    ``B̄ = Qᵀ(B − LD)``, ``C̄ = H_i C Q`` (``L`` the observer gain :attr:`HinfDesign.gain`; the report
+    writes ``A + LC`` with its own sign).  With the observability gramian ``O``
     (``ĀᵀO + OĀ + C̄ᵀC̄ = 0``) and the controllability gramians ``X_ω``, ``X_m`` of ``B̄``,
     ``F̄``, the worst-case initial states ``e_0ω``, ``e_0m`` are the eigenvectors of
     ``O X_ω`` and ``O X_m`` for their largest eigenvalues ((c.23), (c.24) as printed);
@@ -404,9 +443,9 @@ def enhancement_direction(design: HinfDesign, fault: str) -> Enhancement:
     n = A.shape[0]
     others = [W for k, W in fam.spaces.items() if k != fault]
     Q = scipy.linalg.null_space(linalg.orth(np.hstack(others)).T) if others else np.eye(n)
-    Ab = Q.T @ (A + L @ C) @ Q
+    Ab = Q.T @ (A - L @ C) @ Q
     Cb = fam.residual_maps[fault] @ C @ Q
-    Bb = Q.T @ (design.B + L @ design.D)
+    Bb = Q.T @ (design.B - L @ design.D)
     Fb = Q.T @ fam.fault_maps[fault]
     lyap = scipy.linalg.solve_continuous_lyapunov
     O = lyap(Ab.T, -Cb.T @ Cb)
@@ -429,4 +468,4 @@ def enhancement_direction(design: HinfDesign, fault: str) -> Enhancement:
     rows = [i for i, k in enumerate(g.isolates) if k == fault]
     gen = ResidualGenerator(g.A, g.B, (q @ g.C[rows]).reshape(1, -1), (q @ g.D[rows]).reshape(1, -1),
                             g.controls, g.outputs, (f"{fault}[q]",), g.dt, (fault,))
-    return Enhancement(fault, q, float(lam[-1]), gen)
+    return Enhancement(fault, q, float(lam[-1]), gen, model=design.model)
