@@ -41,7 +41,7 @@ def main() -> None:
     dt = 0.01
     plant = path_fault_model(14).discretize(dt)
     noise = 1e-4 * np.array([bank.nominal[sensor_fault_name(o)] for o in plant.outputs])
-    trace = simulate(plant, duration=(args.samples - 1) * dt, measurement_noise=noise, rng=0)
+    trace = simulate(plant, duration=(args.samples - 1) * dt, measurement_noise_std=noise, rng=0)
     gen = bank.generator.discretize(dt)
     v = gen.inputs_from(trace)
     runs = {

@@ -44,7 +44,7 @@ def main() -> None:
     W = np.diag([ACTUATOR_NOISE_STD[c] ** 2 for c in model.controls])
     v_std = np.array([SENSOR_NOISE_STD[o] for o in model.outputs])
     gen = kalman(model, W, np.diag(v_std**2)).generator
-    trace = simulate(model, duration=(args.samples - 1) * 0.01, noise_cov=W, measurement_noise=v_std, rng=0,
+    trace = simulate(model, duration=(args.samples - 1) * 0.01, noise_cov=W, measurement_noise_std=v_std, rng=0,
                      u=lambda t: [np.sin(t), 10 * np.sin(0.3 * t), 1e-3 * np.sin(0.7 * t)])
     v = gen.inputs_from(trace)
     sys_c = gen.to_control()

@@ -12,7 +12,7 @@ runner = CliRunner()
 def test_simulate_writes_parquet(tmp_path):
     out = tmp_path / "t.parquet"
     res = runner.invoke(app, ["simulate", "path12", "-f", "bias:yaw_rate:0.02@10", "--duration", "20",
-                              "--noise", "0.001", "--out", str(out)])
+                              "--noise-std", "0.001", "--out", str(out)])
     assert res.exit_code == 0, res.output
     tr = Trace.load(out)
     assert len(tr) == 2001

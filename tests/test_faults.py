@@ -314,8 +314,8 @@ def _u(t):
 
 
 def _run(scenario=None, seed=123):
-    return simulate(_plant(), scenario, t=SIM_T, u=_u(SIM_T), x0=[0.2, -0.1, 0.5], measurement_noise=[0.01, 0.02, 0.01],
-                    rng=seed)
+    return simulate(_plant(), scenario, t=SIM_T, u=_u(SIM_T), x0=[0.2, -0.1, 0.5],
+                    measurement_noise_std=[0.01, 0.02, 0.01], rng=seed)
 
 
 @pytest.mark.parametrize("kind", list(KINDS))
@@ -357,7 +357,7 @@ def test_actuator_fault_changes_outputs_only_from_onset_and_u_stays_commanded(ki
         # independent: simulate the fault-free plant driven by the faulty actuator signal
         u_act = _u(SIM_T)
         u_act[:, 1] = fault.apply(SIM_T, u_act[:, 1])
-        ref = simulate(_plant(), t=SIM_T, u=u_act, x0=[0.2, -0.1, 0.5], measurement_noise=[0.01, 0.02, 0.01],
+        ref = simulate(_plant(), t=SIM_T, u=u_act, x0=[0.2, -0.1, 0.5], measurement_noise_std=[0.01, 0.02, 0.01],
                        rng=123)
         np.testing.assert_array_equal(tr.x, ref.x)
         np.testing.assert_array_equal(tr.y, ref.y)

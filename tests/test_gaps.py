@@ -44,7 +44,7 @@ def setup():
     model = path_vehicle_12().discretize(DT)
     gen = kalman(model, Q=1e-6 * np.eye(12), R=np.diag(NOISE**2)).generator
     t = np.arange(60_000) * DT
-    cal = gen.run(simulate(model, t=t, u=_u(t), measurement_noise=NOISE, rng=1)).slice(SETTLE)
+    cal = gen.run(simulate(model, t=t, u=_u(t), measurement_noise_std=NOISE, rng=1)).slice(SETTLE)
     ev = ThresholdEvaluator().fit(cal, false_alarm_prob=ALPHA)
     S = np.cov(cal.r.T)
     return model, gen, ev, S
@@ -52,7 +52,7 @@ def setup():
 
 def _run(model, duration, scenario=None, seed=2):
     t = np.arange(int(round(duration / DT))) * DT
-    return simulate(model, scenario, t=t, u=_u(t), measurement_noise=NOISE, rng=seed)
+    return simulate(model, scenario, t=t, u=_u(t), measurement_noise_std=NOISE, rng=seed)
 
 
 def _with_gaps(tr: Trace, bad: np.ndarray, channels=None) -> Trace:

@@ -52,7 +52,7 @@ def _u(t):
 
 def _trace(model, scenario=None, duration=20.0, noise=True, x0=None, seed=1):
     """Noise=False also switches the disturbance off: the nominal, undisturbed plant."""
-    kw = {"noise_cov": [0.5, 0.2], "measurement_noise": [0.1, 0.14, 0.1]} if noise else {}
+    kw = {"noise_std": [0.5, 0.2], "measurement_noise_std": [0.1, 0.14, 0.1]} if noise else {}
     dt = model.dt or DT
     t = np.arange(int(round(duration / dt)) + 1) * dt
     d = (lambda tk: [0.2 * np.sin(tk)]) if noise else None

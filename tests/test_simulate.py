@@ -119,7 +119,7 @@ def _noisy() -> FaultModel:
 
 
 def test_same_seed_same_trace_other_seed_other_noise():
-    kw = {"duration": 4.0, "dt": 0.02, "noise_cov": [0.5, 0.2], "measurement_noise": [0.01, 0.03]}
+    kw = {"duration": 4.0, "dt": 0.02, "noise_std": [0.5, 0.2], "measurement_noise_std": [0.01, 0.03]}
     a, b = simulate(_noisy(), rng=5, **kw), simulate(_noisy(), rng=np.random.default_rng(5), **kw)
     np.testing.assert_array_equal(a.y, b.y)
     np.testing.assert_array_equal(a.x, b.x)
@@ -129,10 +129,34 @@ def test_same_seed_same_trace_other_seed_other_noise():
     assert np.any(a.x[1:] != c.x[1:])
 
 
+@pytest.mark.parametrize("std", [0.3, [0.5, 0.2]])
+def test_a_std_and_its_square_as_a_covariance_give_the_same_trace_bit_for_bit(std):
+    """The std/cov convention: ``*_std=s`` and ``*_cov=s**2`` (a scalar or vector of variances, or the diagonal
+    matrix) draw the same noise with the same seed."""
+    s = np.asarray(std, dtype=float)
+    t = np.arange(201) * 0.02
+    kw = {"t": t, "u": _u(t), "rng": 5}
+    v = 0.1 * s  # the measurement noise std
+    ref = simulate(_noisy(), noise_std=std, measurement_noise_std=v, **kw)
+    variances = s**2 if s.ndim else float(s) ** 2
+    for cov, meas in ((variances, v**2), (np.diag(np.broadcast_to(s**2, (2,))), np.diag(np.broadcast_to(v**2, (2,))))):
+        got = simulate(_noisy(), noise_cov=cov, measurement_noise_cov=meas, **kw)
+        np.testing.assert_array_equal(got.y, ref.y)
+        np.testing.assert_array_equal(got.x, ref.x)
+    assert np.abs(ref.y - simulate(_noisy(), **kw).y).max() > 0  # the noise is there
+
+
+def test_a_std_and_a_covariance_of_the_same_noise_are_refused_together():
+    with pytest.raises(ParameterError, match="give noise_std or noise_cov, not both"):
+        simulate(_noisy(), duration=1.0, dt=0.1, noise_std=0.1, noise_cov=0.01)
+    with pytest.raises(ParameterError, match="give measurement_noise_std or measurement_noise_cov, not both"):
+        simulate(_noisy(), duration=1.0, dt=0.1, measurement_noise_std=[0.1, 0.2], measurement_noise_cov=np.eye(2))
+
+
 def test_measurement_noise_covariance_statistics():
     R = np.array([[0.04, 0.012], [0.012, 0.09]])
     N = 40_000
-    tr = simulate(_continuous(), t=np.arange(N) * 0.01, measurement_noise=R, rng=11)
+    tr = simulate(_continuous(), t=np.arange(N) * 0.01, measurement_noise_cov=R, rng=11)
     assert not tr.x.any()  # zero input, zero state: y is the noise
     S = np.cov(tr.y.T)
     # std of a sample covariance entry of Gaussian data: sqrt((R_ii R_jj + R_ij^2) / N)
@@ -144,7 +168,7 @@ def test_measurement_noise_covariance_statistics():
 @pytest.mark.parametrize("std", [0.2, [0.1, 0.3]])
 def test_measurement_noise_std_chi_square(std):
     N = 20_000
-    tr = simulate(_continuous(), t=np.arange(N) * 0.01, measurement_noise=std, rng=3)
+    tr = simulate(_continuous(), t=np.arange(N) * 0.01, measurement_noise_std=std, rng=3)
     sig2 = np.broadcast_to(np.asarray(std, float) ** 2, (2,))
     lo, hi = scipy.stats.chi2.ppf([1e-6, 1 - 1e-6], N - 1)
     for j in range(2):
@@ -265,8 +289,9 @@ def test_nonlinear_plant_with_sensor_fault():
         ({"duration": -1.0, "dt": 0.1}, ParameterError, "duration must be >= 0"),
         ({"duration": 1.0, "dt": 0.0}, ParameterError, r"dt \(the sample time\) must be > 0"),
         ({"t": np.array([0.0, 0.1, 0.25, 0.3])}, DataError, "uniformly spaced"),
-        ({"duration": 1.0, "dt": 0.1, "measurement_noise": [0.1, 0.2, 0.3]}, ParameterError, "standard deviations"),
-        ({"duration": 1.0, "dt": 0.1, "measurement_noise": [[1.0, 2.0], [2.0, 1.0]]}, ParameterError, "semidefinite"),
+        ({"duration": 1.0, "dt": 0.1, "measurement_noise_std": [0.1, 0.2, 0.3]}, ParameterError, "standard deviations"),
+        ({"duration": 1.0, "dt": 0.1, "measurement_noise_cov": [[1.0, 2.0], [2.0, 1.0]]}, ParameterError,
+         "semidefinite"),
         ({"duration": 1.0, "dt": 0.1, "scenario": FaultScenario([Bias("brake", 1.0)])}, ParameterError,
          r"no signal named 'brake'"),
         ({"duration": 1.0, "dt": 0.1, "scenario": FaultScenario([Bias("u1", 1.0, location="sensor")])}, ParameterError,

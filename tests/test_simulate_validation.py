@@ -63,7 +63,7 @@ D = 0.5 * np.cos(2.3 * T)
 
 def run(scenario=None, rng=7, **kw):
     return simulate(plant(), scenario, duration=DURATION, dt=DT, u=U, d=D, x0=[0.4, -0.2, 0.1],
-                    noise_cov=[0.1, 0.2, 0.05], measurement_noise=[0.01, 0.02], rng=rng, **kw)
+                    noise_std=[0.1, 0.2, 0.05], measurement_noise_std=[0.01, 0.02], rng=rng, **kw)
 
 
 SIZE = st.floats(-1e100, 1e100, allow_nan=False)
@@ -134,7 +134,7 @@ def _pendulum() -> NonlinearPlant:
 @settings(max_examples=10)
 @given(st.integers(0, 2**31 - 1), st.integers(0, 2**31 - 1))
 def test_nonlinear_path_is_deterministic_per_seed(seed, other):
-    kw = {"duration": 2.0, "dt": 0.02, "noise_cov": [1e-4, 1e-3], "measurement_noise": 0.01,
+    kw = {"duration": 2.0, "dt": 0.02, "noise_std": [1e-4, 1e-3], "measurement_noise_std": 0.01,
           "u": lambda tk: [0.1 * np.sin(tk)]}
     a, b = simulate(_pendulum(), rng=seed, **kw), simulate(_pendulum(), rng=seed, **kw)
     assert a.y.tobytes() == b.y.tobytes() and a.x.tobytes() == b.x.tobytes()
@@ -279,9 +279,9 @@ def test_available_memory_reads_meminfo_or_falls_back(tmp_path):
     ("kwargs", "error", "pattern"),
     [
         ({"x0": [np.nan, 0.0, 0.0]}, ParameterError, "x0 must be finite"),
-        ({"measurement_noise": -0.1}, ParameterError, "measurement_noise holds standard deviations.*>= 0"),
-        ({"measurement_noise": [0.1, np.inf]}, ParameterError, "measurement_noise must be finite"),
-        ({"noise_cov": [0.1, -0.2, 0.1]}, ParameterError, "noise_cov holds standard deviations.*>= 0"),
+        ({"measurement_noise_std": -0.1}, ParameterError, "measurement_noise_std holds standard deviations.*>= 0"),
+        ({"measurement_noise_std": [0.1, np.inf]}, ParameterError, "measurement_noise_std must be finite"),
+        ({"noise_std": [0.1, -0.2, 0.1]}, ParameterError, "noise_std holds standard deviations.*>= 0"),
         ({"rng": -3}, ParameterError, "rng, a seed, must be >= 0"),
         ({"substeps": 0}, ParameterError, "substeps must be >= 1"),
         ({"u": np.full((161, 2), np.nan)}, DataError, "u has a non-finite value nan in signal 'u1' at sample 0"),
@@ -295,9 +295,9 @@ def test_bad_arguments_are_refused_before_any_work(kwargs, error, pattern):
 
 
 def test_issue_examples_give_clear_errors():
-    """``x0=[nan]`` and ``measurement_noise=-0.1`` were accepted before (issue 12)."""
+    """``x0=[nan]`` and ``measurement_noise_std=-0.1`` were accepted before (issue 12)."""
     m = FaultModel(A=[[-1.0]], C=[[1.0]], Bu=[[1.0]], outputs=["y"], controls=["u"], states=["x"])
     with pytest.raises(ParameterError, match="x0 must be finite"):
         simulate(m, duration=1.0, dt=0.1, x0=[np.nan])
     with pytest.raises(ParameterError, match=">= 0"):
-        simulate(m, duration=1.0, dt=0.1, measurement_noise=-0.1)
+        simulate(m, duration=1.0, dt=0.1, measurement_noise_std=-0.1)

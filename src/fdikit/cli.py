@@ -109,7 +109,8 @@ def simulate(
                                          "e.g. bias:yaw_rate:0.02@10."),
     duration: float = typer.Option(30.0, help="Simulated time [s]."),
     dt: float = typer.Option(0.01, help="Sample time [s]."),
-    noise: float = typer.Option(0.0, help="Measurement noise std, the same on every output."),
+    noise_std: float = typer.Option(0.0, "--noise-std",
+                                    help="Measurement noise standard deviation, the same on every output."),
     seed: int = typer.Option(0, help="Random seed."),
     param: list[str] = typer.Option([], "--param", "-p", help="Plant parameter name=value, e.g. speed=20."),
     out: Path = typer.Option(Path("out/trace.parquet"), help="Parquet file to write."),
@@ -125,7 +126,7 @@ def simulate(
         dt = check_positive(dt, "dt", hint=" s")
         if dt > duration:
             raise ParameterError(f"dt (--dt) = {dt:g} s must not exceed duration (--duration) = {duration:g} s")
-        noise = check_nonnegative(noise, "noise")
+        noise_std = check_nonnegative(noise_std, "noise_std")
         seed = check_seed(seed)
         kw = _plant_params(plant, param)
         model = get_plant(plant, **kw)
@@ -133,7 +134,7 @@ def simulate(
         scenario = FaultScenario([parse_fault(s) for s in fault])
         with console.status(f"simulating {plant} for {duration:g} s ..."), warnings.catch_warnings(record=True) as seen:
             warnings.simplefilter("always", FdiWarning)
-            trace = run(model, scenario, duration=duration, dt=dt, measurement_noise=noise or None, rng=seed,
+            trace = run(model, scenario, duration=duration, dt=dt, measurement_noise_std=noise_std or None, rng=seed,
                         meta={"plant_name": plant, "plant_params": kw})
         for w in seen:  # one line each (a fault that never acts ...), not Python's warning format
             console.print(f"[yellow]warning:[/yellow] {w.message}")

@@ -42,10 +42,10 @@ from fdikit.faults import FaultScenario
 from fdikit.lti import dlsim_blocked
 from fdikit.model import FaultModel
 from fdikit.simulate_checks import (
-    check_covariance,
     check_duration,
     check_initial_state,
     check_memory,
+    check_noise,
     check_rng,
     check_sample_time,
     check_scenario,
@@ -171,8 +171,10 @@ def simulate(
     u=None,
     d=None,
     x0=None,
+    noise_std=None,
     noise_cov=None,
-    measurement_noise=None,
+    measurement_noise_std=None,
+    measurement_noise_cov=None,
     rng: np.random.Generator | int | None = None,
     method: str = "rk4",
     substeps: int = 4,
@@ -202,12 +204,15 @@ def simulate(
         Commanded controls and disturbances (zero when omitted); finite.
     x0 : array, optional
         Initial state, one finite value per state.
-    noise_cov : optional
-        Linear plants: covariance (or std vector) of the model's noise group ``w``, drawn
-        every sample and held over it.  Nonlinear plants: covariance of an additive
-        state increment per sample.
-    measurement_noise : optional
-        Standard deviations (scalar or one per output, finite and >= 0) or a p x p covariance.
+    noise_std, noise_cov : optional, at most one of them
+        Linear plants: the model's noise group ``w``, drawn every sample and held over it.
+        Nonlinear plants: an additive state increment per sample.  ``noise_std`` is a standard
+        deviation (a scalar or one per signal, finite and >= 0); ``noise_cov`` a covariance (a
+        symmetric positive semidefinite matrix, or a scalar/vector of variances meaning ``σ² I`` /
+        ``diag``).  A std of ``s`` and a cov of ``s**2`` give the same trace, bit for bit.
+    measurement_noise_std, measurement_noise_cov : optional, at most one of them
+        Additive output noise: standard deviations (scalar or one per output) or a covariance
+        (p x p matrix, or a scalar/vector of variances), as for the process noise.
     rng : numpy.random.Generator or int seed (>= 0)
     method : ``'rk4'`` (fixed step, ``substeps`` per sample) or ``'solve_ivp'`` (RK45), nonlinear plants only.
     substeps : int >= 1
@@ -275,10 +280,11 @@ def simulate(
         raise DataError(f"t is spaced {h:g} s but the discrete plant runs at dt={plant.dt:g} s; give t at its dt")
     x0 = check_initial_state(x0, states)
     if isinstance(plant, FaultModel):
-        W = check_covariance("noise_cov", noise_cov, len(plant.noise), "noise input w")
+        W = check_noise("noise_std", noise_std, "noise_cov", noise_cov, len(plant.noise), "noise input w")
     else:
-        W = check_covariance("noise_cov", noise_cov, len(states), "state")
-    R = check_covariance("measurement_noise", measurement_noise, len(outputs), "output")
+        W = check_noise("noise_std", noise_std, "noise_cov", noise_cov, len(states), "state")
+    R = check_noise("measurement_noise_std", measurement_noise_std, "measurement_noise_cov", measurement_noise_cov,
+                    len(outputs), "output")
     u_cmd = check_signal("u", u, t, controls)
     d_arr = check_signal("d", d, t, dists)
     warn_inactive(scenario, t)

@@ -33,7 +33,7 @@ from fdikit.faults import FaultScenario
 from fdikit.model import FaultModel
 
 __all__ = [
-    "check_covariance",
+    "check_noise",
     "check_duration",
     "check_initial_state",
     "check_memory",
@@ -158,37 +158,16 @@ def check_signal(name: str, value, t: np.ndarray, names: Sequence[str]) -> np.nd
     return arr
 
 
-def check_covariance(name: str, value, k: int, what: str) -> np.ndarray | None:
-    """Covariance from None, a scalar/vector of standard deviations (>= 0), or a k x k PSD matrix."""
-    if value is None:
-        return None
-    if k == 0:
+def check_noise(std_name: str, std, cov_name: str, cov, k: int, what: str) -> np.ndarray | None:
+    """Covariance of ``k`` noise signals from ``std`` (standard deviations) or ``cov`` (a covariance), or None.
+
+    :func:`fdikit.validate.noise_covariance` (the std/cov convention), after refusing noise for no signal.
+    """
+    if (std is not None or cov is not None) and k == 0:
+        name = std_name if std is not None else cov_name
         raise ParameterError(f"{name} was given but there is no signal for it (the model has no noise inputs w); "
                              "add a noise group (FaultModel(..., Bw=..., noise=[...])) or omit it")
-    try:
-        arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name} must be a number (a standard deviation), one per {what}, or a {k}x{k} "
-                             f"covariance matrix; got {value!r:.60}") from None
-    if not np.all(np.isfinite(arr)):
-        raise ParameterError(f"{name} must be finite, got {arr.tolist()}")
-    if arr.ndim <= 1:
-        if arr.size not in (1, k):
-            raise ParameterError(f"{name} has {arr.size} standard deviations; need 1 or {k} (one per {what})")
-        if np.any(arr < 0):
-            raise ParameterError(f"{name} holds standard deviations, which must be >= 0; got {arr.tolist()}")
-        return np.diag(np.broadcast_to(arr, (k,)) ** 2)
-    if arr.shape != (k, k):
-        raise ParameterError(f"{name} has shape {arr.shape}; need a scalar, {k} standard deviations or a {k}x{k} "
-                             "covariance matrix")
-    if not np.allclose(arr, arr.T):
-        raise ParameterError(f"{name} must be a symmetric positive semidefinite {k}x{k} covariance; it is not "
-                             "symmetric")
-    lowest = np.linalg.eigvalsh(arr).min()
-    if lowest < -1e-12 * max(1.0, np.abs(arr).max()):
-        raise ParameterError(f"{name} must be a symmetric positive semidefinite {k}x{k} covariance (or std vector); "
-                             f"its smallest eigenvalue is {lowest:.3g}")
-    return arr
+    return validate.noise_covariance(std_name, std, cov_name, cov, k, what)
 
 
 def check_initial_state(x0, states: Sequence[str]) -> np.ndarray | None:

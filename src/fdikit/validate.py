@@ -33,6 +33,7 @@ __all__ = [
     "as_vector",
     "as_complex_vector",
     "as_covariance",
+    "noise_covariance",
     "number",
     "positive",
     "non_negative",
@@ -178,6 +179,45 @@ def as_covariance(
             raise error(f"{name} must be positive semidefinite (smallest eigenvalue {low:.3g}); "
                         "a covariance has non-negative eigenvalues")
     return out
+
+
+def noise_covariance(std_name: str, std, cov_name: str, cov, k: int, what: str = "signal", *,
+                     error: type[Exception] = ParameterError) -> np.ndarray | None:
+    """The ``k x k`` covariance of ``k`` noise signals given either as a standard deviation or as a covariance.
+
+    The std/cov convention of ``docs/ARCHITECTURE.md``: ``std`` is a standard deviation σ (a scalar, or one per
+    signal, each >= 0) and gives ``diag(σ²)``; ``cov`` is a covariance (a ``k x k`` symmetric positive
+    semidefinite matrix, or a scalar/vector of variances meaning ``σ² I`` / ``diag``).  Giving both is an error;
+    giving neither returns None.  A std of ``s`` and a cov of ``s**2`` give the same matrix, bit for bit.
+    """
+    if std is not None and cov is not None:
+        raise error(f"give {std_name} or {cov_name}, not both: {std_name} is a standard deviation σ (a scalar or one "
+                    f"per {what}), {cov_name} a covariance σ² (a {k} x {k} matrix, or a scalar/vector meaning σ² I / "
+                    "diag)")
+    if std is None and cov is None:
+        return None
+    name, value = (std_name, std) if std is not None else (cov_name, cov)
+    arr = as_array(name, value, error=error, finite=False)
+    if not np.all(np.isfinite(arr)):
+        raise error(f"{name} must be finite, got {_show(arr.tolist())}")
+    if std is not None:
+        if arr.ndim > 1:
+            raise error(f"{name} is a standard deviation: a scalar or one per {what} ({k}), got an array of shape "
+                        f"{arr.shape}; give a {k} x {k} covariance matrix as {cov_name}")
+        if arr.size not in (1, k):
+            raise error(f"{name} has {arr.size} standard deviations; need 1 or {k} (one per {what})")
+        if np.any(arr < 0):
+            raise error(f"{name} holds standard deviations, which must be >= 0; got {_show(arr.tolist())}")
+        return np.diag(np.broadcast_to(arr, (k,)) ** 2)
+    if arr.ndim <= 1:
+        if arr.size not in (1, k):
+            raise error(f"{name} has {arr.size} variances; need 1 or {k} (one per {what}) or a {k} x {k} "
+                        "covariance matrix")
+        if np.any(arr < 0):
+            raise error(f"{name} holds variances σ² (a scalar or vector means σ² I / diag), which must be >= 0; "
+                        f"got {_show(arr.tolist())}")
+        return np.diag(np.broadcast_to(arr, (k,)))
+    return as_covariance(name, arr, k, error=error, scalar_ok=False)
 
 
 def number(name: str, value, *, error: type[Exception] = ParameterError, finite: bool = True) -> float:

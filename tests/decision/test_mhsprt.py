@@ -431,7 +431,7 @@ def test_path_bank_steps_are_isolated_at_once(path_setup, signal, size):
 
     ev, gen, plant, noise = path_setup
     faults = [] if signal is None else [Bias(signal, size, onset=8.0, location="sensor")]
-    d = ev.run(gen.run(simulate(plant, FaultScenario(faults), duration=12.0, measurement_noise=noise, rng=123)))
+    d = ev.run(gen.run(simulate(plant, FaultScenario(faults), duration=12.0, measurement_noise_std=noise, rng=123)))
     before, after = d.t < 8.0, d.t >= 8.0
     assert d.probabilities[before, 1:].max() < 1e-2 and not d.alarm[before].any()
     if signal is None:

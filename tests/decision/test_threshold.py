@@ -30,8 +30,8 @@ def test_calibrated_rate_matches_binomial_on_fresh_data():
     2 z φ(z) δσ/σ, ≈ 16 counts here).
     """
     model, W, V, gen = _kalman_setup()
-    fit_run = gen.run(simulate(model, duration=1000, noise_cov=W, measurement_noise=np.sqrt(np.diag(V)), rng=1))
-    fresh = gen.run(simulate(model, duration=1000, noise_cov=W, measurement_noise=np.sqrt(np.diag(V)), rng=2))
+    fit_run = gen.run(simulate(model, duration=1000, noise_cov=W, measurement_noise_std=np.sqrt(np.diag(V)), rng=1))
+    fresh = gen.run(simulate(model, duration=1000, noise_cov=W, measurement_noise_std=np.sqrt(np.diag(V)), rng=2))
     alpha = 0.03
     ev = ThresholdEvaluator().fit(fit_run.slice(start=2.0), false_alarm_prob=alpha)
     r = fresh.slice(start=2.0)

@@ -194,7 +194,7 @@ def test_innovations_are_white_with_the_predicted_covariance(dw):
     d = kalman(m, Q, R)
     N, burn = 30_000, 500
     tr = simulate(m, duration=(N + burn - 1) * 0.1, u=lambda t: [np.sin(0.3 * t)], noise_cov=Q,
-                  measurement_noise=R, rng=2024)
+                  measurement_noise_cov=R, rng=2024)
     e = d.generator.run(tr).r[burn:]
     assert e.shape == (N, 2)
     Sig = d.innovation_covariance

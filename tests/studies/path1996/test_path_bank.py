@@ -104,14 +104,14 @@ def test_all_fifteen_faults_detected_and_isolated(bank):
     bank logic (filters pointing to two or more faults are discarded)."""
     plant = path_fault_model(14).discretize(0.01)
     noise = 1e-4 * np.array([bank.nominal[sensor_fault_name(o)] for o in plant.outputs])
-    healthy = bank.generator.run(simulate(plant, duration=600, measurement_noise=noise, rng=1)).slice(start=10)
+    healthy = bank.generator.run(simulate(plant, duration=600, measurement_noise_std=noise, rng=1)).slice(start=10)
     ev = ThresholdEvaluator(groups=bank.groups, persistence=(5, 10)).fit(healthy, false_alarms_per_hour=1)
     faults = [f for specs in FILTER_GROUPS.values() for f in specs]
     assert len({f.partition(":")[0] for f in faults}) == 15
     for k, fault in enumerate(plant.faults):
         signal, loc = fault.rsplit("_", 1)
         scenario = FaultScenario([Bias(signal, bank.nominal[fault], onset=5.0, location=loc)])
-        tr = simulate(plant, scenario, duration=20.0, measurement_noise=noise, rng=10 + k)
+        tr = simulate(plant, scenario, duration=20.0, measurement_noise_std=noise, rng=10 + k)
         s = score(tr, ev.run(bank.generator.run(tr)))
         assert s.detected and s.detection_delay < 0.5, fault
         assert s.isolated == fault and s.false_alarms == 0, (fault, s.isolated)

@@ -151,9 +151,9 @@ def test_varying_speed_switches_the_zoh_model_every_sample():
 
 
 def test_measurement_noise_reproducible_with_seed():
-    a = vanderploeg_case("S1", duration=20.0, measurement_noise=1e-4, rng=7)
-    b = vanderploeg_case("S1", duration=20.0, measurement_noise=1e-4, rng=7)
-    c = vanderploeg_case("S1", duration=20.0, measurement_noise=1e-4, rng=8)
+    a = vanderploeg_case("S1", duration=20.0, measurement_noise_std=1e-4, rng=7)
+    b = vanderploeg_case("S1", duration=20.0, measurement_noise_std=1e-4, rng=7)
+    c = vanderploeg_case("S1", duration=20.0, measurement_noise_std=1e-4, rng=8)
     clean = vanderploeg_case("S1", duration=20.0)
     np.testing.assert_array_equal(a.y, b.y)
     assert not np.array_equal(a.y, c.y) and a.meta["seed"] == 7

@@ -43,7 +43,7 @@ from fdikit.design.observers.beard_jones import BeardJonesDesign, beard_jones
 from fdikit.errors import DesignError, ParameterError
 from fdikit.linalg import resolve_faults
 from fdikit.model import FaultModel, actuator_fault_name, sensor_fault_name
-from fdikit.plants.path_vehicle import OUTPUTS, path_vehicle_12, path_vehicle_14
+from fdikit.plants.path_vehicle import path_vehicle_12, path_vehicle_14
 from fdikit.residuals import ResidualGenerator, stack_generators
 
 __all__ = [

@@ -198,7 +198,7 @@ def _test_run(spec, noise_fraction: float, size: float = 1.0, duration: float = 
     if fault is not None:
         signal, loc = fault.rsplit("_", 1)
         faults = [Bias(signal, size * bank.nominal[fault], onset=_ONSET, location=loc)]
-    trace = simulate(plant, FaultScenario(faults), duration=duration, measurement_noise=noise, rng=s)
+    trace = simulate(plant, FaultScenario(faults), duration=duration, measurement_noise_std=noise, rng=s)
     return trace, gen.run(trace)
 
 

@@ -121,13 +121,13 @@ def run_kalman_demo(
 
     rng = np.random.default_rng(seed)
     seeds = rng.integers(2**31, size=2)
-    healthy = simulate(model, duration=60 * calibration_minutes, noise_cov=W, measurement_noise=v_std,
+    healthy = simulate(model, duration=60 * calibration_minutes, noise_cov=W, measurement_noise_std=v_std,
                        rng=int(seeds[0]))
     evaluator = ThresholdEvaluator().fit(generator.run(healthy).slice(start=5.0),
                                         false_alarms_per_hour=false_alarms_per_hour)
 
     scenario = FaultScenario([Bias("yaw_rate", fault_size, onset=onset)], label="yaw-rate gyro bias")
-    trace = simulate(model, scenario, duration=duration, noise_cov=W, measurement_noise=v_std, rng=int(seeds[1]),
+    trace = simulate(model, scenario, duration=duration, noise_cov=W, measurement_noise_std=v_std, rng=int(seeds[1]),
                      meta={"demo": "path12 yaw-rate bias", "plant": "path12 (Douglas et al. 1996, App. D)"})
     residuals = generator.run(trace)
     diagnosis = evaluator.run(residuals)
@@ -188,14 +188,14 @@ def run_demo(
     plant = path_fault_model(14).discretize(dt)
     noise = noise_fraction * np.array([bank.nominal[sensor_fault_name(o)] for o in plant.outputs])
     seeds = np.random.default_rng(seed).integers(2**31, size=1 + len(BANK_SCENARIOS))
-    healthy = simulate(plant, duration=60 * calibration_minutes, measurement_noise=noise, rng=int(seeds[0]))
+    healthy = simulate(plant, duration=60 * calibration_minutes, measurement_noise_std=noise, rng=int(seeds[0]))
     evaluator = ThresholdEvaluator(groups=bank.groups, persistence=(5, 10)).fit(
         gen.run(healthy).slice(start=10.0), false_alarms_per_hour=1.0)
     traces, diagnoses, scores, files = {}, {}, {}, {}
     panels = []
     for (label, signal, loc, size), s in zip(BANK_SCENARIOS, seeds[1:]):
         scenario = FaultScenario([Bias(signal, size, onset=onset, location=loc)], label=label)
-        trace = simulate(plant, scenario, duration=duration, measurement_noise=noise, rng=int(s),
+        trace = simulate(plant, scenario, duration=duration, measurement_noise_std=noise, rng=int(s),
                          meta={"demo": f"path bank: {label}"})
         residuals = gen.run(trace)
         diagnosis = evaluator.run(residuals)
