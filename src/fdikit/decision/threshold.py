@@ -35,7 +35,38 @@ __all__ = ["ThresholdEvaluator", "alpha_from_rate"]
 
 
 def alpha_from_rate(false_alarms_per_hour: float, dt: float) -> float:
-    """Per-sample false-alarm probability for a target number of false alarms per hour."""
+    """Per-sample false-alarm probability for a target number of false alarms per hour.
+
+    ``α = rate · dt / 3600``, capped at 1: every exceedance counted as one alarm, so the conversion is
+    conservative (persistence and correlated residuals only lower the rate).
+
+    Parameters
+    ----------
+    false_alarms_per_hour : float
+        Target number of false alarms per hour of fault-free running [1/h]; positive.
+    dt : float
+        Sample time of the residuals [s]; positive.
+
+    Returns
+    -------
+    float
+        The per-sample false-alarm probability ``α`` in (0, 1].
+
+    Raises
+    ------
+    ParameterError
+        When the rate or ``dt`` is not positive.
+
+    Examples
+    --------
+    >>> from fdikit.decision.threshold import alpha_from_rate
+    >>> alpha_from_rate(36.0, 0.1)
+    0.001
+
+    References
+    ----------
+    Douglas et al. 1996, Ch. 1 (a threshold per residual, traded between the rates of false and missed alarms).
+    """
     if not false_alarms_per_hour > 0 or not dt > 0:
         raise ParameterError(f"need a positive rate and sample time, got {false_alarms_per_hour}/h and dt={dt}")
     return min(1.0, false_alarms_per_hour * dt / 3600.0)
@@ -70,6 +101,11 @@ class ThresholdEvaluator:
     >>> ev = ThresholdEvaluator().fit(healthy, false_alarm_prob=1e-3)
     >>> round(float(ev.thresholds[0]), 1)
     3.3
+
+    References
+    ----------
+    Douglas et al. 1996, Ch. 1 (a simple threshold per residual, set from empirical studies that balance the
+    rate of false alarms against the rate of missed alarms).
     """
 
     def __init__(
