@@ -45,10 +45,32 @@ _LOG2PI = float(np.log(2.0 * np.pi))
 class IMMStep:
     """Output of one IMM cycle (Table 2.1 step 4, fused values are output only).
 
-    ``x, P`` fused filtered estimate and covariance, ``mu`` mode probabilities ``μ_k``,
-    ``x_modes, P_modes`` mode-matched filtered estimates, ``log_likelihood`` the log predictive
-    density ``log p(y_k | Y_{k−1})`` (nan when invalid), ``valid`` False for a NaN measurement
-    (prediction only: ``x, mu`` are then the predicted values).
+    Attributes
+    ----------
+    x, P : ndarray
+        Fused filtered estimate ``x̂_{k|k}`` (n) and covariance (n x n), (2.7).
+    mu : ndarray
+        Mode probabilities ``μ_k`` (M).
+    x_modes, P_modes : ndarray
+        Mode-matched filtered estimates (M x n) and covariances (M x n x n).
+    log_likelihood : float
+        Log predictive density ``log p(y_k | Y_{k−1})``; NaN when the sample is invalid.
+    valid : bool
+        False for a NaN measurement (prediction only: ``x, mu`` are then the predicted values).
+
+    Examples
+    --------
+    >>> m0 = LinearGaussianModel(A=[[1.0]], C=[[1.0]], Q=[[0.01]], R=[[0.1]], name="nominal")
+    >>> m1 = LinearGaussianModel(A=[[1.0]], C=[[2.0]], Q=[[0.01]], R=[[0.1]], name="gain fault")
+    >>> imm = IMMFilter([m0, m1], [[0.99, 0.01], [0.01, 0.99]], x0=[1.0], P0=[[0.01]])
+    >>> stepper = imm.online()
+    >>> step = stepper.step(None, [2.0])
+    >>> step.x_modes.shape, step.P_modes.shape, step.valid
+    ((2, 1), (2, 1, 1), True)
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.1, Table 2.1, (2.3)–(2.7), (2.12).
     """
 
     x: np.ndarray
@@ -64,9 +86,41 @@ class IMMStep:
 class IMMResult:
     """Batch output of :meth:`IMMFilter.run` (arrays with one row per sample).
 
-    ``x`` (N, n) fused estimates, ``P`` (N, n, n) fused covariances or None, ``mu`` (N, M) mode
-    probabilities, ``log_mu`` (N, M) their logarithms (finite far below the double range of ``mu``),
-    ``x_modes`` (N, M, n) or None, ``log_likelihood`` (N,), ``valid`` (N,).
+    Attributes
+    ----------
+    t : ndarray
+        Sample times (N,) (the sample index when none were given).
+    x : ndarray
+        Fused estimates (N, n).
+    P : ndarray or None
+        Fused covariances (N, n, n), None when ``run(store_covariance=False)``.
+    mu : ndarray
+        Mode probabilities (N, M).
+    log_mu : ndarray
+        Their logarithms (N, M), finite far below the double range of ``mu``.
+    x_modes : ndarray or None
+        Mode-matched estimates (N, M, n), None unless ``run(store_modes=True)``.
+    log_likelihood : ndarray
+        ``log p(y_k | Y_{k−1})`` (N,); NaN on invalid samples.
+    valid : ndarray of bool
+        (N,); False where the measurement had a NaN entry (prediction only).
+    modes : tuple of str
+        Mode names, in the order of the columns of ``mu``.
+    nominal : int
+        Index of the nominal (fault-free) mode (default 0).
+
+    Examples
+    --------
+    >>> m0 = LinearGaussianModel(A=[[1.0]], C=[[1.0]], Q=[[0.01]], R=[[0.1]], name="nominal")
+    >>> m1 = LinearGaussianModel(A=[[1.0]], C=[[2.0]], Q=[[0.01]], R=[[0.1]], name="gain fault")
+    >>> imm = IMMFilter([m0, m1], [[0.99, 0.01], [0.01, 0.99]], x0=[1.0], P0=[[0.01]])
+    >>> res = imm.run(np.zeros((5, 0)), 2.0 * np.ones((5, 1)))
+    >>> res.x.shape, res.P.shape, res.mu.shape, res.x_modes is None, res.modes
+    ((5, 1), (5, 1, 1), (5, 2), True, ('nominal', 'gain fault'))
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.1, Table 2.1, (2.3)–(2.7), (2.12).
     """
 
     t: np.ndarray
@@ -91,17 +145,31 @@ class IMMFilter:
 
     Parameters
     ----------
-    modes : the mode models, sharing n, m, p.
-    transition : Π, (M, M) row-stochastic, ``Π[i, j] = P(s_{k+1}=j | s_k=i)``.
-    mu0 : prior mode probabilities of the first sample (default uniform).
-    x0, P0 : prior state mean and covariance of the first sample, shared ``(n,)``/``(n, n)``
+    modes : sequence of LinearGaussianModel
+        The M mode models, sharing n, m, p; their ``name`` labels the modes (``"mode<i>"`` if unnamed).
+    transition : array_like
+        Π, (M, M) row-stochastic, ``Π[i, j] = P(s_{k+1}=j | s_k=i)``.
+    mu0 : array_like, optional
+        Prior mode probabilities of the first sample (M); default uniform.
+    x0, P0 : array_like, optional
+        Prior state mean and covariance of the first sample, shared ``(n,)``/``(n, n)``
         or per mode ``(M, n)``/``(M, n, n)`` (default zero and identity).
-    nominal : index of the nominal (fault-free) mode, for the diagnosis.
-    min_probability : floor on the predicted probabilities ``μ_{k|k−1}`` (a Π
-        with zeros can lock a mode out); 0 disables it.
+    nominal : int, optional
+        Index of the nominal (fault-free) mode, for the diagnosis (default 0).
+    min_probability : float, optional
+        Floor on the predicted probabilities ``μ_{k|k−1}`` (a Π with zeros can lock a mode out);
+        0 (the default) disables it; must be below 1/M.
 
-    Example
-    -------
+    Raises
+    ------
+    ModelError
+        If the modes are not ``LinearGaussianModel`` s of equal dimensions with unique names, or Π is not
+        an (M, M) row-stochastic matrix.
+    ParameterError
+        If ``mu0``, ``x0``, ``P0``, ``nominal`` or ``min_probability`` has the wrong shape or range.
+
+    Examples
+    --------
     >>> import numpy as np
     >>> m0 = LinearGaussianModel(A=[[1.0]], C=[[1.0]], Q=[[0.01]], R=[[0.1]], name="nominal")
     >>> m1 = LinearGaussianModel(A=[[1.0]], C=[[2.0]], Q=[[0.01]], R=[[0.1]], name="gain fault")
@@ -109,6 +177,10 @@ class IMMFilter:
     >>> res = imm.run(np.zeros((50, 0)), 2.0 * np.ones((50, 1)))
     >>> bool(res.mu[-1, 1] > 0.99), str(res.diagnosis().isolated[-1])
     (True, 'gain fault')
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.1, Table 2.1, (2.3)–(2.7), (2.12).
     """
 
     modes: Sequence[LinearGaussianModel]
@@ -181,10 +253,24 @@ class IMMFilter:
 
         Parameters
         ----------
-        u : (N, m) inputs, or a :class:`~fdikit.trace.Trace` (then ``y`` and ``t`` come from it).
-        y : (N, p) measurements; rows with NaN are prediction-only samples (marked invalid).
-        t : (N,) times (default sample index).
-        store_covariance, store_modes : keep the fused covariances / mode-matched estimates.
+        u : array_like or Trace
+            (N, m) inputs, or a :class:`~fdikit.trace.Trace` (then ``y`` and ``t`` come from it).
+        y : array_like
+            (N, p) measurements; rows with NaN are prediction-only samples (marked invalid).
+        t : array_like, optional
+            (N,) times (default sample index).
+        store_covariance, store_modes : bool
+            Keep the fused covariances (default True) / mode-matched estimates (default False).
+
+        Returns
+        -------
+        IMMResult
+            The filtered record.
+
+        Raises
+        ------
+        DataError
+            If ``u``, ``y``, ``t`` do not have matching shapes or ``u`` has NaN/inf entries.
         """
         if isinstance(u, Trace):
             u, y, t = u.u, u.y, u.t
@@ -227,7 +313,37 @@ class IMMFilter:
 
 
 class IMMStepper:
-    """Online IMM: ``step(u_k, y_k)`` → :class:`IMMStep`; NaN in ``y_k`` → prediction only."""
+    """Online IMM: ``step(u_k, y_k)`` → :class:`IMMStep`; NaN in ``y_k`` → prediction only.
+
+    Parameters
+    ----------
+    imm : IMMFilter
+        The filter whose priors ``x0, P0, mu0`` initialise the stepper (usually made by :meth:`IMMFilter.online`).
+
+    Attributes
+    ----------
+    x_pred, P_pred : ndarray
+        Per-mode priors ``x̂^(j)_{k|k−1}`` (M x n) and ``P^(j)_{k|k−1}`` (M x n x n) for the next sample.
+    log_mu, log_mu_pred : ndarray
+        Log mode probabilities after the last update and predicted for the next sample (M).
+
+    Examples
+    --------
+    >>> m0 = LinearGaussianModel(A=[[1.0]], C=[[1.0]], Q=[[0.01]], R=[[0.1]], name="nominal")
+    >>> m1 = LinearGaussianModel(A=[[1.0]], C=[[2.0]], Q=[[0.01]], R=[[0.1]], name="gain fault")
+    >>> imm = IMMFilter([m0, m1], [[0.99, 0.01], [0.01, 0.99]], x0=[1.0], P0=[[0.01]])
+    >>> stepper = imm.online()
+    >>> for _ in range(3):
+    ...     step = stepper.step(None, [2.0])
+    >>> step.mu.round(4).tolist()
+    [0.0002, 0.9998]
+    >>> stepper.step(None, [float("nan")]).valid      # missing measurement: prediction only
+    False
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.1, Table 2.1, (2.3)–(2.7), (2.12).
+    """
 
     def __init__(self, imm: IMMFilter) -> None:
         md = imm.modes
