@@ -40,3 +40,10 @@ def test_nav_lists_every_page():
     pages = {str(p.relative_to(ROOT / "docs")) for p in (ROOT / "docs").rglob("*.md")}
     assert pages - listed == set(), f"pages not in the mkdocs.yml nav: {sorted(pages - listed)}"
     assert listed - pages == set(), f"nav entries without a page: {sorted(listed - pages)}"
+
+
+def test_test_files_named_in_the_docs_exist():
+    texts = [p for p in (ROOT / "docs").rglob("*.md")] + [ROOT / "README.md"]
+    named = {(p.name, m) for p in texts for m in re.findall(r"tests/[\w/]+\.py", p.read_text(encoding="utf-8"))}
+    missing = sorted(f"{page}: {path}" for page, path in named if not (ROOT / path).exists())
+    assert not missing, "the docs name test files that do not exist:\n" + "\n".join(missing)
