@@ -110,6 +110,16 @@ def cusum_arl(drift, threshold, shift=0.0, two_sided: bool = True):
     338.1
     >>> round(float(cusum_arl(0.5, 4.0, shift=1.0)), 2)
     8.34
+
+    Raises
+    ------
+    ParameterError
+        When a drift is negative or a threshold is not positive.
+
+    References
+    ----------
+    Siegmund 1985 (the overshoot-corrected approximation); Basseville & Nikiforov 1993, §5.2, (5.2.44);
+    van Dobben de Bruyn 1968 (the two-sided combination).
     """
     nu, h = np.asarray(drift, dtype=float), np.asarray(threshold, dtype=float)
     if not np.all(nu >= 0):
@@ -168,12 +178,25 @@ def cusum_design(arl0: float, shift: float, two_sided: bool = True) -> tuple[flo
     Returns
     -------
     (drift, threshold) : tuple of float
+        ``ν = δ/2`` and the ``h`` whose Siegmund ARL0 is ``arl0``, both in units of σ.
+
+    Raises
+    ------
+    ParameterError
+        When ``shift`` is not a positive finite number, when ``arl0`` is not a finite number of samples
+        above 1, or when ``arl0`` is not above the run length of ``h = 0`` with that drift (no threshold
+        reaches it).
 
     Examples
     --------
     >>> nu, h = cusum_design(500.0, 1.0)
     >>> nu, round(h, 3)
     (0.5, 5.063)
+
+    References
+    ----------
+    Basseville & Nikiforov 1993, §2.2 (the drift half-way between the two means) and §5.2, (5.2.44)
+    (Siegmund's ARL).
     """
     if not np.isfinite(shift) or not shift > 0:
         raise ParameterError(f"fault size (shift) must be positive, in units of sigma; got {shift}")
@@ -317,6 +340,11 @@ class CusumEvaluator:
     >>> ev = CusumEvaluator().fit(healthy, arl0=1000.0, shift=1.0)
     >>> ev.drift.round(2).tolist(), ev.threshold.round(2).tolist()
     ([0.5, 0.5], [6.46, 6.44])
+
+    References
+    ----------
+    Page 1954 (the one-sided cumulative sum); Basseville & Nikiforov 1993, §2.2 (the two-sided CUSUM);
+    Douglas et al. 1996, Ch. 7 introduction (the CUSUM compared with the Shiryayev SPRT).
     """
 
     def __init__(
