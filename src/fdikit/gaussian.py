@@ -37,6 +37,45 @@ class LinearGaussianModel:
     (the thesis's ``(Q)^{1/2} w̄`` with unit-variance ``w̄``).  Build from a discrete
     :class:`~fdikit.model.FaultModel` with :meth:`from_fault_model` (uses ``A, Bu, C, Du``).
     ``name`` labels the model as one mode of a bank (the IMM's hypotheses).
+
+    Parameters
+    ----------
+    A : array_like
+        State matrix (n x n).
+    C : array_like
+        Output matrix (p x n).
+    Q : array_like
+        Process noise covariance ``cov(w)`` (n x n), symmetric positive semidefinite.
+    R : array_like
+        Measurement noise covariance ``cov(v)`` (p x p), positive definite.
+    B : array_like, optional
+        Input matrix (n x m); no inputs (m = 0) if omitted.
+    D : array_like, optional
+        Feedthrough matrix (p x m); zero if omitted.
+    name : str, optional
+        Label of the model (e.g. the mode name in an IMM bank); default ``""``.
+
+    Attributes
+    ----------
+    A, B, C, D, Q, R : ndarray
+        The matrices above, read-only.
+    name : str
+        The label.
+
+    Raises
+    ------
+    ModelError
+        If a matrix has the wrong shape, ``Q`` or ``R`` is not symmetric PSD, or ``R`` is singular.
+
+    Examples
+    --------
+    >>> mdl = LinearGaussianModel(A=[[0.9]], C=[[1.0]], Q=[[0.1]], R=[[1.0]], name="nominal")
+    >>> mdl.n, mdl.m, mdl.p, mdl.B.shape, mdl.name
+    (1, 0, 1, (1, 0), 'nominal')
+    >>> from fdikit.plants import white_speyer
+    >>> plant = white_speyer().discretize(0.1)
+    >>> LinearGaussianModel.from_fault_model(plant, Q=0.01 * np.eye(plant.n), R=np.eye(plant.p)).p
+    2
     """
 
     A: np.ndarray
@@ -99,6 +138,33 @@ class NonlinearGaussianModel:
     ``f_jacobian(x, u)`` / ``h_jacobian(x, u)`` are optional analytic Jacobians; when
     omitted, central finite differences are used (:func:`numerical_jacobian`).
     ``n_inputs`` is the length of ``u`` (0: ``u`` is an empty vector).
+
+    Parameters
+    ----------
+    f : callable
+        State transition ``f(x, u) -> x_next`` (n).
+    h : callable
+        Measurement ``h(x, u) -> y`` (p).
+    Q : array_like
+        Process noise covariance (n x n); its size fixes ``n``.
+    R : array_like
+        Measurement noise covariance (p x p), positive definite; its size fixes ``p``.
+    n_inputs : int, optional
+        Length of ``u`` (default 0).
+    f_jacobian, h_jacobian : callable, optional
+        Analytic Jacobians ``(x, u) -> (n x n)`` and ``(x, u) -> (p x n)``; finite differences if None.
+
+    Raises
+    ------
+    ModelError
+        If ``Q``/``R`` are not symmetric PSD (``R`` positive definite), or ``f``, ``h`` or a Jacobian is
+        not callable.
+
+    Examples
+    --------
+    >>> mdl = NonlinearGaussianModel(f=lambda x, u: x + 0.1 * np.sin(x), h=lambda x, u: x, Q=[[0.01]], R=[[0.1]])
+    >>> mdl.n, mdl.p, mdl.n_inputs
+    (1, 1, 0)
     """
 
     f: Fun

@@ -64,6 +64,15 @@ def numerical_jacobian(fun: Fun, x, u) -> np.ndarray:
     -------
     ndarray
         ``len(fun(x, u))`` x n matrix.
+
+    Examples
+    --------
+    >>> numerical_jacobian(lambda x, u: np.array([x[0] * x[1]]), [2.0, 3.0], None).round(8).tolist()
+    [[3.0, 2.0]]
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.3, (2.44)–(2.45) (the Jacobians the EKF needs).
     """
     x = np.asarray(x, dtype=float).reshape(-1)
     f0 = np.asarray(fun(x, u), dtype=float).reshape(-1)
@@ -89,6 +98,40 @@ def ekf_predict(x, P, f: Fun, u, Q, jacobian: Fun | None = None) -> tuple[np.nda
     """EKF time update (Hallouzi 2008, (2.46)–(2.48)): ``x⁺ = f(x, u)``, ``P⁺ = F P Fᵀ + Q``.
 
     ``F = jacobian(x, u)`` if given, else :func:`numerical_jacobian` of ``f`` at ``(x, u)``.
+
+    Parameters
+    ----------
+    x, P : array_like
+        Filtered state ``x̂(k|k)`` (n) and covariance ``P(k|k)`` (n x n).
+    f : callable
+        State transition ``f(x, u) -> x_next`` (n).
+    u : array_like or None
+        Input ``u(k)``, passed to ``f`` unchanged.
+    Q : array_like
+        Process noise covariance (n x n).
+    jacobian : callable, optional
+        ``jacobian(x, u) -> F`` (n x n); central finite differences if None.
+
+    Returns
+    -------
+    x_pred, P_pred : ndarray
+        ``x̂(k+1|k)`` (n) and the symmetrised ``P(k+1|k)`` (n x n).
+
+    Raises
+    ------
+    ModelError
+        If ``f`` returns a vector of another size than ``x``, or the Jacobian is not n x n.
+
+    Examples
+    --------
+    >>> f = lambda x, u: x + 0.1 * np.sin(x)
+    >>> x, P = ekf_predict([1.0], [[0.5]], f, None, [[0.01]])
+    >>> x.round(6).tolist(), P.round(6).tolist()
+    ([1.084147], [[0.56549]])
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.3, Table 2.3, (2.46)–(2.48).
     """
     x = np.asarray(x, dtype=float).reshape(-1)
     x_pred = np.asarray(f(x, u), dtype=float).reshape(-1)
@@ -105,7 +148,50 @@ def ekf_update(
     """EKF measurement update (Hallouzi 2008, (2.49)–(2.51), Joseph form of (2.51)).
 
     Returns ``(x_filt, P_filt, innovation, S, log_likelihood)`` as
-    :func:`~fdikit.multimodel.kalman.kf_update`, with ``e = y − h(x, u)`` and ``H = ∂h/∂x``.
+    :func:`~fdikit.multimodel.kalman_steps.kf_update`, with ``e = y − h(x, u)`` and ``H = ∂h/∂x``.
+
+    Parameters
+    ----------
+    x, P : array_like
+        Predicted state ``x̂(k|k−1)`` (n) and covariance ``P(k|k−1)`` (n x n).
+    y : array_like
+        Measurement ``y(k)`` (p).
+    h : callable
+        Measurement function ``h(x, u) -> y`` (p).
+    u : array_like or None
+        Input ``u(k)``, passed to ``h`` unchanged.
+    R : array_like
+        Measurement noise covariance (p x p).
+    jacobian : callable, optional
+        ``jacobian(x, u) -> H`` (p x n); central finite differences if None.
+
+    Returns
+    -------
+    x_filt, P_filt : ndarray
+        ``x̂(k|k)`` and ``P(k|k)`` (Joseph form).
+    innovation : ndarray
+        ``e(k) = y − h(x̂(k|k−1), u)`` (p).
+    S : ndarray
+        Innovation covariance ``H P Hᵀ + R`` (p x p).
+    log_likelihood : float
+        ``log N(e; 0, S)``.
+
+    Raises
+    ------
+    ModelError
+        If the Jacobian is not p x n.
+    DataError
+        If ``H P Hᵀ + R`` is not positive definite.
+
+    Examples
+    --------
+    >>> x, P, e, S, ll = ekf_update([1.0], [[0.5]], [1.2], lambda x, u: x ** 2, None, [[0.1]])
+    >>> x.round(6).tolist(), e.round(6).tolist(), S.round(6).tolist()
+    ([1.095238], [0.2], [[2.1]])
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.3, Table 2.3, (2.49)–(2.51).
     """
     x = np.asarray(x, dtype=float).reshape(-1)
     P = np.asarray(P, dtype=float)
@@ -131,8 +217,26 @@ class ExtendedKalmanFilter:
     Parameters
     ----------
     model : NonlinearGaussianModel
+        The model ``f``, ``h``, ``Q``, ``R`` (and optional Jacobians).
     x0, P0 : array_like
-        Prior ``x̂(0|−1)``, ``P(0|−1)``.
+        Prior ``x̂(0|−1)`` (n), ``P(0|−1)`` (n x n).
+
+    Raises
+    ------
+    ParameterError
+        If ``model`` is not a ``NonlinearGaussianModel`` or the prior has the wrong size.
+
+    Examples
+    --------
+    >>> f = lambda x, u: x + 0.1 * np.sin(x)
+    >>> mdl = NonlinearGaussianModel(f=f, h=lambda x, u: x, Q=[[0.01]], R=[[0.1]])
+    >>> step = ExtendedKalmanFilter(mdl, [0.0], [[1.0]]).step(None, [0.5])
+    >>> step.x_filt.round(6).tolist(), step.x_pred.round(6).tolist(), step.valid
+    ([0.454545], [0.498451], True)
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.3, Table 2.3, (2.46)–(2.51).
     """
 
     def __init__(self, model: NonlinearGaussianModel, x0, P0) -> None:
@@ -164,6 +268,32 @@ def extended_kalman_filter(model: NonlinearGaussianModel, u, y, x0, P0) -> Kalma
     """Run the EKF over a record; same outputs as :func:`~fdikit.multimodel.kalman.kalman_filter`.
 
     NaN/inf in ``u`` or ``y`` raises :class:`~fdikit.errors.DataError` (use the online filter).
+
+    Parameters
+    ----------
+    model : NonlinearGaussianModel
+        The model.
+    u, y : array_like
+        Inputs (N x ``model.n_inputs``, or None when there are none) and measurements (N x p).
+    x0, P0 : array_like
+        Prior ``x̂(0|−1)`` (n), ``P(0|−1)`` (n x n).
+
+    Returns
+    -------
+    KalmanResult
+        The filtered record (:class:`~fdikit.multimodel.kalman.KalmanResult`).
+
+    Examples
+    --------
+    >>> f = lambda x, u: x + 0.1 * np.sin(x)
+    >>> mdl = NonlinearGaussianModel(f=f, h=lambda x, u: x, Q=[[0.01]], R=[[0.1]])
+    >>> res = extended_kalman_filter(mdl, None, [[0.5], [0.6], [0.7]], [0.0], [[1.0]])
+    >>> res.x_filt.round(4).ravel().tolist()
+    [0.4545, 0.5534, 0.6459]
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.3, Table 2.3, (2.46)–(2.51).
     """
     ekf = ExtendedKalmanFilter(model, x0, P0)
     u, y = check_record(u, y, model.n_inputs, model.p)
