@@ -87,6 +87,39 @@ class GaussianDensity:
 
     A singular covariance is refused (:class:`~fdikit.errors.ParameterError`) unless ``regularization=ε``
     adds ``ε·diag(Λ)`` (shrinks the correlations by ``1/(1 + ε)``; a component of zero variance is refused either way).
+
+    Parameters
+    ----------
+    mean : (n,) array_like
+        Mean of the residual under the hypothesis; stored as a float vector.
+    cov : float, (n,) or (n, n) array_like
+        Covariance ``Λ``: a variance (``σ² I``), variances (diagonal) or a symmetric positive definite matrix;
+        stored as the (n, n) matrix actually used (after ``regularization``).
+    regularization : float, default 0.0
+        ``ε > 0`` adds ``ε·diag(Λ)`` to a singular or ill-conditioned ``Λ``; 0 refuses such a ``Λ``.
+
+    Attributes
+    ----------
+    dim : int
+        ``n``, the number of residual components.
+
+    Raises
+    ------
+    ParameterError
+        When ``mean`` or ``cov`` is not finite, ``cov`` has the wrong shape, is not symmetric, has a component
+        of zero variance or is singular (without ``regularization``).
+
+    References
+    ----------
+    Douglas et al. 1996, §7.2.1, (7.1) (the densities ``f_i`` of the recursion) and §7.3.2 (Gaussian hypotheses).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.decision.densities import GaussianDensity
+    >>> g = GaussianDensity(np.zeros(2), 1.0)
+    >>> g.dim, np.round(g.logpdf(np.zeros((1, 2))), 6).tolist()
+    (2, [-1.837877])
     """
 
     mean: np.ndarray
@@ -127,6 +160,39 @@ def gaussian_mean_density(center, cov, mean_cov, regularization: float = 0.0) ->
     Derivation (simpler than the report's completion of squares, whose printed constants are garbled):
     ``x = m + v`` with ``v ~ N(0, Λ)`` independent of ``m``; a sum of independent Gaussians is Gaussian with the
     sum of means and covariances.  ``Σ_μ`` may be singular (a mean known in some directions).
+
+    Parameters
+    ----------
+    center : (n,) array_like
+        ``m*``, the expected mean.
+    cov : float, (n,) or (n, n) array_like
+        ``Λ``, the covariance about the mean (scalar: ``σ² I``; vector: diagonal).
+    mean_cov : float, (n,) or (n, n) array_like
+        ``Σ_μ``, the covariance of the unknown mean; positive semi-definite.
+    regularization : float, default 0.0
+        Passed to :class:`GaussianDensity` for the sum ``Λ + Σ_μ``.
+
+    Returns
+    -------
+    GaussianDensity
+        ``N(m*, Λ + Σ_μ)``.
+
+    Raises
+    ------
+    ParameterError
+        When ``mean_cov`` is not positive semi-definite, or an argument is not finite, of the wrong shape or
+        not symmetric (and, from :class:`GaussianDensity`, when ``Λ + Σ_μ`` is singular).
+
+    References
+    ----------
+    Douglas et al. 1996, §7.3.2, Prop. 7.4 (with (7.22) of §7.2.4: an unknown change replaced by its density).
+
+    Examples
+    --------
+    >>> from fdikit.decision.densities import gaussian_mean_density
+    >>> d = gaussian_mean_density([0.0], 1.0, 3.0)
+    >>> d.cov.tolist(), round(float(d.logpdf([0.0])[0]), 6)
+    ([[4.0]], -1.612086)
     """
     center = _vec(center, "center")
     n = center.size
@@ -166,6 +232,44 @@ class UniformMeanDensity:
     uniform mean by ``n_points`` scrambled-Sobol points in the box drawn with ``rng`` (seeded; same seed, same
     density), i.e. an equal-weight Gaussian mixture — itself a proper density, so the recursion stays exact Bayes
     for it.
+
+    Parameters
+    ----------
+    low, high : (n,) array_like
+        Corners of the box of the unknown mean, ``low <= high``.
+    cov : float, (n,) or (n, n) array_like
+        ``Λ``, the covariance about the mean (scalar: ``σ² I``; vector: diagonal).
+    method : {"erf", "mixture"}, default "erf"
+        The exact product form (diagonal ``Λ`` only) or the Sobol-point Gaussian mixture.
+    n_points : int, default 1024
+        Number of mixture points (rounded up to a power of two); ``"mixture"`` only.
+    rng : numpy.random.Generator or int, optional
+        Seed or generator of the scrambled Sobol points; required for ``"mixture"``.
+    regularization : float, default 0.0
+        ``ε > 0`` adds ``ε·diag(Λ)``, as in :class:`GaussianDensity`.
+
+    Attributes
+    ----------
+    dim : int
+        ``n``, the number of residual components.
+
+    Raises
+    ------
+    ParameterError
+        When ``high < low`` somewhere, ``cov`` is not a valid covariance, ``"erf"`` is given a non-diagonal
+        ``cov``, ``"mixture"`` has no ``rng``, or ``method`` is unknown.
+
+    References
+    ----------
+    Douglas et al. 1996, §7.3.2, Prop. 7.5 (the printed erf formula, corrected here for ``n > 1``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.decision.densities import UniformMeanDensity
+    >>> u = UniformMeanDensity([-1.0], [1.0], 0.01)
+    >>> np.round(np.exp(u.logpdf([0.0, 5.0])), 6).tolist()
+    [0.5, 0.0]
     """
 
     low: np.ndarray
