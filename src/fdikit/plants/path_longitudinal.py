@@ -141,11 +141,22 @@ def path_longitudinal_7() -> FaultModel:
 
     ``A`` with A(2,3) = +19.0734 and ``C`` in the labelled row order (module docstring); no
     controls (``B``, ``D`` are not printed), no fault inputs.  The air-mass sensor fault of the
-    example is the target (``'air_mass'`` resolves to ``[f, A f]`` with ``C f = e_1`` via
-    :func:`fdikit.design.resolve_faults`); the printed nuisance maps are in
-    :func:`path_longitudinal_7_fault_maps`.  ``resolve_faults(model, ['engine_speed', 'accel_x'])``
+    example is the target (``'air_mass_sensor'`` resolves to ``[f, A f]`` with ``C f = e_1`` via
+    :func:`fdikit.linalg.resolve_faults`); the printed nuisance maps are in
+    :func:`path_longitudinal_7_fault_maps`.
+    ``resolve_faults(model, ['engine_speed_sensor', 'accel_x_sensor'])``
     gives the exact maps of this (rounded) model instead, which differ from the printed ones by
     the rounding (≤ 0.05 in ``f``, ≤ 0.23 in ``A f``).
+
+    Returns
+    -------
+    FaultModel
+        Continuous model with 7 balanced states ``x1 … x7``, the 7 outputs listed in the module
+        docstring, and no controls, disturbance, fault or noise inputs.
+
+    References
+    ----------
+    Douglas et al. 1996, §9.6, (9.84)–(9.89).
 
     Examples
     --------
@@ -168,6 +179,16 @@ def path_longitudinal_7_fault_maps() -> dict[str, np.ndarray]:
 
     Each is ``[f, A f]`` (7 x 2) to 4 decimals; ``F̂_{y_m} = [F_yω, F_yẍ]`` is the 4-column
     complementary map of the air-mass filter.  Pass the dict as ``nuisance=`` to a design.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        ``'engine_speed_sensor'`` → ``F_yω`` and ``'accel_x_sensor'`` → ``F_yẍ``, each a (7, 2) array
+        ``[f, A f]``; new arrays on each call.
+
+    References
+    ----------
+    Douglas et al. 1996, §9.6, (9.88)–(9.89).
 
     Examples
     --------

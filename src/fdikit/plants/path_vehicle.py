@@ -276,6 +276,27 @@ def path_vehicle_12(tiny: str = "zero") -> FaultModel:
     Table 2.1 without −90.91 and −80 (:data:`TABLE_2_1_EIGENVALUES_12`), to within the
     rounding.
 
+    Parameters
+    ----------
+    tiny : {"zero", "midpoint"}, default "zero"
+        How entries printed ``±0.00`` are read: as 0, or as ``±0.0025`` (the midpoint of their
+        rounding interval; an assumption that gives ``C`` full rank).
+
+    Returns
+    -------
+    FaultModel
+        Continuous model, 12 states, the 12 outputs :data:`OUTPUTS`, the controls :data:`CONTROLS`
+        (``Bu`` (12, 3), ``Du`` (12, 3)); no disturbance, fault or noise inputs.
+
+    Raises
+    ------
+    ParameterError
+        If ``tiny`` is not ``"zero"`` or ``"midpoint"``.
+
+    References
+    ----------
+    Douglas et al. 1996, App. D, (d.2a–d); §2.3, Table 2.1.
+
     Examples
     --------
     >>> from fdikit.plants import path_vehicle_12
@@ -304,6 +325,26 @@ def path_vehicle_14(tiny: str = "zero") -> FaultModel:
     alpha, tau_b, beta``.  Eigenvalues: Table 2.1, method 1
     (:data:`TABLE_2_1_EIGENVALUES_14`), to within the 2-decimal rounding of the data.
     Reconstructed data; see the module docstring.
+
+    Parameters
+    ----------
+    tiny : {"zero", "midpoint"}, default "zero"
+        How entries printed ``±0.00`` are read: as 0, or as ``±0.0025`` (see :func:`path_vehicle_12`).
+
+    Returns
+    -------
+    FaultModel
+        Continuous model, 14 states, the 12 outputs :data:`OUTPUTS`, the controls :data:`CONTROLS`
+        (``Bu`` (14, 3), ``Du = 0``); no disturbance, fault or noise inputs.
+
+    Raises
+    ------
+    ParameterError
+        If ``tiny`` is not ``"zero"`` or ``"midpoint"``.
+
+    References
+    ----------
+    Douglas et al. 1996, App. D, (d.1a–d); §2.3, Table 2.1.
 
     Examples
     --------
@@ -335,6 +376,21 @@ def rounding_intervals(n_states: int) -> dict[str, tuple[np.ndarray, np.ndarray]
         ``[-0.005, 0]`` for ``-0.00``, ``[0, 0.005]`` for ``0.00``, and ``lo = hi`` for
         exact zeros (printed ``0``) and kinematic ones.  Use these to propagate the
         rounding of the printed data (e.g. Monte Carlo of the spectrum).
+
+    Raises
+    ------
+    ParameterError
+        If ``n_states`` is not 12 or 14.
+
+    References
+    ----------
+    Douglas et al. 1996, App. D (the printed 2-decimal listings).
+
+    Examples
+    --------
+    >>> lo, hi = rounding_intervals(12)["A"]
+    >>> lo.shape, bool((lo <= hi).all())
+    ((12, 12), True)
     """
     if n_states == 12:
         m = _matrices_12()

@@ -81,6 +81,22 @@ class SingleTrackParameters:
         thesis' sign convention.
     g : float
         Gravitational acceleration (m/s²).
+
+    Raises
+    ------
+    ParameterError
+        On construction, if a field is not a finite number, a length, mass, inertia or ``g`` is not
+        positive, or a cornering stiffness is not negative.
+
+    References
+    ----------
+    van der Ploeg 2018, §4-1, Table 4-1; App. B-2-1, (B.8).
+
+    Examples
+    --------
+    >>> p = SingleTrackParameters(m=1800.0)
+    >>> p.m, round(p.wheelbase, 6)
+    (1800.0, 2.7)
     """
 
     l_f: float = 1.108
@@ -122,6 +138,30 @@ def understeer_gradient(params: SingleTrackParameters = PRIUS_2010) -> float:
     ``m_f = m l_r / L`` and ``m_r = m l_f / L`` are the static axle loads (kg).  ``K_u > 0``
     is understeer (stable at every speed; no critical speed).  For :data:`PRIUS_2010`
     ``K_u = 0.003526`` rad/(m/s²) (computed from Table 4-1; not printed in the thesis).
+
+    Parameters
+    ----------
+    params : SingleTrackParameters, default PRIUS_2010
+        Vehicle parameters.
+
+    Returns
+    -------
+    float
+        ``K_u`` in rad/(m/s²).
+
+    Raises
+    ------
+    ParameterError
+        If ``params`` is not a :class:`SingleTrackParameters`.
+
+    References
+    ----------
+    van der Ploeg 2018, Table 4-1 (the parameters); App. B-2-1 (the single-track model).
+
+    Examples
+    --------
+    >>> round(understeer_gradient(), 6)
+    0.003526
     """
     if not isinstance(params, SingleTrackParameters):
         raise ParameterError(f"params must be a SingleTrackParameters, got {type(params).__name__}")
@@ -155,6 +195,10 @@ def single_track(speed: float, params: SingleTrackParameters = PRIUS_2010, dt: f
     ------
     ParameterError
         If ``speed`` is not a positive finite number (the model has ``1/V_x`` terms).
+
+    References
+    ----------
+    van der Ploeg 2018, App. B-2, (B.8)–(B.12); §4-3-1, (4.5) (the ZOH sampling); Table 4-1.
 
     Examples
     --------
@@ -273,6 +317,10 @@ class SingleTrackLPV:
     steering_fault : bool
         Add the additive steering fault input ``steering_actuator`` (default True).
 
+    References
+    ----------
+    van der Ploeg 2018, §4-3-4, (4.17); §4-3-1, (4.5).
+
     Examples
     --------
     >>> family = single_track_lpv()
@@ -353,5 +401,34 @@ def single_track_lpv(
 
     See :class:`SingleTrackLPV`; ``family(v)`` equals ``single_track(v, params, dt)`` (plus the
     steering fault) and ``family.dae_matrices(v)`` gives the DAE (4.17).
+
+    Parameters
+    ----------
+    params : SingleTrackParameters, default PRIUS_2010
+        Vehicle parameters (Table 4-1).
+    dt : float, default 0.01
+        Sample time ``h`` [s].
+    steering_fault : bool, default True
+        Give each member the additive steering fault input ``steering_actuator``.
+
+    Returns
+    -------
+    SingleTrackLPV
+        The family; call it with a speed in m/s.
+
+    Raises
+    ------
+    ParameterError
+        If ``params`` is not a :class:`SingleTrackParameters` or ``dt`` is not a positive number.
+
+    References
+    ----------
+    van der Ploeg 2018, §4-3-4, (4.17).
+
+    Examples
+    --------
+    >>> family = single_track_lpv(dt=0.02)
+    >>> family(20.0).dt, family.dae_matrices(20.0)[0].shape
+    (0.02, (7, 6))
     """
     return SingleTrackLPV(params, dt, steering_fault)

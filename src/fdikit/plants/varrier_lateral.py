@@ -66,9 +66,30 @@ class VarrierParameters:
 
     Attributes
     ----------
-    m : mass (kg); l_V, l_H : centre of gravity to front / rear axle (m); I_z : yaw inertia
-    (kg m²); c_V, c_H : front / rear axle cornering stiffness (N/rad, positive); g : gravity
-    (m/s², listed in the table, unused by the model).
+    m : float
+        Mass (kg).
+    l_V, l_H : float
+        Centre of gravity to front / rear axle (m).
+    I_z : float
+        Yaw inertia (kg m²).
+    c_V, c_H : float
+        Front / rear axle cornering stiffness (N/rad, positive).
+    g : float
+        Gravity (m/s², listed in the table, unused by the model).
+
+    Raises
+    ------
+    ModelError
+        On construction, if a field is not a positive finite number.
+
+    References
+    ----------
+    Varrier et al. 2014, §5.1 (the parameter table).
+
+    Examples
+    --------
+    >>> VarrierParameters(m=1700.0).m
+    1700.0
     """
 
     m: float = 1621.0
@@ -93,10 +114,31 @@ SCENIC = VarrierParameters()
 def rho_from_speed(speed) -> np.ndarray | float:
     """Scheduling parameter ``ρ = 1/v`` (v in m/s), §5.1.
 
+    Parameters
+    ----------
+    speed : float or array_like
+        Longitudinal speed(s) ``v`` [m/s].
+
+    Returns
+    -------
+    float or numpy.ndarray
+        ``ρ = 1/v`` [s/m]: a float for a scalar speed, else an array of the speeds' shape.
+
     Raises
     ------
-    ModelError
+    ParameterError
         If a speed is not positive and finite.
+
+    References
+    ----------
+    Varrier et al. 2014, §5.1.
+
+    Examples
+    --------
+    >>> rho_from_speed(20.0)
+    0.05
+    >>> rho_from_speed([10.0, 20.0]).tolist()
+    [0.1, 0.05]
     """
     v = validate.as_array("speed", speed, finite=False)
     if not np.all(np.isfinite(v) & (v > 0)):
@@ -125,6 +167,29 @@ def _check_params(params) -> VarrierParameters:
 def varrier_lateral_continuous(speed: float, params: VarrierParameters = SCENIC) -> FaultModel:
     """Continuous bicycle model (47), corrected, at a constant speed (m/s).
 
+    Parameters
+    ----------
+    speed : float
+        Longitudinal speed ``v`` [m/s], positive.
+    params : VarrierParameters, default SCENIC
+        Vehicle parameters (§5.1 table).
+
+    Returns
+    -------
+    FaultModel
+        Continuous model, states ``sideslip`` [rad], ``yaw_rate`` [rad/s]; outputs
+        ``lateral_acceleration`` [m/s²], ``yaw_rate``; control ``steering`` [rad] (with feedthrough
+        ``Du``); no disturbance or fault inputs.
+
+    Raises
+    ------
+    ParameterError
+        If ``speed`` is not one positive finite number, or ``params`` is not a :class:`VarrierParameters`.
+
+    References
+    ----------
+    Varrier et al. 2014, §5.1, (47) (two typos corrected, see the module docstring).
+
     Examples
     --------
     >>> m = varrier_lateral_continuous(20.0)
@@ -150,6 +215,31 @@ def varrier_lateral_lpv(dt: float = T_D, params: VarrierParameters = SCENIC, *, 
     ``A₀(ρ) = A₀₀ + ρ A₀₁ + ρ² A₀₂``, ``B₀(ρ) = B₀₀ + ρ B₀₁``, ``C₀(ρ) = C₀₀ + ρ C₀₁``,
     ``D₀`` constant; disturbance ``unknown_input`` with ``B_d = 0.2 B₀(ρ*)`` and
     ``D_d = [0; 2.064]`` (§5.3); fault ``lateral_acceleration_sensor`` with ``D_f = [1; 0]`` (§5.4).
+
+    Parameters
+    ----------
+    dt : float, default T_D (0.02)
+        Sample time ``T_d`` [s] of the forward-Euler discretisation.
+    params : VarrierParameters, default SCENIC
+        Vehicle parameters.
+    rho_star : float, default RHO_STAR (0.048)
+        Scheduling point ρ* [s/m] of ``B_d = 0.2 B₀(ρ*)``.
+
+    Returns
+    -------
+    LPVModel
+        Degree-2 polynomial in ρ (scheduling ``"1/speed"``): terms ``0, 1, 2`` are discrete
+        :class:`~fdikit.model.FaultModel` coefficient matrices with 2 states, 2 outputs, the control
+        ``steering``, the disturbance ``unknown_input`` and the fault ``lateral_acceleration_sensor``.
+
+    Raises
+    ------
+    ParameterError
+        If ``dt`` or ``rho_star`` is not a positive number, or ``params`` is not a :class:`VarrierParameters`.
+
+    References
+    ----------
+    Varrier et al. 2014, §5.1, (48a)–(48d); §5.3 (``B_d``, ``D_d``); §5.4 (``D_f``).
 
     Examples
     --------
@@ -182,6 +272,30 @@ def varrier_lateral_lpv(dt: float = T_D, params: VarrierParameters = SCENIC, *, 
 def varrier_lateral(speed: float = 1.0 / RHO_STAR, dt: float = T_D, params: VarrierParameters = SCENIC) -> FaultModel:
     """The discrete model (48) frozen at one speed (m/s); default 20.83 m/s (ρ* = 0.048).
 
+    Parameters
+    ----------
+    speed : float, default 1 / RHO_STAR (20.83)
+        Longitudinal speed ``v`` [m/s], positive.
+    dt : float, default T_D (0.02)
+        Sample time [s].
+    params : VarrierParameters, default SCENIC
+        Vehicle parameters.
+
+    Returns
+    -------
+    FaultModel
+        Discrete model ``(48)`` at ``ρ = 1/speed``, with the disturbance ``unknown_input`` and the
+        fault ``lateral_acceleration_sensor`` of :func:`varrier_lateral_lpv`.
+
+    Raises
+    ------
+    ParameterError
+        If ``speed`` is not one positive finite number, or ``dt`` or ``params`` is invalid.
+
+    References
+    ----------
+    Varrier et al. 2014, §5.1, (48); §5.3–5.4.
+
     Examples
     --------
     >>> round(float(varrier_lateral(1 / 0.048).A[0, 0]), 6)
@@ -199,10 +313,38 @@ def varrier_uncertainty(dt: float = T_D, params: VarrierParameters = SCENIC, *, 
 
     Parameters
     ----------
-    mode : ``"literal"`` — ``A₁ = 0.2 A₀(ρ*)`` as printed (it contains ``0.2 I``, a ±20 %
+    dt : float, default T_D (0.02)
+        Sample time [s] of the discrete model (48).
+    params : VarrierParameters, default SCENIC
+        Vehicle parameters.
+    mode : {"literal", "continuous"}, default "literal"
+        ``"literal"`` — ``A₁ = 0.2 A₀(ρ*)`` as printed (it contains ``0.2 I``, a ±20 %
         per-step scaling of the state); ``"continuous"`` — ``A₁ = 0.2 (A₀(ρ*) − I) = 0.2 T_d A(ρ*)``,
         20 % of the continuous dynamics (an fdikit reading, not the paper's).
-    scale : the 20 % of §5.3.
+    rho_star : float, default RHO_STAR (0.048)
+        Scheduling point ρ* [s/m] at which ``A₀`` is evaluated.
+    scale : float, default 0.2
+        The 20 % of §5.3.
+
+    Returns
+    -------
+    Uncertainty
+        One uncertain direction ``stiffness`` with ``A`` of shape (1, 2, 2) (``A₁``); ``C`` certain.
+
+    Raises
+    ------
+    ParameterError
+        If ``mode`` is not one of the two readings, or ``dt``, ``params``, ``rho_star`` or ``scale`` is invalid.
+
+    References
+    ----------
+    Varrier et al. 2014, §5.3.
+
+    Examples
+    --------
+    >>> u = varrier_uncertainty(mode="continuous")
+    >>> u.name, u.A.shape, round(float(u.A[0, 0, 0]), 6)
+    ('stiffness', (1, 2, 2), -0.016406)
     """
     scale = validate.number("scale", scale)
     validate.choice("uncertainty mode", mode, ("literal", "continuous"))
