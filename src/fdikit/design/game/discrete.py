@@ -48,7 +48,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
@@ -59,7 +59,7 @@ from fdikit.design.game.setup import GameProblem, game_problem, weight
 from fdikit.design.observers.full_order import observer_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
-from fdikit.protocols import joined_form
+from fdikit.protocols import FieldReport
 from fdikit.residuals import ResidualGenerator
 
 __all__ = [
@@ -360,7 +360,7 @@ def discrete_game_generator(setup: DiscreteGameSetup, L, targets: Sequence[str] 
 
 
 @dataclass(frozen=True, eq=False)
-class DiscreteGtfdfDesign:
+class DiscreteGtfdfDesign(FieldReport):
     """Discrete single-fault game filter (DGTFDF, Murray 2012, (5.42)–(5.43)).
 
     Attributes
@@ -391,21 +391,7 @@ class DiscreteGtfdfDesign:
         Pi = np.linalg.inv(self.covariances[k])
         return (Pi + Pi.T) / 2
 
-    model: FaultModel | None = field(default=None, repr=False, kw_only=True)  # set by the design function
-
-    def internal_form(self) -> FaultModel:
-        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
-
-        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
-        model the design was made for (field ``model``, set by the design function).
-        """
-        return joined_form(self, self.model)
-
-    def report(self) -> dict:
-        """``target``, ``gain`` (observer gain ``Φ L`` at the final ``L``), ``poles`` (of ``Φ(I − LC)``),
-        ``levels`` (``< 1`` ⇔ the game bound holds), ``settled`` and ``settling_step``."""
-        return {"target": self.target, "gain": self.gain, "poles": self.poles, "levels": self.levels,
-                "settled": self.settled, "settling_step": self.settling_step}
+    REPORT = ("target", "gain", "poles", "levels", "settled", "settling_step")
 
 
 def dgtfdf(setup: DiscreteGameSetup, targets: str | Sequence[str] | None = None,
@@ -466,7 +452,7 @@ def dgtfdf(setup: DiscreteGameSetup, targets: str | Sequence[str] | None = None,
 
 
 @dataclass(frozen=True, eq=False)
-class DiscreteGtmfdfDesign:
+class DiscreteGtmfdfDesign(FieldReport):
     """Discrete multiple-fault game filter (DGTMFDF, Murray 2012, (5.31)–(5.41)), one constant gain.
 
     Attributes
@@ -493,22 +479,7 @@ class DiscreteGtmfdfDesign:
     riccati: GameRiccatiSolution
     notes: tuple[str, ...]
 
-    model: FaultModel | None = field(default=None, repr=False, kw_only=True)  # set by the design function
-
-    def internal_form(self) -> FaultModel:
-        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
-
-        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
-        model the design was made for (field ``model``, set by the design function).
-        """
-        return joined_form(self, self.model)
-
-    def report(self) -> dict:
-        """``gain`` (observer gain ``Φ L``), ``poles`` (of ``Φ(I − LC)``), ``sigma_min`` (``σ_min(I − LC)``),
-        ``cost`` and ``initial_cost`` (``J̄``), ``method``, ``iterations`` and ``notes`` (how each stage stopped)."""
-        return {"gain": self.gain, "poles": self.poles, "sigma_min": self.sigma_min, "cost": self.cost,
-                "initial_cost": self.initial_cost, "method": self.method, "iterations": self.iterations,
-                "notes": self.notes}
+    REPORT = ("gain", "poles", "sigma_min", "cost", "initial_cost", "method", "iterations", "notes")
 
 
 def _try_cost(setup: DiscreteGameSetup, L: np.ndarray, floor: float, max_radius: float):

@@ -121,10 +121,6 @@ class BeardJonesDesign:
                 "condition_number": self.condition_number}
 
 
-def _is_stable(lam: np.ndarray, discrete: bool) -> np.ndarray:
-    return np.abs(lam) < 1 if discrete else lam.real < 0
-
-
 def _self_conjugate(name: str, lam: np.ndarray, scale: float) -> None:
     for z in lam[lam.imag != 0]:
         if np.min(np.abs(lam - np.conj(z))) > 1e-10 * scale:
@@ -258,8 +254,8 @@ def _check_sets(model, dims, poles, complement_poles):
             raise DesignError(f"set {name!r} has {lam.size} eigenvalues but needs {wanted[name]} "
                               f"(detection-space dimensions {dims}, n = {n})")
         _self_conjugate(name, lam, scale)
-        if not np.all(_is_stable(lam, discrete)):
-            raise DesignError(f"set {name!r} has unstable eigenvalues {lam[~_is_stable(lam, discrete)].tolist()}")
+        if not np.all(linalg.is_stable(lam, discrete)):
+            raise DesignError(f"set {name!r} has unstable eigenvalues {lam[~linalg.is_stable(lam, discrete)].tolist()}")
     everything = np.concatenate(list(sets.values()))
     for i, z in enumerate(everything):
         if np.any(np.abs(everything[i + 1 :] - z) <= 1e-9 * scale):

@@ -17,14 +17,15 @@ Kalman residual the white innovation sequence with covariance ``C P Cᵀ + R``.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg
 
-from fdikit import validate
+from fdikit import linalg, validate
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
+from fdikit.protocols import joined_form
 from fdikit.residuals import ResidualGenerator
 
 __all__ = ["ObserverDesign", "observer", "kalman", "observer_generator", "unobservable_modes"]
@@ -49,6 +50,23 @@ class ObserverDesign:
     poles: np.ndarray
     covariance: np.ndarray | None = None
     innovation_covariance: np.ndarray | None = None
+    model: FaultModel | None = field(default=None, repr=False, kw_only=True)  # set by the design function
+
+    def internal_form(self) -> FaultModel:
+        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
+
+        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
+        model the design was made for (field ``model``, set by the design function).
+        """
+        return joined_form(self, self.model)
+
+    def report(self) -> dict:
+        """``gain`` (``L``), ``poles`` (of ``A − L C``), ``covariance`` (``P``) and ``innovation_covariance``.
+
+        The two covariances are None for a pole-placement design.
+        """
+        return {"gain": self.gain, "poles": self.poles, "covariance": self.covariance,
+                "innovation_covariance": self.innovation_covariance}
 
 
 def unobservable_modes(A: np.ndarray, C: np.ndarray) -> np.ndarray:
@@ -99,7 +117,7 @@ def observer_generator(
 
 
 def _check_stable(model: FaultModel, poles: np.ndarray, what: str) -> None:
-    bad = np.abs(poles) >= 1 if model.is_discrete else poles.real >= 0
+    bad = ~linalg.is_stable(poles, model.is_discrete)
     if np.any(bad):
         modes = unobservable_modes(model.A, model.C)
         raise DesignError(
@@ -153,7 +171,7 @@ def observer(model: FaultModel, poles: Sequence[complex], method: str = "place")
         raise DesignError(f"pole placement failed for poles {poles.tolist()}: {exc}") from exc
     achieved = scipy.linalg.eigvals(model.A - L @ model.C)
     _check_stable(model, achieved, "the placed observer")
-    return ObserverDesign(observer_generator(model, L), L, achieved)
+    return ObserverDesign(observer_generator(model, L), L, achieved, model=model)
 
 
 def _poles(poles, n: int) -> np.ndarray:
@@ -230,4 +248,4 @@ def kalman(model: FaultModel, Q, R) -> ObserverDesign:
         ) from exc
     poles = scipy.linalg.eigvals(A - L @ C)
     _check_stable(model, poles, "the Kalman filter")
-    return ObserverDesign(observer_generator(model, L), L, poles, (P + P.T) / 2, (innov + innov.T) / 2)
+    return ObserverDesign(observer_generator(model, L), L, poles, (P + P.T) / 2, (innov + innov.T) / 2, model=model)

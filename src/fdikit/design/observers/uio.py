@@ -208,11 +208,6 @@ def _rank_abs(M: np.ndarray, tol: float) -> int:
 
 
 # ---------------------------------------------------------------------- helpers
-def _stable(lam: np.ndarray, discrete: bool, margin: float = 0.0) -> np.ndarray:
-    lam = np.asarray(lam, dtype=complex)
-    return np.abs(lam) < 1 - margin if discrete else lam.real < -margin
-
-
 def _fmt(z: np.ndarray) -> list:
     return [complex(np.round(v, 6)) if abs(np.imag(v)) > 0 else float(np.round(np.real(v), 6)) for v in z]
 
@@ -365,8 +360,8 @@ def uio(
     At = Z.T @ A1 @ Z
     fixed = scipy.linalg.eigvals(At[no:, no:]) if no < n else np.zeros(0, complex)
     margin = 1e3 * max(n, 1) * _EPS * max(1.0, np.linalg.norm(A, 2))
-    if fixed.size and not np.all(_stable(fixed, discrete, margin)):
-        bad = fixed[~_stable(fixed, discrete, margin)]
+    if fixed.size and not np.all(linalg.is_stable(fixed, discrete, margin)):
+        bad = fixed[~linalg.is_stable(fixed, discrete, margin)]
         raise DesignError(
             f"(C, T A) is not detectable: its unobservable modes {_fmt(bad)} — the invariant zeros of (A, E, C) "
             f"with E the directions of {list(decoupled)} — are not stable "
@@ -383,8 +378,8 @@ def uio(
             raise DesignError(
                 f"need {no} UIO poles (n = {n} minus {n - no} fixed modes {_fmt(fixed)}), got {poles.size}"
             )
-        if not np.all(_stable(poles, discrete)):
-            raise DesignError(f"requested UIO poles {_fmt(poles[~_stable(poles, discrete)])} are not stable")
+        if not np.all(linalg.is_stable(poles, discrete)):
+            raise DesignError(f"requested UIO poles {_fmt(poles[~linalg.is_stable(poles, discrete)])} are not stable")
         W = linalg.orth(Co)  # compress dependent outputs; W Wᵀ Co = Co
         try:
             Lr = np.asarray(control.place(Ao.T, (W.T @ Co).T, poles)).T
@@ -393,8 +388,9 @@ def uio(
         K1 = Zo @ Lr @ W.T
     N = A1 - K1 @ C
     achieved = scipy.linalg.eigvals(N)
-    if not np.all(_stable(achieved, discrete)):
-        raise DesignError(f"the placed UIO is not stable: poles {_fmt(achieved[~_stable(achieved, discrete)])}")
+    if not np.all(linalg.is_stable(achieved, discrete)):
+        bad = achieved[~linalg.is_stable(achieved, discrete)]
+        raise DesignError(f"the placed UIO is not stable: poles {_fmt(bad)}")
     K = K1 + N @ H
     notes = []
     if fixed.size:
