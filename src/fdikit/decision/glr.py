@@ -61,6 +61,30 @@ def glr_threshold(false_alarm_prob: float, window: int, dof: int = 1) -> float:
     ``h = χ²_p.isf(α/M) / 2`` (the union bound over the ``M`` change times of the window;
     see the module docstring).
 
+    Parameters
+    ----------
+    false_alarm_prob : float
+        ``α`` in (0, 1), the per-sample false-alarm probability bound of one block's test.
+    window : int
+        ``M``, the number of change times tried (:class:`GlrEvaluator` ``window``).
+    dof : int, default 1
+        ``p``, the block dimension (number of residuals in the vector test).
+
+    Returns
+    -------
+    float
+        ``h = χ²_p.isf(α/M)/2``.
+
+    Raises
+    ------
+    ParameterError
+        When ``α`` is not in (0, 1), or ``window`` or ``dof`` is not a positive integer.
+
+    References
+    ----------
+    Willsky & Jones 1976 (the GLR for a jump of unknown size); Basseville & Nikiforov 1993, §2.4; Douglas et al.
+    1996, §7.2.3 (the GLR test compared with the Shiryayev SPRT in likelihood-ratio form).
+
     Examples
     --------
     >>> round(glr_threshold(1e-3, 50, 1), 3)
@@ -86,13 +110,32 @@ def residual_blocks(
         ``'isolates'``: the residuals tied to the same fault form a block (an untied
         residual is a block of its own); ``'each'``: one block per residual (scalar
         tests); ``'all'``: one block of all residuals; a sequence: one label per residual.
-    names, isolates : the residuals' names and tied faults.
+    names : sequence of str
+        The residuals' names.
+    isolates : sequence of str or None
+        The fault tied to each residual (None: untied).
 
     Returns
     -------
     tuple of (name, residual indices)
         Block names: the fault (``'isolates'``), the residual name (``'each'``), the label,
         or ``'all'``.
+
+    Raises
+    ------
+    ParameterError
+        When ``blocks`` is an unknown string, or a sequence whose length is not the number of residuals.
+
+    References
+    ----------
+    Willsky & Jones 1976 (the GLR for a jump of unknown size); Basseville & Nikiforov 1993, §2.4; Douglas et al.
+    1996, §7.2.3 (the GLR test compared with the Shiryayev SPRT in likelihood-ratio form).
+
+    Examples
+    --------
+    >>> from fdikit.decision.glr import residual_blocks
+    >>> residual_blocks("isolates", ("a", "b", "c"), ("fa", "fa", None))
+    (('fa', (0, 1)), ('c', (2,)))
     """
     q = len(names)
     if isinstance(blocks, str):
@@ -139,6 +182,58 @@ class BlockLayout:
     which leave sums and squares unchanged); ``chol`` and ``whiten`` are the padded
     Cholesky factors ``L_g`` of the block covariances and their inverses.  ``cov`` is a
     (q, q) matrix or a (q,) vector of variances.
+
+    Parameters
+    ----------
+    blocks : 'isolates', 'each', 'all' or sequence
+        The grouping (:func:`residual_blocks`).
+    names : sequence of str
+        The ``q`` residual names.
+    isolates : sequence of str or None
+        Fault tied to each residual.
+    groups : sequence or None
+        Filter of each residual in a bank (a block must lie within one filter), or None.
+    cov : (q,) or (q, q) ndarray
+        Variances or covariance of the residuals (:func:`as_covariance`); only the diagonal blocks are used.
+
+    Attributes
+    ----------
+    blocks : tuple of (name, residual indices)
+        As returned by :func:`residual_blocks`.
+    names : tuple of str
+        Block names.
+    q : int
+        Number of residuals.
+    dims : (G,) int ndarray
+        ``p_g``, the size of each block.
+    index : (G, P) int ndarray
+        Residual index of each padded slot (``q``, the zero column, in the padding).
+    chol, whiten : (G, P, P) ndarray
+        ``L_g`` and ``L_g⁻¹`` per block, zero-padded.
+    isolates : tuple of str or None
+        Each block's fault (its residuals' common fault, None when they differ).
+    groups : tuple or None
+        Each block's filter.
+
+    Raises
+    ------
+    DataError
+        When a block's covariance is not positive definite.
+    ParameterError
+        When a block mixes residuals of different filters of a bank.
+
+    References
+    ----------
+    Willsky & Jones 1976 (the GLR for a jump of unknown size); Basseville & Nikiforov 1993, §2.4; Douglas et al.
+    1996, §7.2.3 (the GLR test compared with the Shiryayev SPRT in likelihood-ratio form).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.decision.glr import BlockLayout
+    >>> lay = BlockLayout("isolates", ("a", "b", "c"), ("fa", "fa", "fb"), None, np.array([1.0, 4.0, 9.0]))
+    >>> lay.names, lay.dims.tolist(), lay.gather(np.array([1.0, 2.0, 3.0])).tolist()
+    (('fa', 'fb'), [2, 1], [[1.0, 2.0], [3.0, 0.0]])
     """
 
     def __init__(self, blocks, names, isolates, groups, cov: np.ndarray) -> None:
@@ -199,7 +294,36 @@ def _as_mean(mean, q: int) -> np.ndarray:
 
 
 def as_covariance(cov, q: int) -> np.ndarray:
-    """A covariance given as a scalar, (q,) variances or a (q, q) matrix, as variances or a matrix."""
+    """A covariance given as a scalar, (q,) variances or a (q, q) matrix, as variances or a matrix.
+
+    Parameters
+    ----------
+    cov : float or array_like
+        A variance for every residual, ``q`` variances (or one), or a (q, q) matrix.
+    q : int
+        Number of residuals.
+
+    Returns
+    -------
+    (q,) or (q, q) ndarray
+        Variances (from a scalar or a vector) or the matrix.
+
+    Raises
+    ------
+    DataError
+        When the number of variances or the matrix shape does not fit ``q`` residuals.
+
+    References
+    ----------
+    Willsky & Jones 1976 (the GLR for a jump of unknown size); Basseville & Nikiforov 1993, §2.4; Douglas et al.
+    1996, §7.2.3 (the GLR test compared with the Shiryayev SPRT in likelihood-ratio form).
+
+    Examples
+    --------
+    >>> from fdikit.decision.glr import as_covariance
+    >>> as_covariance(2.0, 3).tolist()
+    [2.0, 2.0, 2.0]
+    """
     c = np.asarray(cov, dtype=float)
     if c.ndim == 0:
         c = np.full(q, float(c))
@@ -226,7 +350,43 @@ def _check_cov(cov) -> np.ndarray | None:
 
 
 def fit_moments(residuals: Residuals, minimum: int = 10) -> tuple[np.ndarray, np.ndarray]:
-    """Mean and covariance of the valid, finite rows of fault-free residuals."""
+    """Mean and covariance of the valid, finite rows of fault-free residuals.
+
+    Parameters
+    ----------
+    residuals : Residuals
+        Fault-free residuals; invalid and non-finite rows are skipped.
+    minimum : int, default 10
+        Fewest usable rows accepted.
+
+    Returns
+    -------
+    mean : (q,) ndarray
+        Sample mean ``μ0``.
+    cov : (q, q) ndarray
+        Sample covariance (``ddof=1``).
+
+    Raises
+    ------
+    DataError
+        When ``residuals`` is not a ``Residuals``, or has fewer than ``minimum`` usable rows.
+
+    References
+    ----------
+    Willsky & Jones 1976 (the GLR for a jump of unknown size); Basseville & Nikiforov 1993, §2.4; Douglas et al.
+    1996, §7.2.3 (the GLR test compared with the Shiryayev SPRT in likelihood-ratio form).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.residuals import Residuals
+    >>> from fdikit.decision.glr import fit_moments
+    >>> rng = np.random.default_rng(0)
+    >>> healthy = Residuals(np.arange(200) * 0.01, rng.standard_normal((200, 2)), ("a", "b"), ("fa", "fb"))
+    >>> mean, cov = fit_moments(healthy)
+    >>> mean.shape, cov.shape
+    ((2,), (2, 2))
+    """
     residuals = checked_residuals(residuals, None)
     r = residuals.r[residuals.valid]
     r = r[np.all(np.isfinite(r), axis=1)]
@@ -274,6 +434,11 @@ class GlrEvaluator:
     >>> d = GlrEvaluator(window=30, threshold=glr_threshold(1e-3, 30)).run(res)
     >>> a = d.first_alarm(); a.fault, a.index - 300, int(d.meta["change_index"][a.index, 0])
     ('fa', 6, 301)
+
+    References
+    ----------
+    Willsky & Jones 1976 (the GLR for a jump of unknown size); Basseville & Nikiforov 1993, §2.4; Douglas et al.
+    1996, §7.2.3 (the GLR test compared with the Shiryayev SPRT in likelihood-ratio form).
     """
 
     def __init__(
