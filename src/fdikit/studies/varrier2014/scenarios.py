@@ -60,13 +60,53 @@ FAULT_NAME = "lateral_acceleration_sensor"
 
 
 def speed_profile(t: np.ndarray) -> np.ndarray:
-    """Default speed (m/s): ``20.83 + 4 sin(2πt/100) + 2 sin(2πt/37)``."""
+    """Default speed (m/s): ``20.83 + 4 sin(2πt/100) + 2 sin(2πt/37)``.
+
+    Parameters
+    ----------
+    t : array_like
+        Times [s].
+
+    Returns
+    -------
+    numpy.ndarray
+        Speeds [m/s], the shape of ``t``; mean ``1/ρ* = 20.83`` m/s (75 km/h).
+
+    References
+    ----------
+    Varrier et al. 2014, §5.3 (the mean speed; the variation is an fdikit choice).
+
+    Examples
+    --------
+    >>> speed_profile([0.0, 25.0]).round(3).tolist()
+    [20.833, 23.047]
+    """
     t = np.asarray(t, dtype=float)
     return 1 / RHO_STAR + 4.0 * np.sin(2 * np.pi * t / 100) + 2.0 * np.sin(2 * np.pi * t / 37)
 
 
 def steering_profile(t: np.ndarray) -> np.ndarray:
-    """Default road-wheel steering (rad): ``0.02 sin(2π 0.2 t) + 0.01 sin(2π 0.05 t + 1)``."""
+    """Default road-wheel steering (rad): ``0.02 sin(2π 0.2 t) + 0.01 sin(2π 0.05 t + 1)``.
+
+    Parameters
+    ----------
+    t : array_like
+        Times [s].
+
+    Returns
+    -------
+    numpy.ndarray
+        Steering angles [rad], the shape of ``t``.
+
+    References
+    ----------
+    Varrier et al. 2014, §5.3–5.4 (the profile itself is an fdikit choice).
+
+    Examples
+    --------
+    >>> steering_profile([0.0]).round(6).tolist()
+    [0.008415]
+    """
     t = np.asarray(t, dtype=float)
     return 0.02 * np.sin(2 * np.pi * 0.2 * t) + 0.01 * np.sin(2 * np.pi * 0.05 * t + 1.0)
 
@@ -90,12 +130,29 @@ def varrier_trace(
 
     Parameters
     ----------
-    delta : amplitude δ̄ of the slow stiffness uncertainty δ(t) = δ̄ cos(2πt/90).
-    disturbance : standard deviation of the unknown input d.
-    noise_std : white noise standard deviations on (a_y, r).
-    fault_size, fault_window : the bias and its interval ``[start, end)`` in s.
-    uncertainty_mode : ``"literal"`` or ``"continuous"`` (see :func:`varrier_uncertainty`).
-    speed, steering : functions of time; seed : int or Generator.
+    duration : float, default 200.0
+        Length of the run [s]; ``round(duration / dt)`` samples.
+    dt : float, default T_D (0.02)
+        Sample time [s].
+    delta : float, default 1.0
+        Amplitude δ̄ of the slow stiffness uncertainty δ(t) = δ̄ cos(2πt/90).
+    disturbance : float, default 0.003
+        Standard deviation of the unknown input d.
+    noise_std : tuple of float, default (0.0, 0.0)
+        White noise standard deviations on (a_y [m/s²], r [rad/s]).
+    fault_size : float, default 0.5
+        The ``a_y`` sensor bias [m/s²].
+    fault_window : tuple of float, default (150.0, 158.0)
+        The bias interval ``[start, end)`` [s].
+    uncertainty_mode : {"continuous", "literal"}, default "continuous"
+        Reading of ``A₁`` (see :func:`fdikit.plants.varrier_lateral.varrier_uncertainty`).
+    speed, steering : callable
+        Functions of the time array giving the speed [m/s] and the road-wheel steering [rad];
+        default :func:`speed_profile`, :func:`steering_profile`.
+    params : VarrierParameters, default SCENIC
+        Vehicle parameters.
+    seed : int or numpy.random.Generator, default 0
+        Randomness of the unknown input and the noise.
 
     Returns
     -------
@@ -103,6 +160,21 @@ def varrier_trace(
         Controls ``steering``; outputs ``lateral_acceleration``, ``yaw_rate`` and the measured
         ``speed``; states ``sideslip, yaw_rate``; disturbances ``unknown_input`` and ``delta``;
         fault labels ``lateral_acceleration_sensor`` on the fault window.
+
+    Raises
+    ------
+    ModelError
+        If ``duration`` or ``dt`` is not positive, or the fault window is empty.
+
+    References
+    ----------
+    Varrier et al. 2014, §5.1, (48); §5.3 (uncertainty, unknown input); §5.4 (the faulty scenario).
+
+    Examples
+    --------
+    >>> tr = varrier_trace(duration=4.0, fault_window=(2.0, 3.0))
+    >>> tr.y.shape, int((tr.fault == "lateral_acceleration_sensor").sum())
+    ((200, 3), 50)
     """
     if not (duration > 0 and dt > 0):
         raise ModelError(f"duration and dt must be positive, got {duration}, {dt}")
@@ -144,7 +216,36 @@ def varrier_trace(
 
 
 def fault_window_masks(trace: Trace, s: int) -> tuple[np.ndarray, np.ndarray]:
-    """Samples whose window ``[k−s, k]`` is entirely faulty, and those with no faulty sample (k ≥ s)."""
+    """Samples whose window ``[k−s, k]`` is entirely faulty, and those with no faulty sample (k ≥ s).
+
+    Parameters
+    ----------
+    trace : Trace
+        A run with fault labels (e.g. from :func:`varrier_trace`).
+    s : int
+        Parity window order (``s + 1`` samples per window; §5.3 uses ``s = 3``).
+
+    Returns
+    -------
+    faulty, healthy : (N,) bool arrays
+        ``faulty[k]``: samples ``k−s … k`` all faulty; ``healthy[k]``: none faulty; both false for ``k < s``.
+
+    Raises
+    ------
+    DataError
+        If the trace has no faulty sample.
+
+    References
+    ----------
+    Varrier et al. 2014, §5.5 (the edge rule is fdikit's, see the module docstring).
+
+    Examples
+    --------
+    >>> tr = varrier_trace(duration=4.0, fault_window=(2.0, 3.0))
+    >>> faulty, healthy = fault_window_masks(tr, 3)
+    >>> int(faulty.sum()), int(healthy.sum())
+    (47, 144)
+    """
     f = trace.fault != NO_FAULT
     if not f.any():
         raise DataError("the trace has no faulty sample; ϖ needs a fault window")
@@ -155,7 +256,35 @@ def fault_window_masks(trace: Trace, s: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def normalise_residual(r: np.ndarray, faulty: np.ndarray) -> np.ndarray:
-    """``r / mean(r over the faulty samples)`` (Remark 8): mean one during the fault."""
+    """``r / mean(r over the faulty samples)`` (Remark 8): mean one during the fault.
+
+    Parameters
+    ----------
+    r : array_like
+        Residual samples.
+    faulty : array_like of bool or int
+        Index of the faulty samples (boolean mask or indices into ``r``).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``r`` divided by its mean over the faulty samples.
+
+    Raises
+    ------
+    DataError
+        If that mean is zero or not finite.
+
+    References
+    ----------
+    Varrier et al. 2014, §5.5, Remark 8.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> normalise_residual(np.array([1.0, 2.0, 4.0]), np.array([False, True, True])).round(6).tolist()
+    [0.333333, 0.666667, 1.333333]
+    """
     r = np.asarray(r, dtype=float)
     m = np.mean(r[faulty])
     if not np.isfinite(m) or m == 0:
@@ -166,6 +295,24 @@ def normalise_residual(r: np.ndarray, faulty: np.ndarray) -> np.ndarray:
 def min_max_ratio(r: np.ndarray, faulty: np.ndarray, healthy: np.ndarray) -> float:
     """ϖ = min |r_n| faulty / max |r_n| healthy (§5.5); > 1 means one threshold separates them.
 
+    Parameters
+    ----------
+    r : (N,) array
+        Residual.
+    faulty, healthy : (N,) bool arrays
+        Masks of the faulty and healthy samples (see :func:`fault_window_masks`).
+
+    Returns
+    -------
+    float
+        ϖ, computed on the normalised residual ``r_n`` of :func:`normalise_residual`.
+
+    References
+    ----------
+    Varrier et al. 2014, §5.5, Remark 8.
+
+    Examples
+    --------
     >>> import numpy as np
     >>> r = np.array([0.1, -0.2, 1.2, 0.8, 0.1])
     >>> min_max_ratio(r, np.array([0, 0, 1, 1, 0], bool), np.array([1, 1, 0, 0, 1], bool))
@@ -177,7 +324,26 @@ def min_max_ratio(r: np.ndarray, faulty: np.ndarray, healthy: np.ndarray) -> flo
 
 @dataclass(frozen=True, eq=False)
 class VarrierComparison:
-    """ϖ of each residual, the residuals (normalised), and the polytopic design used."""
+    """ϖ of each residual, the residuals (normalised), and the polytopic design used.
+
+    Attributes
+    ----------
+    varpi : dict of str to float
+        ϖ of each residual: ``"lpv"``, ``"ulpv_lmi"``, ``"ulpv_adjugate"``, ``"ulpv_theorem1"``, ``"ulpv_constant"``.
+    residuals : dict of str to Residuals
+        Each residual normalised by :func:`normalise_residual` (NaN for the first ``s`` samples).
+    design : RobustParityDesign
+        The polytopic LMI design (``"ulpv_lmi"``).
+
+    References
+    ----------
+    Varrier et al. 2014, §5.5.
+
+    Examples
+    --------
+    >>> VarrierComparison(varpi={"lpv": 1.5}, residuals={}, design=None).varpi["lpv"]
+    1.5
+    """
 
     varpi: dict[str, float]
     residuals: dict[str, Residuals]
@@ -192,6 +358,44 @@ def varrier_comparison(trace: Trace, *, s: int = 3, kappa_fraction: float = 0.9,
     κ = ``kappa_fraction`` × κ_max), ``"ulpv_adjugate"`` (``W₂ = adj Γ_κ c``), ``"ulpv_theorem1"``
     (pointwise Theorem 1) and ``"ulpv_constant"`` (pointwise Theorem 1 with a constant-fault Γ₂).
     The design's uncertainty reading defaults to the trace's (``meta["uncertainty_mode"]``).
+
+    Parameters
+    ----------
+    trace : Trace
+        A run of :func:`varrier_trace` (outputs ``lateral_acceleration``, ``yaw_rate``, ``speed``, fault labels).
+    s : int, default 3
+        Parity window order (3 samples, 60 ms, §5.3).
+    kappa_fraction : float, default 0.9
+        κ as a fraction of κ_max of the criteria grid.
+    rho_range : tuple of float, default (0.0, 0.2)
+        ``(ρ_min, ρ_max)`` [s/m] of the polytopic design and its 41-point criteria grid.
+    order : int, default 5
+        Polynomial order of the LMI design (``order + 1`` vertices).
+    uncertainty_mode : {"literal", "continuous"}, optional
+        Reading of ``A₁`` for the design; default the trace's ``meta["uncertainty_mode"]``.
+
+    Returns
+    -------
+    VarrierComparison
+        ϖ and the normalised residual of each of the five variants, and the LMI design.
+
+    Raises
+    ------
+    DataError
+        If the trace has no faulty sample, or a residual's mean over the faulty time is zero.
+
+    References
+    ----------
+    Varrier et al. 2014, §3 (LPV parity), §4, (40) (U-LPV polytopic LMI), Theorem 1; §5.5 (ϖ).
+
+    Examples
+    --------
+    The polytopic LMI takes a few seconds, so the call is not run here (tests/studies runs it):
+
+    >>> tr = varrier_trace(duration=4.0, fault_window=(2.0, 3.0))
+    >>> result = varrier_comparison(tr, order=2)  # doctest: +SKIP
+    >>> sorted(result.varpi)  # doctest: +SKIP
+    ['lpv', 'ulpv_adjugate', 'ulpv_constant', 'ulpv_lmi', 'ulpv_theorem1']
     """
     if uncertainty_mode is None:
         uncertainty_mode = trace.meta.get("uncertainty_mode", "literal")
