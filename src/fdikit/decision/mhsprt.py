@@ -62,6 +62,38 @@ def magnitude_blocks(residuals: Residuals, groups: Sequence[str] | None = None) 
 
     Components tied to the same fault (and, with ``groups``, in the same filter of a bank) form one block whose
     Euclidean magnitude is one measurement component; an untied residual is a block of its own.
+
+    Parameters
+    ----------
+    residuals : Residuals
+        The residual series whose names and tied faults are grouped; an untied residual's label is its name
+        without a trailing component index (``"a[1]"`` → ``"a"``).
+    groups : sequence of str, optional
+        The filter of each residual in a bank; labels become ``"<group>:<fault>"``.
+
+    Returns
+    -------
+    tuple of str
+        One block label per residual component.
+
+    Raises
+    ------
+    ParameterError
+        When ``groups`` does not have one entry per residual.
+
+    References
+    ----------
+    Douglas et al. 1996, §5.1.1 (the residual magnitudes of the fault detection filters) and §7.4 (the
+    Shiryayev SPRT on the vehicle's filter residuals).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.residuals import Residuals
+    >>> from fdikit.decision.mhsprt import magnitude_blocks
+    >>> r = Residuals(np.arange(3) * 0.1, np.zeros((3, 3)), ("a[0]", "a[1]", "b"), ("fa", "fa", None))
+    >>> magnitude_blocks(r), magnitude_blocks(r, groups=("F1", "F1", "F2"))
+    (('fa', 'fa', 'b'), ('F1:fa', 'F1:fa', 'F2:b'))
     """
     if groups is not None and len(groups) != len(residuals.names):
         raise ParameterError(f"{len(groups)} groups for {len(residuals.names)} residuals")
@@ -135,6 +167,12 @@ class MhsprtEvaluator:
     >>> d = MhsprtEvaluator(dens, p=1e-3, pi=1e-3).run(Residuals(t, x[:, None], ("x",), ()))
     >>> d.hypotheses, d.first_alarm().fault, round(d.first_alarm().time, 2)
     (('none', 'H1', 'H2', 'H3', 'H4'), 'H2', 1.45)
+
+    References
+    ----------
+    Douglas et al. 1996, §7.2.1, Prop. 7.1, (7.1a)–(7.1c) (the posterior recursion; (7.1c) corrected as above),
+    Prop. 7.2 (its bounds), §7.2.3 (the thresholds ``F_{T,i}``), §7.3.1 (Example 1) and §7.4 (the vehicle
+    application).
     """
 
     def __init__(self, densities: Mapping | None = None, *, p=1e-4, pi=1e-3, threshold=0.95,
