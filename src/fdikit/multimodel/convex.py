@@ -52,16 +52,36 @@ class ConvexModelSet:
 
     Attributes
     ----------
-    A : (N, n, n), B : (N, n, m), C : (N, p, n), D : (N, p, m) local matrices.
-    Q : (n, n) process-noise covariance, R : (p, p) measurement-noise covariance.
-    names : model names.
-    varying : which of (A, B, C, D) differ between models.  A matrix common to all models is treated as
+    A, B, C, D : ndarray
+        Local matrices, stacked: A (N, n, n), B (N, n, m), C (N, p, n), D (N, p, m).
+    Q, R : ndarray
+        Process-noise covariance (n, n) and measurement-noise covariance (p, p).
+    names : tuple of str
+        Model names.
+    varying : tuple of bool
+        Which of (A, B, C, D) differ between models.  A matrix common to all models is treated as
         a constant, not as ``Σ μ^(i) M = (1ᵀμ) M``: both agree on the simplex, but only the former has a zero
         derivative in μ, so that the augmented EKF is the linear KF on ``[x; μ]`` when only B varies, as
         §2.4.2 states.
-    offset : ``(A⁺, B⁺, C⁺, D⁺)`` added to every blend, for the limit-value structure (3.39)–(3.40)
+    offset : tuple of ndarray or None
+        ``(A⁺, B⁺, C⁺, D⁺)`` added to every blend, for the limit-value structure (3.39)–(3.40)
         ``M(μ) = M⁺ + Σ μ_j M^Δ_j`` (the local "models" are then the changes ``M^Δ_j``; see
         :func:`limit_value_convex_set`).  ``None`` for a convex model.
+
+    Examples
+    --------
+    Build it with :func:`convex_model_set`:
+
+    >>> ms = convex_model_set([[0.9]], [[[0.0]], [[1.0]]], [[1.0]], Q=[[1e-4]], R=[[1e-2]],
+    ...                       names=["stuck", "nominal"])
+    >>> ms.N, ms.varying
+    (2, (False, True, False, False))
+    >>> [M.tolist() for M in ms.blend([0.25, 0.75])]
+    [[[0.9]], [[0.75]], [[1.0]], [[0.0]]]
+
+    References
+    ----------
+    Hallouzi 2008, §2.2.2, (2.8)–(2.10); §2.3.2, (2.19)–(2.20) for the blend.
     """
 
     A: np.ndarray
@@ -117,11 +137,38 @@ def convex_model_set(A, B, C, D=None, Q=None, R=None, names=None) -> ConvexModel
     Each of ``A, B, C, D`` is either one matrix shared by all models or a sequence/stack of ``N``
     matrices; ``N`` is taken from the stacked ones.  ``D`` defaults to zero.
 
-    Example
+    Parameters
+    ----------
+    A, B, C : array_like
+        State (n x n), input (n x m) and output (p x n) matrices, each one matrix or a stack of N;
+        at least one is a stack.
+    D : array_like, optional
+        Feedthrough (p x m) or a stack of N; zero if omitted.
+    Q, R : array_like
+        Common process (n x n, PSD) and measurement (p x p, positive definite) noise covariances; required.
+    names : sequence of str, optional
+        N model names; default ``"model_1"``, ``"model_2"``, ….
+
+    Returns
     -------
+    ConvexModelSet
+        The set, with ``varying`` marking the matrices that differ between the models.
+
+    Raises
+    ------
+    ModelError
+        If no matrix is stacked, the stacks disagree on N, the shapes do not fit, ``Q``/``R`` are missing or
+        not covariances, or the number of names is not N.
+
+    Examples
+    --------
     >>> ms = convex_model_set(np.eye(1), [[[0.0]], [[2.0]]], np.eye(1), Q=np.eye(1), R=np.eye(1))
     >>> ms.N, ms.blend([0.25, 0.75])[1]
     (2, array([[1.5]]))
+
+    References
+    ----------
+    Hallouzi 2008, §2.2.2, (2.8)–(2.10).
     """
     mats = {"A": A, "B": B, "C": C}
     arrs = {k: np.asarray(v, dtype=float) for k, v in mats.items()}
@@ -168,13 +215,35 @@ def limit_value_convex_set(lv, Q, R) -> ConvexModelSet:
     columns of the augmented EKF are ``A^Δ_j x + B^Δ_j u`` and ``C^Δ_j x + D^Δ_j u`` (the derivatives of the
     blended model with respect to ``μ_j``).
 
-    Example
+    Parameters
+    ----------
+    lv : LimitValueModelSet
+        The limit-value set (offset ``M⁺`` and changes ``M^Δ_j``), from
+        :func:`~fdikit.multimodel.model_set.limit_value_model_set`.
+    Q, R : array_like
+        Process (n x n) and measurement (p x p) noise covariances.
+
+    Returns
     -------
+    ConvexModelSet
+        One "model" per limit-value weight (the changes ``M^Δ_j``), with ``offset = (A⁺, B⁺, C⁺, D⁺)``.
+
+    Raises
+    ------
+    ModelError
+        If ``lv`` has no varying parameter (or as :func:`convex_model_set`).
+
+    Examples
+    --------
     >>> from fdikit.multimodel.model_set import limit_value_model_set
     >>> lv = limit_value_model_set(lambda a: ([[a]], [[1.0]], [[1.0]]), {"a": -1.0}, {"a": -3.0})
     >>> ms = limit_value_convex_set(lv, Q=[[1.0]], R=[[1.0]])
     >>> float(ms.blend([0.5])[0][0, 0]), ms.names
     (-2.0, ('a',))
+
+    References
+    ----------
+    Hallouzi 2008, §3.5, (3.34)–(3.40); §3.6.1, (3.44).
     """
     deltas = lv.deltas
     if not deltas:
@@ -195,6 +264,41 @@ def weight_regressors(models: ConvexModelSet, x_prev, u_prev, x_filt, u, y, weig
     which ``‖Φμ − Γ‖²`` is the cost (2.27); ``"inverse"`` uses ``Q^{-1}, R^{-1}`` as printed in (2.33)
     (with ``Q^{-1}`` the squared norm weights by ``Q^{-2}``, not the ``Q^{-1}`` of (2.27), so the
     printed form appears to have lost the exponent ½).
+
+    Parameters
+    ----------
+    models : ConvexModelSet
+        The local models.
+    x_prev, u_prev : array_like
+        ``x̂_{k−1|k−1}`` (n) and ``u_{k−1}`` (m).
+    x_filt, u, y : array_like
+        ``x̂_{k|k}`` (n), ``u_k`` (m) and ``y_k`` (p).
+    weighting : {"whitened", "inverse"}
+        ``Q^{-1/2}, R^{-1/2}`` (default) or ``Q^{-1}, R^{-1}`` as printed.
+
+    Returns
+    -------
+    Phi : ndarray
+        Regressor ((n + p) x N), one column per local model.
+    Gamma : ndarray
+        Target (n + p).
+
+    Raises
+    ------
+    ModelError
+        On an unknown ``weighting``.
+
+    Examples
+    --------
+    >>> ms = convex_model_set([[0.9]], [[[0.0]], [[1.0]]], [[1.0]], Q=[[1e-4]], R=[[1e-2]],
+    ...                       names=["stuck", "nominal"])
+    >>> Phi, Gamma = weight_regressors(ms, [1.0], [1.0], [1.9], [0.0], [1.9])
+    >>> Phi.round(4).tolist(), Gamma.round(4).tolist()
+    ([[90.0, 190.0], [19.0, 19.0]], [190.0, 19.0])
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.2, Table 2.2 step 2, (2.27), (2.33)–(2.34).
     """
     if weighting not in ("whitened", "inverse"):
         raise ModelError(f"weighting must be 'whitened' (Q^-1/2, R^-1/2) or 'inverse' (Q^-1, R^-1), got {weighting!r}")
@@ -222,11 +326,40 @@ def rls_weight_step(T_prev, xi_prev, Phi, Gamma, lam: float):
 
     Returns ``(T_k, ξ_k, μ̂_k)``.
 
-    Example
+    Parameters
+    ----------
+    T_prev : array_like
+        Square-root information ``T_{k−1}`` (N x N), upper triangular.
+    xi_prev : array_like
+        ``ξ_{k−1}`` (N).
+    Phi, Gamma : array_like
+        Regressor (r x N) and target (r) of this sample (:func:`weight_regressors`).
+    lam : float
+        Forgetting factor λ ∈ (0, 1].
+
+    Returns
     -------
+    T : ndarray
+        ``T_k`` (N x N).
+    xi : ndarray
+        ``ξ_k`` (N).
+    mu : ndarray
+        Unconstrained weight estimate ``μ̂_k`` (N) (least squares when ``T_k`` is singular).
+
+    Raises
+    ------
+    ParameterError
+        If ``lam`` is not in (0, 1].
+
+    Examples
+    --------
     >>> T, xi, mu = rls_weight_step(np.zeros((1, 1)), [0.0], [[2.0]], [1.0], 0.9)
     >>> float(mu[0])
     0.5
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.2, Table 2.2 step 2, (2.35)–(2.36).
     """
     lam = validate.number("lam (the forgetting factor)", lam, finite=False)
     if not 0.0 < lam <= 1.0:
@@ -248,9 +381,33 @@ class ConvexFilterResult:
 
     Attributes
     ----------
-    x : (K, n) filtered states x̂_{k|k}.  P : (K, n, n) their covariances.
-    mu : (K, N) weights used (constrained if the filter projects).  mu_raw : (K, N) before projection.
-    names : model names.
+    x : ndarray
+        (K, n) filtered states x̂_{k|k}.
+    P : ndarray
+        (K, n, n) their covariances.
+    mu : ndarray
+        (K, N) weights used (constrained if the filter projects).
+    mu_raw : ndarray
+        (K, N) weights before the projection.
+    names : tuple of str
+        Model names, in the order of the columns of ``mu``.
+
+    Examples
+    --------
+    >>> ms = convex_model_set([[0.9]], [[[0.0]], [[1.0]]], [[1.0]], Q=[[1e-4]], R=[[1e-2]],
+    ...                       names=["stuck", "nominal"])
+    >>> u = np.sin(0.3 * np.arange(20)).reshape(-1, 1)
+    >>> x, y = 0.0, []
+    >>> for uk in u[:, 0]:                      # the "nominal" model, noise-free
+    ...     y.append([x])
+    ...     x = 0.9 * x + uk
+    >>> res = dual_convex_filter(ms, np.array(y), u, x0=[0.0], P0=[[1.0]])
+    >>> res.x.shape, res.P.shape, res.mu.shape, res.names
+    ((20, 1), (20, 1, 1), (20, 2), ('stuck', 'nominal'))
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.2, Table 2.2; §2.3.3, Table 2.3.
     """
 
     x: np.ndarray
@@ -291,6 +448,42 @@ def innovation_regressors(models: ConvexModelSet, x_prev, S_prev, u_prev, u, y, 
     ``Φ = R_e⁻¹ G``, ``Γ = R_e⁻¹ (e_k + G μ̄)``, ``e_k = y_k − ŷ_k(μ̄)``.
 
     Returns ``(Φ, Γ, F, x̂⁻_k(μ̄), S⁻_k(μ̄))``.
+
+    Parameters
+    ----------
+    models : ConvexModelSet
+        The local models.
+    x_prev, S_prev : ndarray
+        ``x̂_{k−1|k−1}`` (n) and a factor ``S_{k−1|k−1}`` (n x n) of its covariance.
+    u_prev, u, y : ndarray
+        ``u_{k−1}`` (m), ``u_k`` (m) and ``y_k`` (p).
+    mu_prev : ndarray
+        Linearisation point ``μ̄ = μ̂_{k−1}`` (N).
+    Q_sqrt, R_sqrt : ndarray
+        Factors of ``Q`` (n x n) and ``R`` (p x p).
+
+    Returns
+    -------
+    Phi, Gamma : ndarray
+        Whitened regressor (p x N) and target (p).
+    F : ndarray
+        ``∂x̂⁻_k/∂μ`` (n x N).
+    x_pred, S_pred : ndarray
+        ``x̂⁻_k(μ̄)`` (n) and the factor of its covariance (n x n).
+
+    Examples
+    --------
+    >>> ms = convex_model_set([[0.9]], [[[0.0]], [[1.0]]], [[1.0]], Q=[[1e-4]], R=[[1e-2]],
+    ...                       names=["stuck", "nominal"])
+    >>> Phi, Gamma, F, x_pred, S_pred = innovation_regressors(
+    ...     ms, np.array([1.0]), np.array([[0.1]]), np.array([1.0]), np.array([0.0]), np.array([1.9]),
+    ...     np.array([0.5, 0.5]), np.array([[0.01]]), np.array([[0.1]]))
+    >>> F.tolist(), x_pred.round(6).tolist(), Phi.round(4).tolist()
+    ([[0.0, 1.0]], [1.4], [[0.0, 7.4125]])
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.2, (2.16), (2.27), (2.33)–(2.34) (the form corrected here).
     """
     A, B, C, D = models.blend(mu_prev)
     x_pred, S_pred = srkf_predict(x_prev, S_prev, A, B, u_prev, Q_sqrt)
@@ -332,20 +525,51 @@ def dual_convex_filter(models: ConvexModelSet, y, u, x0, P0, mu0=None, lam: floa
 
     Parameters
     ----------
-    models : the local models.  y : (K, p), u : (K, m) data.  x0, P0 : prior x̂_{0|−1}, P_{0|−1}.
-    mu0 : initial weights (default uniform 1/N).  lam : forgetting factor λ ∈ (0, 1] (thesis: 0.9, 0.85).
-    form : ``"corrected"`` or ``"thesis"``.
-    weighting : thesis form only: ``"whitened"`` (Q^{-1/2}, default) or ``"inverse"`` (Q^{-1}, as printed
-        in (2.33)).  ordering : Euclidean projection ordering, see :func:`project_to_simplex`.
-    metric : ``"information"`` (W = TᵀT) or ``"identity"`` (W = I, the thesis); default by ``form``.
-    constrain : see :func:`~fdikit.multimodel.simplex.constrain_weights`: ``True`` (the simplex), ``"affine"``
+    models : ConvexModelSet
+        The local models.
+    y, u : array_like
+        Measurements (K, p) and inputs (K, m) (``u`` may be None when m = 0); finite.
+    x0, P0 : array_like
+        Prior ``x̂_{0|−1}`` (n) and ``P_{0|−1}`` (n x n).
+    mu0 : array_like, optional
+        Initial weights (N); default uniform 1/N.
+    lam : float, optional
+        Forgetting factor λ ∈ (0, 1] (default 0.9; the thesis uses 0.9 and 0.85).
+    form : {"corrected", "thesis"}
+        The corrected filter (default) or Table 2.2 as printed.
+    weighting : {"whitened", "inverse"}
+        Thesis form only: ``Q^{-1/2}`` (default) or ``Q^{-1}`` as printed in (2.33).
+    ordering : {"michelot", "thesis"}
+        Euclidean projection ordering, see :func:`~fdikit.multimodel.simplex.project_to_simplex`.
+    metric : {"information", "identity"}, optional
+        Projection metric ``W = TᵀT`` or ``W = I`` (the thesis); default by ``form``.
+    constrain : bool or str
+        See :func:`~fdikit.multimodel.simplex.constrain_weights`: ``True`` (the simplex, default), ``"affine"``
         (``1ᵀμ = 1`` only, for OD sets, whose weights may be negative), ``"box"`` (limit-value sets) or ``False``.
-    write_back : store ``ξ = T μ^c`` (not stated in the thesis); default by ``form``.
-    T0_scale : ``T_0 = δ I`` and ``ξ_0 = T_0 μ_0`` (a thesis gap).
-    prior_std : regularised forgetting: each step adds the rows ``√(1−λ)/σ [I, μ_0]``, so the weight
+    write_back : bool, optional
+        Store ``ξ = T μ^c`` (not stated in the thesis); default by ``form``.
+    b_after_weights : bool
+        Thesis form: use ``B_{μ̂_k}`` in (2.32) (default True, as §2.4.2 does when only B switches).
+    T0_scale : float
+        ``T_0 = δ I`` and ``ξ_0 = T_0 μ_0`` (a thesis gap); default 1e-3.
+    prior_std : float, optional
+        Regularised forgetting: each step adds the rows ``√(1−λ)/σ [I, μ_0]``, so the weight
         information never falls below ``I/σ²`` around ``μ_0`` (default ``None``: none, as in the thesis).  It
         keeps weights that the data do not determine at ``μ_0`` instead of letting them wander, as they do
         on the B747 benchmark before the states are excited.
+
+    Returns
+    -------
+    ConvexFilterResult
+        Filtered states, covariances and weights per sample.
+
+    Raises
+    ------
+    ParameterError
+        On an unknown ``form``, ``metric``, ``constrain``, ``ordering`` or ``weighting``, ``lam`` outside (0, 1],
+        or a non-positive ``T0_scale``/``prior_std``.
+    ModelError
+        With ``form="thesis"`` on a limit-value set (an offset the printed step has no term for).
 
     Notes
     -----
@@ -353,6 +577,23 @@ def dual_convex_filter(models: ConvexModelSet, y, u, x0, P0, mu0=None, lam: floa
     (corrected; EKF 0.60, IMM 0.35), and in the half-strength turn 3.6 against 0.71 (EKF 0.56, IMM 1.08).
     Neither form is stable on the §3.6 MSD (the f2·x2 scale of sensor 2 is weakly observable and, with no
     prior on the weights, drifts); the thesis uses the augmented EKF there.
+
+    Examples
+    --------
+    >>> ms = convex_model_set([[0.9]], [[[0.0]], [[1.0]]], [[1.0]], Q=[[1e-4]], R=[[1e-2]],
+    ...                       names=["stuck", "nominal"])
+    >>> u = np.sin(0.3 * np.arange(20)).reshape(-1, 1)
+    >>> x, y = 0.0, []
+    >>> for uk in u[:, 0]:                      # the "nominal" model, noise-free
+    ...     y.append([x])
+    ...     x = 0.9 * x + uk
+    >>> res = dual_convex_filter(ms, np.array(y), u, x0=[0.0], P0=[[1.0]])
+    >>> res.mu[-1].round(3).tolist()
+    [0.0, 1.0]
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.2, Table 2.2, (2.29)–(2.38); §2.4.2 (the tracking benchmark).
     """
     validate.instance("models", models, ConvexModelSet, "build the set with convex_model_set(...)")
     if form not in ("corrected", "thesis"):
@@ -436,10 +677,31 @@ def fault_size_from_weights(mu, faulty_models) -> np.ndarray:
     effectiveness: e.g. Table 3.2, ``f_1 = 1 − (μ̂^(2) + μ̂^(4))`` (0-based indices ``[1, 3]``).  ``mu`` is
     (N,) or (K, N); returns a float or (K,).
 
-    Example
+    Parameters
+    ----------
+    mu : array_like
+        Weights (N,) or (K, N).
+    faulty_models : sequence of int
+        0-based indices of the models at ``f = 0`` (the fully faulty ones).
+
+    Returns
     -------
+    float or ndarray
+        ``f`` per sample: a 0-d array for (N,) weights, (K,) otherwise.
+
+    Raises
+    ------
+    ModelError
+        If ``faulty_models`` is empty or holds an index outside 0..N−1.
+
+    Examples
+    --------
     >>> float(fault_size_from_weights([0.1, 0.2, 0.3, 0.1, 0.2, 0.1], [1, 3]))
     0.7
+
+    References
+    ----------
+    Hallouzi 2008, §3.6.1, Table 3.2; §3.6.2, Fig. 3.9.
     """
     mu = np.asarray(mu, dtype=float)
     idx = np.asarray(faulty_models, dtype=int).ravel()
@@ -453,10 +715,26 @@ def lv_parameter(mu, value_at_0: float, value_at_1: float):
 
     ``value_at_0 = θ⁺`` (e.g. ``k_1^max``; 1 for an effectiveness f), ``value_at_1 = θ⁻`` (``k_1^min``; 0).
 
-    Example
+    Parameters
+    ----------
+    mu : float or array_like
+        Limit-value weight(s) μ ∈ [0, 1].
+    value_at_0, value_at_1 : float
+        The parameter at μ = 0 (``θ⁺``) and at μ = 1 (``θ⁻``).
+
+    Returns
     -------
+    ndarray
+        θ, of the shape of ``mu``.
+
+    Examples
+    --------
     >>> float(lv_parameter(0.5, 1.75, 0.25)), float(lv_parameter(0.3, 1.0, 0.0))
     (1.0, 0.7)
+
+    References
+    ----------
+    Hallouzi 2008, §3.5, (3.35); §3.6.2, (3.54), (3.56)–(3.57).
     """
     return value_at_0 + np.asarray(mu, dtype=float) * (value_at_1 - value_at_0)
 
@@ -466,10 +744,31 @@ def lv_reciprocal_parameter(mu, value_at_0: float, value_at_1: float):
 
     ``1/θ`` is affine in μ, from ``1/θ⁺`` at μ = 0 to ``1/θ⁻`` at μ = 1 (``θ⁺ = m_3^max``, ``θ⁻ = m_3^min``).
 
-    Example
+    Parameters
+    ----------
+    mu : float or array_like
+        Limit-value weight(s) μ ∈ [0, 1].
+    value_at_0, value_at_1 : float
+        The parameter at μ = 0 (``θ⁺``) and at μ = 1 (``θ⁻``); both positive.
+
+    Returns
     -------
+    ndarray
+        θ, of the shape of ``mu``.
+
+    Raises
+    ------
+    ModelError
+        If a limit value is not positive.
+
+    Examples
+    --------
     >>> round(float(lv_reciprocal_parameter(0.1, 1.8, 0.2)), 12)
     1.0
+
+    References
+    ----------
+    Hallouzi 2008, §3.6.2, (3.55).
     """
     if value_at_0 <= 0 or value_at_1 <= 0:
         raise ModelError("a reciprocal LV parameter (mass) needs positive limit values")
@@ -481,6 +780,32 @@ def estimated_model_vector(vertices, mu) -> np.ndarray:
     """Estimated model vector ``M̂_k = [v^(1) … v^(N)] μ̂_k`` (Hallouzi 2008, (3.51)).
 
     ``vertices`` is (n_q, N): the vectorised local models ``vec([A B; C D])`` (for the CP set, ``U¹ v^(i)``).
+
+    Parameters
+    ----------
+    vertices : array_like
+        (n_q, N), one vectorised local model per column.
+    mu : array_like
+        Weights (N,) or (K, N).
+
+    Returns
+    -------
+    ndarray
+        ``M̂`` (n_q,) or (K, n_q).
+
+    Raises
+    ------
+    ModelError
+        If the number of columns of ``vertices`` and of weights differ.
+
+    Examples
+    --------
+    >>> estimated_model_vector([[1.0, 3.0], [0.0, 2.0]], [0.25, 0.75]).tolist()
+    [2.5, 1.5]
+
+    References
+    ----------
+    Hallouzi 2008, §3.6.2, (3.51).
     """
     V = np.asarray(vertices, dtype=float)
     mu = np.asarray(mu, dtype=float)
