@@ -14,6 +14,7 @@ import scipy.linalg
 import scipy.signal
 
 from fdikit.design.game.continuous import game_filter, game_filter_bank, single_fault_game_filter
+from fdikit.design.game.discrete import DiscreteGtfdfDesign
 from fdikit.design.game.riccati import game_cost, game_riccati, solve_game_are
 from fdikit.design.game.setup import game_problem
 from fdikit.errors import DesignError, ParameterError
@@ -39,7 +40,7 @@ def _kernel(Pi, rel=1e-6):
 @pytest.fixture(scope="module")
 def f16():
     m = f16xl_longitudinal()
-    faults = {"theta": resolve_faults(m, ["y_theta"])["y_theta_sensor"], "elevon": m.Bu, "gust": m.Bd}
+    faults = {"theta": resolve_faults(m, ["y_theta_sensor"])["y_theta_sensor"], "elevon": m.Bu, "gust": m.Bd}
     return m, faults
 
 
@@ -403,8 +404,10 @@ def test_limit_small_gamma_blocks_nuisance_monotonically(f16):
 # ------------------------------------------------------------------ errors
 def test_errors_name_the_problem(f16):
     m, faults = f16
+    # a discrete model runs Murray's discrete design (test_game_discrete: the same as dgtfdf); the bank stays continuous
+    assert isinstance(single_fault_game_filter(white_speyer().discretize(0.1), "f1", ["f2"]), DiscreteGtfdfDesign)
     with pytest.raises(DesignError, match="discrete"):
-        single_fault_game_filter(white_speyer().discretize(0.1), "f1", ["f2"])
+        game_filter_bank(white_speyer().discretize(0.1), ["f1", "f2"])
     with pytest.raises(ParameterError, match="positive semidefinite"):
         single_fault_game_filter(white_speyer(), "f1", ["f2"], M=-1.0)
     with pytest.raises(DesignError, match="not achievable"):

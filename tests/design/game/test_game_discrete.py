@@ -9,7 +9,10 @@ import pytest
 import scipy.linalg
 
 from fdikit import FaultModel
+from fdikit.design.game.continuous import game_filter, single_fault_game_filter
 from fdikit.design.game.discrete import (
+    DiscreteGtfdfDesign,
+    DiscreteGtmfdfDesign,
     dgtfdf,
     dgtmfdf,
     discrete_game_generator,
@@ -333,3 +336,51 @@ def test_multi_target_f16_design_is_stable_feasible_and_isolates():
     assert ratio_th > 100 and ratio_el > 100
     assert np.linalg.norm(th[:, :2]) > 1.5 * np.linalg.norm(
         np.abs(discrete_game_generator(st, L0).internal_form(faults).freqresp([0.0], "f")[0])[:2, :2])
+
+
+# ---------------------------------------------------------------------- one entry point per design, dispatching on dt
+def _same_design(a, b, fields):
+    """Equal up to the rounding of V̄ = γ·V (the dispatch multiplies, the direct call was given the product)."""
+    for f in fields:
+        x, y = np.asarray(getattr(a, f)), np.asarray(getattr(b, f))
+        np.testing.assert_allclose(x, y, rtol=0, atol=1e-12 * max(np.abs(y).max(), 1e-300), err_msg=f)
+    for M in ("A", "B", "C", "D"):
+        y = getattr(b.generator, M)
+        np.testing.assert_allclose(getattr(a.generator, M), y, rtol=0, atol=1e-12 * max(np.abs(y).max(), 1.0))
+    assert a.generator.residuals == b.generator.residuals and a.generator.isolates == b.generator.isolates
+
+
+def test_single_fault_game_filter_on_a_discrete_model_is_dgtfdf():
+    """ARCHITECTURE conventions: one public name per design; a model with dt runs Murray's DGTFDF with V̄ = γV
+    (V keeps its meaning V̄/γ), the weights per sample, P0 and steps the horizon (defaults P0 = γ, 500 steps)."""
+    dt, gamma = 0.01, 1e-6
+    model = white_speyer("stable-zero").discretize(dt)
+    d = single_fault_game_filter(model, "f1", ["f2"], gamma=gamma, V=1.0 / dt, Q=0.002 * dt, M=0.05 / dt, P0=gamma,
+                                 steps=400)
+    assert isinstance(d, DiscreteGtfdfDesign)
+    _same_design(d, dgtfdf(_ws_single(dt, steps=400)), ["gain", "filter_gain", "filter_gains", "covariances",
+                                                          "levels", "poles"])
+    default = single_fault_game_filter(model, "f1", ["f2"], gamma=gamma, V=1.0 / dt, Q=0.002 * dt, M=0.05 / dt)
+    _same_design(default, dgtfdf(_ws_single(dt, steps=500)), ["gain", "filter_gains", "covariances"])
+    with pytest.raises(ParameterError, match="R_1"):
+        single_fault_game_filter(model, "f1", ["f2"], gamma=gamma, V=1.0 / dt, Q=0.002 * dt, M=0.05 / dt, R=1.0)
+    with pytest.raises(ParameterError, match="P0, steps"):
+        single_fault_game_filter(white_speyer("stable-zero"), "f1", ["f2"], P0=1.0, steps=10)
+
+
+def test_game_filter_on_a_discrete_model_is_dgtmfdf():
+    """game_filter on a model with dt = dgtmfdf on the same setup; method and options go to dgtmfdf, the
+    continuous optimiser's margins are refused."""
+    st = _random_problem(1)
+    kw = dict(gamma=1.0, V=1.0, Q=0.1, M=1.0, K=1.0, N=1.0, P0=1.0, steps=40)
+    d = game_filter(st.model, ["f1", "f2"], **kw, method="fixed-point", options={"max_radius": 0.9999})
+    assert isinstance(d, DiscreteGtmfdfDesign)
+    ref = dgtmfdf(st, method="fixed-point", max_radius=0.9999)
+    _same_design(d, ref, ["gain", "filter_gain", "poles", "cost", "initial_cost", "gradient"])
+    assert d.method == ref.method and d.notes == ref.notes
+    with pytest.raises(ParameterError, match="eps_stab"):
+        game_filter(st.model, ["f1", "f2"], **kw, eps_stab=0.1)
+    with pytest.raises(ParameterError, match="not keywords"):
+        game_filter(st.model, ["f1", "f2"], **kw, options={"maxfun": 3})
+    with pytest.raises(ParameterError, match="discrete optimiser method"):
+        game_filter(st.model, ["f1", "f2"], **kw, method="L-BFGS-B")

@@ -35,17 +35,24 @@ import scipy.linalg
 import scipy.optimize
 
 from fdikit import linalg, validate
+from fdikit.design.game.discrete import (
+    DiscreteGameSetup,
+    DiscreteGtfdfDesign,
+    DiscreteGtmfdfDesign,
+    dgtfdf,
+    dgtmfdf,
+    discrete_game_setup,
+)
 from fdikit.design.game.riccati import (
     checked_gain,
     checked_gamma,
-    per_target,
     require_continuous,
     solve_game_are,
     stacked_cost,
     target_margins,
     target_terms,
 )
-from fdikit.design.game.setup import GameProblem, game_problem, weight
+from fdikit.design.game.setup import GameProblem, game_problem, per_target, weight
 from fdikit.design.observers.full_order import observer_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.linalg import resolve_nuisance
@@ -86,6 +93,26 @@ def _names(target: str, k: int) -> list[str]:
 
 def _given_names(spec) -> list[str]:
     return [str(k) for k in spec] if not isinstance(spec, str) else [spec]
+
+
+def _discrete_setup(model, targets, nuisance, *, gamma, V, Q, M, K=0.0, N=0.0, P0=None, steps=None
+                    ) -> DiscreteGameSetup:
+    """The Murray Ch. 5 setup for a discrete model with the continuous entry points' weights.
+
+    ``V`` keeps its meaning (Murray's ``V = V̄/γ``, so ``Vbar = γ V``); ``Q``, ``M``, ``K``, ``N`` are passed
+    as they are (per-sample weights); ``P0`` defaults to ``γ`` (``P(k0) = P0/γ = I``) and ``steps`` to 500.
+    """
+    g = checked_gamma(gamma)
+    return discrete_game_setup(model, targets, nuisance, gamma=g, Vbar=weight("V", V, model.p) * g, Q=Q, M=M,
+                               K=K, N=N, P0=g if P0 is None else P0, steps=500 if steps is None else steps)
+
+
+def _continuous_only(model: FaultModel, **given) -> None:
+    """Refuse the discrete design's horizon arguments on a continuous model."""
+    bad = [k for k, v in given.items() if v is not None]
+    if bad:
+        raise ParameterError(f"{', '.join(bad)} set the finite horizon of the discrete design (a model with dt); "
+                             "the continuous design is steady-state — leave them unset")
 
 
 # ---------------------------------------------------------------------------- single fault
@@ -139,7 +166,9 @@ def single_fault_game_filter(
     Q=1e-4,
     M=0.01,
     R=0.0,
-) -> SingleFaultGameDesign:
+    P0=None,
+    steps: int | None = None,
+) -> SingleFaultGameDesign | DiscreteGtfdfDesign:
     """Single-fault game-theoretic detection filter, steady state (Murray 2012, (3.29)–(3.30)).
 
     Solves, in the covariance form ``P = Γ⁻¹`` (Murray 2012, §3.3: (3.32) is (3.16) written in
@@ -161,9 +190,17 @@ def single_fault_game_filter(
     To reproduce PATH's example (ν = 1e−8, ν/γ = 0.8, Q = R = M = I): ``gamma = 1.25e-8``,
     ``V = 0.8`` (= ν/γ), ``Q = 1``, ``M = 1``, ``R = 1``.
 
+    **Discrete model** (``model.dt`` set): the discrete single-fault filter of Murray 2012, Ch. 5
+    (DGTFDF, (5.42)–(5.43)) — ``dgtfdf(discrete_game_setup(model, targets, nuisance, gamma=gamma,
+    Vbar=gamma * V, Q=Q, M=M, P0=P0, steps=steps))``: ``V`` keeps its meaning ``V̄/γ``, ``Q`` and ``M``
+    are per-sample weights (from a continuous design at Δt: ``Q Δt``, ``M/Δt``, ``V/Δt``), ``P0``
+    (default ``gamma``, i.e. ``P(k0) = I``) and ``steps`` (default 500) fix the finite horizon whose last
+    gain the generator uses.  ``R`` must be 0 (Ch. 5 has no ``R_1`` term).
+    :func:`~fdikit.design.game.discrete.dgtfdf` stays available for a prepared setup.
+
     Parameters
     ----------
-    model : continuous FaultModel.
+    model : FaultModel, continuous (steady-state design) or discrete (Murray Ch. 5, above).
     targets : the one fault to detect — a fault name resolved by :func:`fdikit.linalg.resolve_faults`
         (``'<output>_sensor'`` = sensor fault ``[F¹, A F¹]``, ``'<control>_actuator'`` = actuator fault,
         a fault input of the model), a one-element sequence of it, or a mapping ``{name: F}``.
@@ -174,16 +211,21 @@ def single_fault_game_filter(
     Q : output weight (p x p or scalar) on ``Ĥ C e``.
     M : complementary-fault weight (dim F̂ square, or scalar).
     R : PATH's weight ``R_1`` on ``(I − Ĥ) C e`` (p x p or scalar; default 0 = Murray's form).
+    P0, steps : discrete models only: initial-error weight (``P(k0) = P0/γ``) and horizon in samples.
 
     Returns
     -------
-    SingleFaultGameDesign
+    SingleFaultGameDesign or DiscreteGtfdfDesign
+        The latter for a discrete model; its ``gain`` is the observer (predictor) gain ``Φ L`` and
+        ``filter_gain`` Murray's filtered-form ``L``.
 
     Raises
     ------
     DesignError
-        For a discrete model, a bad weight, a target hidden by the nuisance faults, or when the
-        Riccati equation has no stabilizing nonnegative solution (γ too small for ``Q``).
+        A bad weight, a target hidden by the nuisance faults, or when the Riccati equation has no
+        stabilizing nonnegative solution (γ too small for ``Q``; discrete: positivity lost at a step).
+    ParameterError
+        ``P0``/``steps`` for a continuous model, a nonzero ``R`` for a discrete one.
 
     Examples
     --------
@@ -196,6 +238,15 @@ def single_fault_game_filter(
     >>> np.round(np.sort(d.poles.real), 4)
     array([-100.1401,   -4.1878,   -1.1925])
     """
+    if model.is_discrete:
+        if np.any(weight("R", R, model.p)):
+            raise ParameterError("R (PATH's weight R_1) has no counterpart in the discrete design of Murray 2012 "
+                                 "Ch. 5; leave R = 0 for a discrete model")
+        setup = _discrete_setup(model, targets, nuisance, gamma=gamma, V=V, Q=Q, M=M, P0=P0, steps=steps)
+        if len(setup.names) != 1:
+            raise DesignError(f"single_fault_game_filter takes one target, got {list(setup.names)}; use game_filter")
+        return dgtfdf(setup)
+    _continuous_only(model, P0=P0, steps=steps)
     require_continuous(model)
     g = checked_gamma(gamma)
     prob = game_problem(model, targets, nuisance)
@@ -410,12 +461,14 @@ def game_filter(
     K=0.01,
     N=1.0,
     L0=None,
-    eps_stab: float = 1e-3,
-    eps_ham: float = 1e-3,
-    barrier: float = 1e-2,
-    method: str = "L-BFGS-B",
+    eps_stab: float | None = None,
+    eps_ham: float | None = None,
+    barrier: float | None = None,
+    method: str | None = None,
     options: Mapping | None = None,
-) -> GameDesign:
+    P0=None,
+    steps: int | None = None,
+) -> GameDesign | DiscreteGtmfdfDesign:
     """Game-theoretic multiple-fault detection filter, steady state (Murray 2012, (3.27)–(3.28)).
 
     Minimises ``J(L) = Σ_i tr[(F̂_i K_i F̂_iᵀ/γ − F_i N_i F_iᵀ) Π_i(L)]`` over the shared gain, each
@@ -440,9 +493,21 @@ def game_filter(
        stopping rules; check the isolation of the design (e.g. DC gains of ``Ĥ_i C (sI − A + LC)⁻¹ F_j``)
        rather than trusting the optimum.
 
+    **Discrete model** (``model.dt`` set): the discrete multiple-fault filter of Murray 2012, Ch. 5
+    (DGTMFDF, one constant gain over a finite horizon) — ``dgtmfdf(discrete_game_setup(model, targets,
+    nuisance, gamma=gamma, Vbar=gamma * V, Q=Q, M=M, K=K, N=N, P0=P0, steps=steps), L0, method=method,
+    **options)``.  ``V`` keeps its meaning ``V̄/γ``; ``Q``, ``M``, ``K``, ``N`` are per-sample weights of
+    the finite-horizon cost (5.39) (from a continuous design at Δt: ``Q Δt``, ``M/Δt``, ``V/Δt``,
+    ``K, N ∝ 1/Δt²``); ``P0`` defaults to ``gamma`` (``P(k0) = I``) and ``steps`` to 500; ``L0`` is in
+    Murray's filtered form; ``method`` is ``'auto'`` (default), ``'fixed-point'`` or ``'gradient'`` and
+    ``options`` takes the keywords ``maxiter``, ``min_sigma``, ``max_radius``, ``xtol`` of
+    :func:`~fdikit.design.game.discrete.dgtmfdf` (which stays available for a prepared setup).
+    ``eps_stab``, ``eps_ham`` and ``barrier`` belong to the continuous optimiser and are refused; the
+    discrete stability bound is ``options={'max_radius': …}``.
+
     Parameters
     ----------
-    model : continuous FaultModel.
+    model : FaultModel, continuous (steady-state design) or discrete (Murray Ch. 5, above).
     targets : target faults (fault names resolved by :func:`fdikit.linalg.resolve_faults`, or a
         mapping name → F); ``F̂_i`` = the other targets plus the ``nuisance`` faults.
     nuisance : faults every residual must block: ``()`` (default) none, ``'others'`` every fault
@@ -454,20 +519,26 @@ def game_filter(
     L0 : initial gain; default the average of the single-fault GTFDF gains
         (:func:`single_fault_game_filter` per target with ``F̂_i``, ``Q_i``, ``M_i``), or, when the
         average violates the margins, the feasible single-fault gain of lowest cost.
-    eps_stab, eps_ham : required margins on ``Re λ(A − LC)`` and ``|Re λ(H_i)|``.
-    barrier : weight of the barrier relative to the normalised cost.
-    method, options : passed to :func:`scipy.optimize.minimize` (default options
-        ``{'maxiter': 500}``).
+    eps_stab, eps_ham : required margins on ``Re λ(A − LC)`` and ``|Re λ(H_i)|`` (default 1e-3 each).
+    barrier : weight of the barrier relative to the normalised cost (default 1e-2).
+    method, options : passed to :func:`scipy.optimize.minimize` (default ``'L-BFGS-B'`` and options
+        ``{'maxiter': 500}``); for a discrete model see above.
+    P0, steps : discrete models only: initial-error weight (``P(k0) = P0/γ``) and horizon in samples.
 
     Returns
     -------
-    GameDesign
+    GameDesign or DiscreteGtmfdfDesign
+        The latter for a discrete model; its ``gain`` is the observer (predictor) gain ``Φ L`` and
+        ``filter_gain`` Murray's filtered-form ``L``.
 
     Raises
     ------
     DesignError
-        For a discrete model, bad weights, or an initial gain that violates the margins or has no
-        stabilizing Riccati solution (give a feasible ``L0``, or relax ``eps_stab``/``eps_ham``).
+        Bad weights, or an initial gain that violates the margins or has no stabilizing Riccati
+        solution (give a feasible ``L0``, or relax ``eps_stab``/``eps_ham``).
+    ParameterError
+        ``P0``/``steps`` for a continuous model; ``eps_stab``/``eps_ham``/``barrier``, an unknown
+        ``method`` or ``options`` key for a discrete one.
 
     Examples
     --------
@@ -477,6 +548,28 @@ def game_filter(
     >>> d.generator.residuals, bool(d.cost < d.initial_cost)
     (('f1[0]', 'f2[0]'), True)
     """
+    if model.is_discrete:
+        given = [nm for nm, val in (("eps_stab", eps_stab), ("eps_ham", eps_ham), ("barrier", barrier))
+                 if val is not None]
+        if given:
+            raise ParameterError(f"{', '.join(given)} are margins of the continuous optimiser; for a discrete model "
+                                 f"(dt={model.dt}) bound the filter poles with options={{'max_radius': ...}}")
+        dmethod = validate.choice("discrete optimiser method", "auto" if method is None else method,
+                                  ("auto", "fixed-point", "gradient"))
+        if options is not None and not isinstance(options, Mapping):
+            raise ParameterError(f"options must be a mapping of dgtmfdf keywords, got {type(options).__name__}")
+        unknown = sorted(set(options or {}) - {"maxiter", "min_sigma", "max_radius", "xtol"})
+        if unknown:
+            raise ParameterError(f"options {unknown} are not keywords of the discrete design; use maxiter, "
+                                 "min_sigma, max_radius, xtol")
+        setup = _discrete_setup(model, targets, nuisance, gamma=gamma, V=V, Q=Q, M=M, K=K, N=N, P0=P0,
+                                steps=steps)
+        return dgtmfdf(setup, L0, method=dmethod, **dict(options or {}))
+    _continuous_only(model, P0=P0, steps=steps)
+    eps_stab = 1e-3 if eps_stab is None else eps_stab
+    eps_ham = 1e-3 if eps_ham is None else eps_ham
+    barrier = 1e-2 if barrier is None else barrier
+    method = "L-BFGS-B" if method is None else method
     require_continuous(model)
     g = checked_gamma(gamma)
     if not callable(method):
