@@ -100,6 +100,24 @@ CASES["S7"] = {**CASES["S6"], "source": "Sec. 4-3-5, Fig. 4-17"}
 def steering_setpoint(t: ArrayLike, amplitude: float = 2.3e-3, frequency: float = 0.3) -> np.ndarray:
     """Lane-keeping steering set-point ``δ_set = 2.3·10⁻³ sin(0.3·2π t)`` rad (van der Ploeg 2018, (4.2)).
 
+    Parameters
+    ----------
+    t : array_like
+        Times [s].
+    amplitude : float, default 2.3e-3
+        Amplitude [rad].
+    frequency : float, default 0.3
+        Frequency [Hz].
+
+    Returns
+    -------
+    numpy.ndarray
+        ``δ_set(t)`` [rad], the shape of ``t``.
+
+    References
+    ----------
+    van der Ploeg 2018, §4-1, (4.2).
+
     Examples
     --------
     >>> round(float(steering_setpoint(1 / 1.2)), 6)   # a quarter period: the amplitude
@@ -113,6 +131,29 @@ def cosine_speed_sweep(t: ArrayLike, duration: float, start_kmh: float = 70.0, e
 
     The S6/S7 profile (Sec. 4-3-4 gives none).  Its largest acceleration is
     ``π (end − start)/(2 T)``: 0.31 m/s² for 70 → 120 km/h over 70 s, so ``a_x ≈ 0`` (4.1) holds.
+
+    Parameters
+    ----------
+    t : array_like
+        Times [s]; clipped to ``[0, duration]``.
+    duration : float
+        Sweep time ``T`` [s], positive.
+    start_kmh, end_kmh : float, default 70.0, 120.0
+        Speeds at ``t = 0`` and ``t = T`` [km/h].
+
+    Returns
+    -------
+    numpy.ndarray
+        Speeds [km/h], the shape of ``t``.
+
+    Raises
+    ------
+    DataError
+        If ``duration`` is not a positive finite number.
+
+    References
+    ----------
+    van der Ploeg 2018, §4-3-4, Fig. 4-15 (profile not given; this one is fdikit's); (4.1).
 
     Examples
     --------
@@ -130,6 +171,27 @@ def design_bank_angle(radius: float, speed_kmh: int = 70) -> float:
 
     Sharper curves than the table's last row get its largest bank (4.00° at 70 km/h: the thesis'
     extrapolation to ``a_y = 3`` m/s², Sec. 4-4); gentler curves the smallest (1.43°).
+
+    Parameters
+    ----------
+    radius : float
+        Curve radius [m], positive.
+    speed_kmh : {70, 90, 120}, default 70
+        Which column of Table 4-2.
+
+    Returns
+    -------
+    float
+        Bank angle [deg].
+
+    Raises
+    ------
+    ModelError
+        If ``speed_kmh`` is not a column of Table 4-2 or ``radius`` is not positive and finite.
+
+    References
+    ----------
+    van der Ploeg 2018, §4-4, Table 4-2.
 
     Examples
     --------
@@ -248,6 +310,18 @@ def lateral_run(
         See the module docstring for the layout; ``meta`` holds the fault schedules, speeds,
         disturbances and parameters, from which :func:`true_steering_faults` rebuilds the faults.
 
+    Raises
+    ------
+    DataError
+        On a non-positive ``dt``, a ``duration`` shorter than one sample, a malformed fault schedule,
+        speed, ``x0`` or noise standard deviation.
+    ModelError
+        If ``params`` is not a :class:`~fdikit.plants.single_track.SingleTrackParameters`.
+
+    References
+    ----------
+    van der Ploeg 2018, §4-1, (4.1)–(4.2); §4-3-1, (4.5); §1-1, (1.3) (the fault model); App. B, (B.12).
+
     Examples
     --------
     >>> tr = lateral_run(40.0, additive_deg=[(30.0, 0.1)])
@@ -313,6 +387,28 @@ def lateral_run(
 def vanderploeg_case(name: str, **overrides) -> Trace:
     """One of the Ch. 4 cases S1–S7 of the module table; ``overrides`` go to :func:`lateral_run`.
 
+    Parameters
+    ----------
+    name : {"S1", "S2", "S3", "S4", "S5", "S6", "S7"}
+        Case label (a key of :data:`CASES`; S8 is :func:`cornering_run`).
+    **overrides
+        Keyword arguments of :func:`lateral_run` that replace the case's (e.g. ``duration=``).
+
+    Returns
+    -------
+    Trace
+        The run of :func:`lateral_run`; ``meta["scenario"]`` is the case label and ``meta["source"]``
+        its section and figures.
+
+    Raises
+    ------
+    ModelError
+        If ``name`` is not one of the cases.
+
+    References
+    ----------
+    van der Ploeg 2018, §4-3-1 to §4-3-5, Figs. 4-3 to 4-17 (per case, see the module table).
+
     Examples
     --------
     >>> tr = vanderploeg_case("S4")
@@ -349,6 +445,42 @@ def cornering_run(
     ``t = 0``; ``f_a = 0.1`` deg is injected at 5 s.  Perturb ``params`` (e.g. ``C_f`` ±10 %)
     and evaluate a nominal residual generator: the difference of its residual from ``G(q)[f]`` is the
     false fault ``Δ_f`` of (4.21).
+
+    Parameters
+    ----------
+    lateral_acceleration : float, default 3.0
+        Steady lateral acceleration ``a_y`` [m/s²], ``>= 0``.
+    speed_kmh : float, default 70.0
+        Constant speed [km/h].
+    bank_deg : float, optional
+        Road bank angle [deg]; default from Table 4-2 by :func:`design_bank_angle` (0 on a straight).
+    params : SingleTrackParameters, default PRIUS_2010
+        The true vehicle.
+    additive_deg : sequence of (time, value), default ((5.0, 0.1),)
+        Steering offset schedule ``f_a`` [deg].
+    duration : float, default 30.0
+        Length [s].
+    excitation : bool, default True
+        Add the (4.2) set-point on top of the steady-state steering.
+    dt : float, default 0.01
+        Sample time [s].
+    **kwargs
+        Further keyword arguments of :func:`lateral_run` (they override the ones set here).
+
+    Returns
+    -------
+    Trace
+        The run of :func:`lateral_run`, with ``meta["lateral_acceleration"]`` and
+        ``meta["steady_state_steering"]`` (``δ_ss`` [rad]) added.
+
+    Raises
+    ------
+    DataError
+        If ``lateral_acceleration`` is negative or not finite.
+
+    References
+    ----------
+    van der Ploeg 2018, §4-4, Table 4-2, (4.21), Figs. 4-18 to 4-20.
 
     Examples
     --------
@@ -387,6 +519,27 @@ def cornering_run(
 def true_steering_faults(trace: Trace) -> tuple[np.ndarray, np.ndarray]:
     """The true ``(f_a, f_m)`` per sample of a scenario trace, ``f_a`` in **rad**, rebuilt from its meta.
 
+    Parameters
+    ----------
+    trace : Trace
+        A trace of :func:`lateral_run`, :func:`vanderploeg_case` or :func:`cornering_run`.
+
+    Returns
+    -------
+    f_a : numpy.ndarray
+        (N,) additive steering fault [rad].
+    f_m : numpy.ndarray
+        (N,) multiplicative steering fault (gain; 1 when healthy).
+
+    Raises
+    ------
+    DataError
+        If ``trace.meta`` has no fault schedule.
+
+    References
+    ----------
+    van der Ploeg 2018, §1-1, (1.3) (``δ = f_m δ_set + f_a``).
+
     Examples
     --------
     >>> f_a, f_m = true_steering_faults(vanderploeg_case("S1", duration=60.0))
@@ -404,10 +557,33 @@ def true_steering_faults(trace: Trace) -> tuple[np.ndarray, np.ndarray]:
 def perturbed_parameters(params: SingleTrackParameters = PRIUS_2010, **scales: float) -> SingleTrackParameters:
     """``params`` with fields multiplied by ``scales``, e.g. ``C_f=1.1`` for +10 % (the Sec. 4-4 study).
 
+    Parameters
+    ----------
+    params : SingleTrackParameters, default PRIUS_2010
+        Nominal vehicle.
+    **scales : float
+        Factor per field name (``l_f``, ``l_r``, ``m``, ``I_z``, ``C_f``, ``C_r``, ``g``).
+
+    Returns
+    -------
+    SingleTrackParameters
+        A new parameter set.
+
+    Raises
+    ------
+    ModelError
+        If a name in ``scales`` is not a field of ``params``.
+    ParameterError
+        If a scaled value is invalid (e.g. a stiffness scaled to a positive value).
+
+    References
+    ----------
+    van der Ploeg 2018, §4-4 (sensitivity analysis).
+
     Examples
     --------
-    >>> perturbed_parameters(C_f=1.1).C_f
-    -128700.00000000001
+    >>> round(perturbed_parameters(C_f=1.1).C_f, 6)
+    -128700.0
     """
     unknown = set(scales) - set(asdict(params))
     if unknown:
