@@ -59,6 +59,15 @@ def atomic_path(path: str | os.PathLike, *, suffix: str = "") -> Iterator[Path]:
         When ``path`` is an existing folder, its folder cannot be created, or the temporary file
         cannot be created, synced or renamed (the previous file is then unchanged).  Exceptions
         raised by the caller's own writing propagate unchanged (the temporary file is removed).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> dest = pathlib.Path(tempfile.mkdtemp()) / "table.csv"
+    >>> with atomic_path(dest, suffix=".csv") as tmp:
+    ...     _ = tmp.write_text("a,b")
+    >>> dest.read_text()
+    'a,b'
     """
     path = Path(path)
     if path.is_dir():
@@ -89,12 +98,64 @@ def atomic_path(path: str | os.PathLike, *, suffix: str = "") -> Iterator[Path]:
 
 
 def write_bytes(path: str | os.PathLike, data: bytes) -> Path:
-    """Write ``data`` to ``path`` atomically (see :func:`atomic_path`); return the path."""
+    """Write ``data`` to ``path`` atomically (see :func:`atomic_path`); return the path.
+
+    Parameters
+    ----------
+    path : str or PathLike
+        Destination file; its folder is created when missing.
+    data : bytes
+        The complete new content.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``, which now holds exactly ``data``.
+
+    Raises
+    ------
+    DataError
+        As :func:`atomic_path`: the destination is a folder, or the file cannot be written (the previous file is
+        then unchanged).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> out = write_bytes(pathlib.Path(tempfile.mkdtemp()) / "blob.bin", bytes([0, 1]))
+    >>> list(out.read_bytes())
+    [0, 1]
+    """
     with atomic_path(path) as tmp:
         tmp.write_bytes(data)
     return Path(path)
 
 
 def write_text(path: str | os.PathLike, text: str, encoding: str = "utf-8") -> Path:
-    """Write ``text`` to ``path`` atomically (see :func:`atomic_path`); return the path."""
+    """Write ``text`` to ``path`` atomically (see :func:`atomic_path`); return the path.
+
+    Parameters
+    ----------
+    path : str or PathLike
+        Destination file; its folder is created when missing.
+    text : str
+        The complete new content.
+    encoding : str, optional
+        Text encoding (UTF-8 by default).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``, which now holds exactly ``text``.
+
+    Raises
+    ------
+    DataError
+        As :func:`atomic_path`.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> write_text(pathlib.Path(tempfile.mkdtemp()) / "note.txt", "done").read_text()
+    'done'
+    """
     return write_bytes(path, text.encode(encoding))

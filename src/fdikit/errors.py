@@ -24,24 +24,76 @@ __all__ = ["FdiError", "ModelError", "DesignError", "DataError", "ParameterError
 
 
 class FdiError(Exception):
-    """Base class of every error fdikit raises deliberately."""
+    """Base class of every error fdikit raises deliberately.
+
+    Examples
+    --------
+    >>> from fdikit.errors import FdiError, ParameterError
+    >>> issubclass(ParameterError, FdiError)
+    True
+    """
 
 
 class ModelError(FdiError, ValueError):
-    """A model is malformed: wrong shapes, duplicate or unknown names, non-finite entries."""
+    """A model is malformed: wrong shapes, duplicate or unknown names, non-finite entries.
+
+    Examples
+    --------
+    >>> from fdikit import FaultModel
+    >>> try:
+    ...     FaultModel(A=[[0.0, 1.0]], C=[[1.0]])
+    ... except ModelError as exc:
+    ...     print(type(exc).__name__)
+    ModelError
+    """
 
 
 class DesignError(FdiError):
-    """A synthesis specification cannot be met (infeasible, ill-conditioned, not detectable ...)."""
+    """A synthesis specification cannot be met (infeasible, ill-conditioned, not detectable ...).
+
+    The message gives the numbers (ranks, dimensions, margins) that make it infeasible.
+
+    Examples
+    --------
+    >>> issubclass(DesignError, ValueError)
+    False
+    """
 
 
 class DataError(FdiError, ValueError):
-    """Data are unusable: NaN/inf, gaps, missing or unexpected signals, malformed or corrupted files."""
+    """Data are unusable: NaN/inf, gaps, missing or unexpected signals, malformed or corrupted files.
+
+    Examples
+    --------
+    >>> from fdikit.trace_io import read_trace
+    >>> try:
+    ...     read_trace("/nonexistent/run.parquet")
+    ... except DataError as exc:
+    ...     print(type(exc).__name__)
+    DataError
+    """
 
 
 class ParameterError(FdiError, ValueError):
-    """An argument is unusable: wrong type, out of range, unknown option or method name."""
+    """An argument is unusable: wrong type, out of range, unknown option or method name.
+
+    Examples
+    --------
+    >>> from fdikit import validate
+    >>> try:
+    ...     validate.positive("dt", -0.01)
+    ... except ParameterError as exc:
+    ...     print(exc)
+    dt must be a positive number, got -0.01
+    """
 
 
 class FdiWarning(UserWarning):
-    """A result is computed but probably not what was meant (the message says why)."""
+    """A result is computed but probably not what was meant (the message says why).
+
+    Examples
+    --------
+    >>> import warnings
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("error", FdiWarning)  # turn fdikit's warnings into errors
+    """

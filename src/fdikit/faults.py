@@ -77,11 +77,28 @@ class Fault(ABC):
     a control).  Every number (onset, end and the kind's size) must be finite; they are
     stored as floats.
 
+    Parameters
+    ----------
+    target : str
+        The signal the fault acts on: an output (sensor fault) or a control (actuator fault) of the plant.
+    onset : float, keyword-only
+        Time [s] the fault appears (default 0).
+    end : float or None, keyword-only
+        Time [s] it disappears; ``None`` (default) for a permanent fault.
+    location : {'sensor', 'actuator'} or None, keyword-only
+        Where it acts; ``None`` resolves it from the plant's names.
+
     Raises
     ------
     ParameterError
         For an empty or non-string target, an unknown location, a non-number or non-finite
         onset, end or size, an end not after the onset, or a size out of the kind's range.
+
+    Examples
+    --------
+    >>> f = Bias("yaw_rate", 0.02, onset=10.0, end=20.0)
+    >>> f.active([5.0, 10.0, 19.9, 20.0]).tolist()
+    [False, True, True, False]
     """
 
     target: str
@@ -181,7 +198,20 @@ class Fault(ABC):
 
 @dataclass(frozen=True)
 class Bias(Fault):
-    """Additive step: ``v + size`` (sensor bias, Douglas et al. 1996 eq. (3.3); actuator offset)."""
+    """Additive step: ``v + size`` (sensor bias, Douglas et al. 1996 eq. (3.3); actuator offset).
+
+    Parameters
+    ----------
+    size : float
+        The step added to the signal, in its units.
+
+    The target, onset, end and location are those of :class:`Fault`.
+
+    Examples
+    --------
+    >>> Bias("yaw_rate", 0.02, onset=10).size
+    0.02
+    """
 
     size: float = 0.0
     _values: ClassVar[tuple[str, ...]] = ("size",)
@@ -192,7 +222,20 @@ class Bias(Fault):
 
 @dataclass(frozen=True)
 class Drift(Fault):
-    """Ramp: ``v + rate * (t - onset)``."""
+    """Ramp: ``v + rate * (t - onset)``.
+
+    Parameters
+    ----------
+    rate : float
+        Slope, in the signal's units per second.
+
+    The target, onset, end and location are those of :class:`Fault`.
+
+    Examples
+    --------
+    >>> Drift("speed", 0.1, onset=2.0).rate
+    0.1
+    """
 
     rate: float = 0.0
     _values: ClassVar[tuple[str, ...]] = ("rate",)
@@ -207,6 +250,18 @@ class Stuck(Fault):
 
     Lock-in-place of a control surface, Hallouzi 2008 §4.1; stuck actuator,
     Douglas et al. 1996 App. A (``m_i = −u_i + u_ic``).
+
+    Parameters
+    ----------
+    value : float or None
+        The value the signal holds; ``None`` (default) holds its value at the onset.
+
+    The target, onset, end and location are those of :class:`Fault`.
+
+    Examples
+    --------
+    >>> Stuck("steering", onset=3.0).value is None
+    True
     """
 
     value: float | None = None
@@ -224,7 +279,20 @@ class Stuck(Fault):
 
 @dataclass(frozen=True)
 class LossOfEffectiveness(Fault):
-    """Multiplicative loss: ``(1 - loss) * v`` with ``loss`` in [0, 1] (Hallouzi 2008, §4.1)."""
+    """Multiplicative loss: ``(1 - loss) * v`` with ``loss`` in [0, 1] (Hallouzi 2008, §4.1).
+
+    Parameters
+    ----------
+    loss : float
+        Lost fraction of the signal, in [0, 1] (1: the actuator does nothing).
+
+    The target, onset, end and location are those of :class:`Fault`.
+
+    Examples
+    --------
+    >>> LossOfEffectiveness("throttle", 0.3).loss
+    0.3
+    """
 
     loss: float = 0.0
     _values: ClassVar[tuple[str, ...]] = ("loss",)
@@ -240,7 +308,20 @@ class LossOfEffectiveness(Fault):
 
 @dataclass(frozen=True)
 class ScaleFactor(Fault):
-    """Gain error: ``factor * v`` (a sensor scale-factor fault; van der Ploeg's ``f_m``)."""
+    """Gain error: ``factor * v`` (a sensor scale-factor fault; van der Ploeg's ``f_m``).
+
+    Parameters
+    ----------
+    factor : float
+        Multiplier of the signal (1: no fault).
+
+    The target, onset, end and location are those of :class:`Fault`.
+
+    Examples
+    --------
+    >>> ScaleFactor("lateral_acceleration", 1.2).factor
+    1.2
+    """
 
     factor: float = 1.0
     _values: ClassVar[tuple[str, ...]] = ("factor",)
@@ -251,7 +332,20 @@ class ScaleFactor(Fault):
 
 @dataclass(frozen=True)
 class Noise(Fault):
-    """Extra zero-mean Gaussian noise of standard deviation ``std``."""
+    """Extra zero-mean Gaussian noise of standard deviation ``std``.
+
+    Parameters
+    ----------
+    std : float
+        Standard deviation of the added noise (>= 0), in the signal's units.
+
+    The target, onset, end and location are those of :class:`Fault`.
+
+    Examples
+    --------
+    >>> Noise("yaw_rate", 0.01).std
+    0.01
+    """
 
     std: float = 0.0
     _values: ClassVar[tuple[str, ...]] = ("std",)
@@ -269,7 +363,24 @@ class Noise(Fault):
 
 @dataclass(frozen=True)
 class Intermittent(Fault):
-    """Bias ``size`` switched on for ``duty * period`` seconds out of every ``period`` after onset."""
+    """Bias ``size`` switched on for ``duty * period`` seconds out of every ``period`` after onset.
+
+    Parameters
+    ----------
+    size : float
+        The step added while on.
+    period : float
+        Period [s] (> 0, default 1).
+    duty : float
+        On fraction of each period, in (0, 1] (default 0.5).
+
+    The target, onset, end and location are those of :class:`Fault`.
+
+    Examples
+    --------
+    >>> Intermittent("speed", 0.2, period=2.0, duty=0.25).active([0.0, 0.4, 0.6, 2.1]).tolist()
+    [True, True, False, True]
+    """
 
     size: float = 0.0
     period: float = 1.0
@@ -309,6 +420,11 @@ class FaultScenario:
     ------
     ParameterError
         When ``faults`` is not an iterable of :class:`Fault` or ``label`` is not a non-empty str.
+
+    Examples
+    --------
+    >>> FaultScenario([Bias("yaw_rate", 0.02, onset=10)]).label
+    'yaw_rate'
     """
 
     def __init__(self, faults: Iterable[Fault] = (), label: str | None = None) -> None:
@@ -433,6 +549,16 @@ def parse_fault(spec: str) -> Fault:
         For a spec that is not a str, does not follow the grammar, names an unknown kind or
         holds a number that cannot be read, is not finite or is out of the kind's range.
 
+    Parameters
+    ----------
+    spec : str
+        The fault spec.
+
+    Returns
+    -------
+    Fault
+        The fault of the spec's kind.
+
     Examples
     --------
     >>> parse_fault("intermittent:speed:0.2/2/0.25@4-10")
@@ -505,6 +631,16 @@ def format_fault(fault: Fault) -> str:
     ParameterError
         For an object that is not one of the fault kinds, or a target that the grammar cannot
         hold (anything but letters, digits, ``_`` and ``.``).
+
+    Parameters
+    ----------
+    fault : Fault
+        Any fault kind of this module.
+
+    Returns
+    -------
+    str
+        Its spec string.
 
     Examples
     --------

@@ -56,11 +56,36 @@ __all__ = ["GapRule", "Recovery", "gap_options"]
 def gap_options(g: ResidualGenerator, residual_cov, tol) -> tuple[np.ndarray, float]:
     """``(Σ, tol)`` of the gap rule after checking them; what :class:`GapRule` and a clean ``run`` both check.
 
+    Parameters
+    ----------
+    g : ResidualGenerator
+        The discrete generator the rule is for (its residual count sizes ``Σ``).
+    residual_cov : array or None
+        Covariance of the fault-free residuals (q x q, or a length-q row of variances); ``None`` means ``I``.
+    tol : float
+        ``recovery_tol``: a sample after a gap is recovering until each residual's transient standard deviation is
+        at most ``tol`` times its noise standard deviation; in ``(0, 1]``.
+
+    Returns
+    -------
+    S : (q, q) array
+        The residual covariance ``Σ``.
+    tol : float
+        The tolerance as a float.
+
     Raises
     ------
     ParameterError
         For a ``recovery_tol`` outside ``(0, 1]`` or a ``residual_cov`` that is not a finite symmetric
         ``q x q`` matrix with a positive diagonal.
+
+    Examples
+    --------
+    >>> from fdikit.residuals import ResidualGenerator
+    >>> g = ResidualGenerator([[0.5]], [[0.0, 1.0]], [[-1.0]], [[0.0, 1.0]], ["u"], ["y"], ["r"], dt=1.0)
+    >>> S, tol = gap_options(g, None, 0.1)
+    >>> S.tolist(), tol
+    ([[1.0]], 0.1)
     """
     if isinstance(tol, bool) or not isinstance(tol, (int, float, np.integer, np.floating)):
         raise ParameterError(f"recovery_tol must be a number in (0, 1], got {tol!r}")
@@ -90,6 +115,28 @@ class GapRule:
     The module docstring gives the rule and its derivation.  Built once per generator: it checks
     ``residual_cov`` and ``tol`` (:class:`~fdikit.errors.ParameterError`), splits the filter into
     its independent parts, and caches per pattern of valid channels the matrices of the rule.
+
+    Parameters
+    ----------
+    g : ResidualGenerator
+        The discrete generator.
+    residual_cov, tol :
+        As :func:`gap_options`.
+
+    Attributes
+    ----------
+    rho : float
+        Spectral radius of the filter's ``A``.
+    settle : int
+        Least number of recovering samples after a gap in which a part is fed held values,
+        ``ceil(log tol / log ρ(A))`` (``-1``: never, for ``ρ(A) >= 1``).
+
+    Examples
+    --------
+    >>> from fdikit.residuals import ResidualGenerator
+    >>> g = ResidualGenerator([[0.5]], [[0.0, 1.0]], [[-1.0]], [[0.0, 1.0]], ["u"], ["y"], ["r"], dt=1.0)
+    >>> GapRule(g, None, 0.1).settle
+    4
     """
 
     def __init__(self, g: ResidualGenerator, residual_cov, tol) -> None:
@@ -154,7 +201,23 @@ class GapRule:
 
 
 class Recovery:
-    """Which samples after a gap are still recovering (the bookkeeping of :class:`GapRule`)."""
+    """Which samples after a gap are still recovering (the bookkeeping of :class:`GapRule`).
+
+    Parameters
+    ----------
+    rule : GapRule
+        The rule of the generator whose samples are tracked.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.residuals import ResidualGenerator
+    >>> g = ResidualGenerator([[0.5]], [[0.0, 1.0]], [[-1.0]], [[0.0, 1.0]], ["u"], ["y"], ["r"], dt=1.0)
+    >>> rec = Recovery(GapRule(g, None, 0.1))
+    >>> rec.invalid_sample(np.array([True, False]))  # the output is missing
+    >>> rec.active
+    True
+    """
 
     def __init__(self, rule: GapRule) -> None:
         self.rule = rule

@@ -22,7 +22,39 @@ __all__ = ["dlsim_blocked", "lifted_matrices"]
 
 
 def lifted_matrices(A: np.ndarray, B: np.ndarray, M: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """``Φ`` (M n x n), ``T`` (M n x M m), ``A^M`` and ``Γ_M`` (n x M m) of the lifted recursion."""
+    """``Φ`` (M n x n), ``T`` (M n x M m), ``A^M`` and ``Γ_M`` (n x M m) of the lifted recursion.
+
+    Parameters
+    ----------
+    A : (n, n) array
+        State matrix of ``x[k+1] = A x[k] + B v[k]``.
+    B : (n, m) array
+        Input matrix.
+    M : int
+        Block length (>= 1).
+
+    Returns
+    -------
+    Phi : (M n, n) array
+        ``[I; A; …; A^{M-1}]``.
+    T : (M n, M m) array
+        Block lower-triangular Toeplitz matrix of the Markov parameters ``A^j B`` (zero diagonal blocks).
+    AM : (n, n) array
+        ``A^M``.
+    Gamma : (n, M m) array
+        ``[A^{M-1} B, …, A B, B]``, so that ``s[b+1] = A^M s[b] + Γ_M v_b``.
+
+    Raises
+    ------
+    ParameterError
+        For a non-square ``A``, a ``B`` with another number of rows, or ``M < 1``.
+
+    Examples
+    --------
+    >>> Phi, T, AM, Gamma = lifted_matrices([[0.5]], [[1.0]], 3)
+    >>> Phi.ravel().tolist(), AM.item(), Gamma.ravel().tolist()
+    ([1.0, 0.5, 0.25], 0.125, [0.25, 0.5, 1.0])
+    """
     M = validate.integer("M (the block length)", M, minimum=1)
     A = validate.as_square("A", A)
     B = validate.as_matrix("B", B, (A.shape[0], None))
@@ -51,9 +83,25 @@ def dlsim_blocked(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Response of a discrete state space to the input sequence ``v`` (N x m).
 
+    Parameters
+    ----------
+    A, B, C, D : arrays
+        ``x[k+1] = A x[k] + B v[k]``, ``y[k] = C x[k] + D v[k]`` (n x n, n x m, p x n, p x m).
+    v : (N, m) array
+        Input sequence, finite.
+    x0 : (n,) array, optional
+        Initial state (zero when omitted).
+    block : int, optional
+        Block length ``M`` of the lifted solve (>= 1; 32 balances the loop against the block products).
+
     Returns
     -------
-    y : (N, p) outputs, x : (N, n) states (``x[0] = x0``), x_end : (n,) the state after the last sample.
+    y : (N, p) array
+        Outputs.
+    x : (N, n) array
+        States, ``x[0] = x0``.
+    x_end : (n,) array
+        The state after the last sample.
 
     Raises
     ------
@@ -61,6 +109,13 @@ def dlsim_blocked(
         When ``v`` holds a NaN/inf (it would spread to the earlier samples of its 32-sample block).
     ParameterError
         For malformed matrices, a non-finite ``x0`` or a bad ``block``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> y, x, x_end = dlsim_blocked([[0.5]], [[1.0]], [[1.0]], [[0.0]], np.ones((4, 1)))
+    >>> y.ravel().tolist(), x_end.tolist()
+    ([0.0, 1.0, 1.5, 1.75], [1.875])
     """
     block = validate.integer("block", block, minimum=1)
     A = validate.as_square("A", A)

@@ -216,6 +216,13 @@ class Trace:
     DataError
         For anything above that does not hold; the message names the field, the sample or the
         name at fault.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> tr = Trace(t=np.arange(3) * 0.1, u=np.zeros((3, 1)), y=np.ones((3, 1)), controls=["steer"], outputs=["r"])
+    >>> tr.dt, tr.fault.tolist()
+    (0.1, ['none', 'none', 'none'])
     """
 
     t: np.ndarray

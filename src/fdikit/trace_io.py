@@ -161,7 +161,36 @@ def _info_bytes(trace: Trace) -> bytes:
 
 
 def write_trace(trace: Trace, path: str | Path) -> Path:
-    """Write ``trace`` to the Parquet file ``path`` atomically; the implementation of :meth:`Trace.save`."""
+    """Write ``trace`` to the Parquet file ``path`` atomically; the implementation of :meth:`Trace.save`.
+
+    Parameters
+    ----------
+    trace : Trace
+        The run to store (every field, its metadata and the per-sample fault labels).
+    path : str or Path
+        Destination ``.parquet`` file; written through :func:`fdikit.atomic.atomic_path`, with page checksums and
+        the content digest of the module docstring.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+
+    Raises
+    ------
+    DataError
+        When a fault label is not valid UTF-8 text, or the file cannot be written (the previous file is then
+        unchanged).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib, numpy as np
+    >>> from fdikit.trace import Trace
+    >>> tr = Trace(t=np.arange(4) * 0.5, u=np.zeros((4, 0)), y=np.arange(4.0)[:, None], controls=[], outputs=["y"])
+    >>> path = write_trace(tr, pathlib.Path(tempfile.mkdtemp()) / "run.parquet")
+    >>> read_trace(path).y[:, 0].tolist()
+    [0.0, 1.0, 2.0, 3.0]
+    """
     import pyarrow as pa
     import pyarrow.compute as pc
     import pyarrow.parquet as pq
@@ -198,7 +227,36 @@ def write_trace(trace: Trace, path: str | Path) -> Path:
 def read_trace(path: str | Path, *, verify: bool = True, cls: type[Trace] | None = None) -> Trace:
     """Read and verify the trace file ``path``; the implementation of :meth:`Trace.load`.
 
-    ``cls`` is the class to build (default :class:`~fdikit.trace.Trace`).
+    Parameters
+    ----------
+    path : str or Path
+        A ``.parquet`` file written by :func:`write_trace`.
+    verify : bool, optional
+        Check the page checksums and the content digest (default); ``False`` skips the digest (faster, for files
+        known to be intact).
+    cls : type, optional
+        The class to build (default :class:`~fdikit.trace.Trace`).
+
+    Returns
+    -------
+    Trace
+        The stored run, bit for bit.
+
+    Raises
+    ------
+    DataError
+        When the file is missing, not a regular file, empty, truncated, not a trace file, or its content does not
+        match its checksums or digest (the message says which).
+    ParameterError
+        When ``verify`` is not a bool.
+
+    Examples
+    --------
+    >>> try:
+    ...     read_trace("/nonexistent/run.parquet")
+    ... except DataError as exc:
+    ...     print(exc)
+    no trace file at /nonexistent/run.parquet
     """
     import pyarrow as pa
     import pyarrow.compute as pc
