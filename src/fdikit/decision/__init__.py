@@ -26,7 +26,7 @@ given ``names=`` (or a mapping ``{name: value}``).  Bad arguments raise
   (Wald 1947).
 * :mod:`fdikit.decision.mhsprt` — Multiple-hypothesis Shiryayev SPRT (Malladi & Speyer; Douglas et al. 1996, Ch. 7).
 * :mod:`fdikit.decision.shiryayev` — Thresholds of the Shiryayev SPRT: the false-alarm bound and the dynamic-
-  programming threshold (§7.1).
+  programming threshold (Douglas et al. 1996, §7.2.2–7.2.3).
 * :mod:`fdikit.decision.densities` — Hypothesis densities for the multiple-hypothesis Shiryayev SPRT (Douglas et al.
   1996, §7.2).
 * :mod:`fdikit.decision.whiten` — Prewhitening of coloured residuals before a test that assumes white ones (CUSUM,

@@ -1,4 +1,5 @@
-"""Thresholds of the Shiryayev SPRT: the false-alarm bound and the dynamic-programming threshold (§7.1)."""
+"""Thresholds of the Shiryayev SPRT: the false-alarm bound and the dynamic-programming threshold (Douglas et al.
+1996, §7.2.2–7.2.3)."""
 
 from __future__ import annotations
 
@@ -27,6 +28,39 @@ def shiryayev_threshold(
     * from costs ``Q`` (false alarm), ``S`` (miss-alarm, i.e. delay, per sample) and ``C`` (per measurement): the
       report's bound on the infinite-horizon threshold, ``F_T ≤ (Q − C)/(Q + S)`` (from (7.21) with ``A ≥ 0``).
       The exact value needs the expected cost-to-go ``A(F_T)``; :func:`shiryayev_dp` computes it for ``m = 1``.
+
+    Parameters
+    ----------
+    false_alarm_prob : float, optional
+        ``α`` in (0, 1); give this or the costs.
+    false_alarm_cost : float, optional
+        ``Q``, the cost of a false alarm; must exceed ``measurement_cost``.
+    delay_cost : float, optional
+        ``S >= 0``, the cost per sample of a missed (delayed) announcement; needed with ``false_alarm_cost``.
+    measurement_cost : float, default 0.0
+        ``C >= 0``, the cost per measurement.
+
+    Returns
+    -------
+    float
+        ``F_T = 1 − α``, or the bound ``(Q − C)/(Q + S)``.
+
+    Raises
+    ------
+    ParameterError
+        When neither or both of ``false_alarm_prob`` and ``false_alarm_cost`` are given, ``α`` is not in (0, 1),
+        or the costs violate ``S >= 0``, ``C >= 0``, ``Q > C`` (a missing ``delay_cost`` included).
+
+    References
+    ----------
+    Douglas et al. 1996, §7.2.3, (7.20)–(7.21) (the threshold bound and ``α_i = 1 − F_{T,i}``) and §7.2.2,
+    (7.10b) (``Q > C``).
+
+    Examples
+    --------
+    >>> from fdikit.decision.shiryayev import shiryayev_threshold
+    >>> shiryayev_threshold(0.05), round(shiryayev_threshold(false_alarm_cost=10.0, delay_cost=1.0), 6)
+    (0.95, 0.909091)
     """
     if (false_alarm_prob is None) == (false_alarm_cost is None):
         raise ParameterError("give either false_alarm_prob, or false_alarm_cost and delay_cost")
@@ -49,6 +83,36 @@ class ShiryayevDP:
     ``threshold``: infinite-horizon ``F_T`` (7.21); ``bound``: ``(Q − C)/(Q + S)``; ``horizon_thresholds[n−1]``:
     the threshold with ``n`` stages to go (non-decreasing in ``n``, → ``threshold``); ``grid``/``cost``: ``J*(F)``;
     ``converged``: value iteration met ``tol``.
+
+    Attributes
+    ----------
+    threshold : float
+        Infinite-horizon threshold ``F_T`` (7.21): announce while the posterior is at or above it.
+    bound : float
+        The report's bound ``(Q − C)/(Q + S)`` (:func:`shiryayev_threshold`).
+    horizon_thresholds : (iterations,) ndarray
+        ``horizon_thresholds[n − 1]`` is the threshold with ``n`` stages to go.
+    grid : (grid_size,) ndarray
+        Posterior values ``F`` in [0, 1] (logit-spaced) on which ``J*`` is tabulated.
+    cost : (grid_size,) ndarray
+        ``J*(F)``, the Bayes risk of the optimal policy on ``grid``.
+    iterations : int
+        Value-iteration sweeps run.
+    converged : bool
+        Whether the last sweep changed ``J`` by at most ``tol · Q``.
+
+    References
+    ----------
+    Douglas et al. 1996, §7.2.2, (7.8)–(7.10) (the dynamic program) and §7.2.3, (7.20)–(7.21) (its thresholds).
+
+    Examples
+    --------
+    >>> from fdikit.decision.densities import GaussianDensity
+    >>> from fdikit.decision.shiryayev import shiryayev_dp
+    >>> res = shiryayev_dp(GaussianDensity(0.0, 1.0), GaussianDensity(1.0, 1.0), 0.01, 10.0, 1.0,
+    ...                    grid_size=201, nodes=201)
+    >>> res.converged, round(res.threshold, 2), round(res.expected_cost(0.0), 2)
+    (True, 0.49, 6.99)
     """
 
     threshold: float
@@ -86,6 +150,56 @@ def shiryayev_dp(
     density ``M f_1 + (1 − M) f_0``.  ``F`` lives on a logit-spaced grid (``J`` is concave, interpolated linearly),
     the expectation is a trapezoid rule on ``nodes`` points.  The report calls this intractable and stops at the
     bound; for ``m > 1`` the state is ``m``-dimensional and no grid is offered.
+
+    Parameters
+    ----------
+    f0, f1 : density
+        Scalar densities (``dim`` 1, row-wise ``logpdf``) of the measurement without and with the fault, e.g.
+        :class:`~fdikit.decision.densities.GaussianDensity`.
+    p : float
+        Per-sample prior probability of the switch ``H_0 → H_1``, in [0, 1).
+    false_alarm_cost : float
+        ``Q``.
+    delay_cost : float
+        ``S``, per sample of delay.
+    measurement_cost : float, default 0.0
+        ``C``, per measurement.
+    grid_size : int, default 401
+        Points of the posterior grid (0, 1 and ``grid_size − 2`` logit-spaced points in between).
+    nodes : int, default 401
+        Trapezoid nodes of the expectation over the next measurement.
+    x_range : (float, float), optional
+        Integration range of the measurement; default ±12 σ around the supports of ``f0`` and ``f1`` (required
+        for densities other than ``GaussianDensity`` / ``UniformMeanDensity``).
+    tol : float, default 1e-10
+        Stop when a sweep changes ``J`` by at most ``tol · Q``.
+    max_iter : int, default 100000
+        Most value-iteration sweeps.
+
+    Returns
+    -------
+    ShiryayevDP
+        The infinite-horizon threshold, the bound, the thresholds per horizon, ``J*`` on the grid and the
+        convergence record.
+
+    Raises
+    ------
+    ParameterError
+        When ``p`` is not in [0, 1), the costs are invalid (:func:`shiryayev_threshold`), a density is not
+        scalar, or ``x_range`` is needed and not given.
+
+    References
+    ----------
+    Douglas et al. 1996, §7.2.2, (7.8)–(7.10), Lemma 7.3, and §7.2.3, (7.20)–(7.21).
+
+    Examples
+    --------
+    >>> from fdikit.decision.densities import GaussianDensity
+    >>> from fdikit.decision.shiryayev import shiryayev_dp
+    >>> res = shiryayev_dp(GaussianDensity(0.0, 1.0), GaussianDensity(1.0, 1.0), 0.01, 10.0, 1.0,
+    ...                    grid_size=201, nodes=201)
+    >>> round(res.threshold, 2), round(res.bound, 6)
+    (0.49, 0.909091)
     """
     if not 0 <= p < 1:
         raise ParameterError(f"p must be in [0, 1), got {p}")
