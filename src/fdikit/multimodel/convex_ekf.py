@@ -33,13 +33,35 @@ __all__ = ["augmented_jacobians", "augmented_ekf"]
 def augmented_jacobians(models: ConvexModelSet, x, mu, u) -> tuple[np.ndarray, np.ndarray]:
     """Jacobians ``(Ā, C̄)`` of the augmented CM model at ``(x, μ, u)`` (Hallouzi 2008, (2.52)–(2.53)).
 
-    Example
+    Parameters
+    ----------
+    models : ConvexModelSet
+        The local models.
+    x : array_like
+        State (n) at which to linearise.
+    mu : array_like
+        Weights (N).
+    u : array_like
+        Input (m).
+
+    Returns
     -------
+    Abar : ndarray
+        ``∂[x⁺; μ⁺]/∂[x; μ]`` ((n + N) x (n + N)), (2.44).
+    Cbar : ndarray
+        ``∂y/∂[x; μ]`` (p x (n + N)), (2.45).
+
+    Examples
+    --------
     >>> from fdikit.multimodel.convex import convex_model_set
     >>> ms = convex_model_set([[[0.5]], [[1.0]]], np.zeros((1, 1)), np.eye(1), Q=np.eye(1), R=np.eye(1))
     >>> Abar, Cbar = augmented_jacobians(ms, [2.0], [0.5, 0.5], [0.0])
     >>> Abar.tolist(), Cbar.tolist()
     ([[0.75, 1.0, 2.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], [[1.0, 0.0, 0.0]])
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.3, (2.40)–(2.45), Table 2.3, (2.52)–(2.53).
     """
     x = np.ravel(x).astype(float)
     mu = models.check_weights(mu)
@@ -66,17 +88,59 @@ def augmented_ekf(models: ConvexModelSet, y, u, x0, P0, mu0=None, Q_mu=None, P_m
 
     Parameters
     ----------
-    Q_mu : (N, N) random-walk covariance Q^μ, the main tuning knob (thesis §2.4.2: 1e-2 I).
-    mu0 : initial weights (default uniform).  P_mu0 : their covariance (default ``I/12``, the variance of a
-    uniform weight on [0, 1]; the thesis gives none).
-    constrain : weight constraint after each update, see :func:`~fdikit.multimodel.simplex.constrain_weights`
-        (``True``: the simplex; ``"box"`` for limit-value sets, §3.6; ``"affine"``; ``False``).
-    projection : ``"euclidean"`` (default; §2.3.2 with W = I, the covariance left unchanged, as the thesis
+    models : ConvexModelSet
+        The local models.
+    y, u : array_like
+        Measurements (K, p) and inputs (K, m) (``u`` may be None when m = 0); finite.
+    x0, P0 : array_like
+        Prior ``x̂_{0|−1}`` (n) and ``P_{0|−1}`` (n x n).
+    mu0 : array_like, optional
+        Initial weights (N); default uniform.
+    Q_mu : array_like
+        (N, N) random-walk covariance Q^μ, the main tuning knob (thesis §2.4.2: 1e-2 I); required.
+    P_mu0 : array_like, optional
+        Covariance of ``mu0`` (default ``I/12``, the variance of a uniform weight on [0, 1]; the thesis gives none).
+    constrain : bool or str
+        Weight constraint after each update, see :func:`~fdikit.multimodel.simplex.constrain_weights`
+        (``True``: the simplex, default; ``"box"`` for limit-value sets, §3.6; ``"affine"``; ``False``).
+    ordering : {"michelot", "thesis"}
+        Ordering of the Euclidean simplex projection (:func:`~fdikit.multimodel.simplex.project_to_simplex`).
+    projection : {"euclidean", "covariance"}
+        ``"euclidean"`` (default; §2.3.2 with W = I, the covariance left unchanged, as the thesis
         implies) or ``"covariance"``: Simon & Chia's (2002) projection with ``W = P⁻¹`` on the whole augmented
         state, i.e. ``1ᵀμ = 1`` applied as a noise-free measurement: ``z ← z − P Dᵀ(D P Dᵀ)⁻¹(D z − 1)``,
         ``P ← P − P Dᵀ(D P Dᵀ)⁻¹ D P`` with ``D = [0, 1ᵀ]``, so the states move with the weights they are
         correlated with and the filter keeps no variance along ``1ᵀμ``.  Negative weights are then zeroed by
         the same projection (active set, §2.3.2), leaving ``P`` unchanged for them.
+
+    Returns
+    -------
+    ConvexFilterResult
+        Filtered states, their covariances (the x block of P) and the weights per sample.
+
+    Raises
+    ------
+    ParameterError
+        If ``Q_mu`` is missing, a covariance has the wrong size, or ``projection``, ``ordering`` or
+        ``constrain`` is unknown.
+
+    Examples
+    --------
+    >>> from fdikit.multimodel.convex import convex_model_set
+    >>> ms = convex_model_set([[0.9]], [[[0.0]], [[1.0]]], [[1.0]], Q=[[1e-4]], R=[[1e-2]],
+    ...                       names=["stuck", "nominal"])
+    >>> u = np.sin(0.3 * np.arange(20)).reshape(-1, 1)
+    >>> x, y = 0.0, []
+    >>> for uk in u[:, 0]:                      # the "nominal" model, noise-free
+    ...     y.append([x])
+    ...     x = 0.9 * x + uk
+    >>> res = augmented_ekf(ms, np.array(y), u, x0=[0.0], P0=[[1.0]], Q_mu=1e-2 * np.eye(2))
+    >>> bool(res.mu[-1, 1] > 0.99), res.x.shape
+    (True, (20, 1))
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.3, (2.39)–(2.45), Table 2.3, (2.46)–(2.53); §2.3.2, (2.37)–(2.38) for the projection.
     """
     validate.instance("models", models, ConvexModelSet, "build the set with convex_model_set(...)")
     if projection not in ("euclidean", "covariance"):
