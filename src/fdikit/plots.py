@@ -49,21 +49,42 @@ def plot_residuals(
     names: Sequence[str] | None = None,
     title: str | None = None,
     path: str | Path | None = None,
+    ax=None,
 ):
     """One panel per residual with its threshold band, alarm samples and the fault onset.
 
-    Returns the matplotlib figure; writes it to ``path`` (PNG, PDF ...; atomically, see
-    :func:`save_figure`) when given.
+    Parameters
+    ----------
+    residuals, diagnosis, thresholds, center, onset, names, title
+        The series, its decisions (alarm samples marked), the band ``center ± thresholds``, the fault
+        onset time, the residuals to draw (default all) and a title.
+    path : str or Path, optional
+        Write the figure there (PNG, PDF ...; atomically, see :func:`save_figure`).
+    ax : matplotlib Axes or sequence of Axes, optional
+        Draw into these instead of a new figure: one Axes per residual, or a single Axes for all.
+
+    Returns
+    -------
+    matplotlib.figure.Figure or the given ``ax``
+        A new figure when ``ax`` is None, else ``ax``.  The backend is never changed.
     """
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
-
     names = list(names or residuals.names)
     idx = [residuals.names.index(n) for n in names]
-    fig, axes = plt.subplots(len(idx), 1, sharex=True, figsize=(9, 1.6 * len(idx) + 0.8), squeeze=False)
-    for ax, j in zip(axes[:, 0], idx):
+    given = ax
+    if ax is None:
+        import matplotlib.pyplot as plt
+
+        fig, grid = plt.subplots(len(idx), 1, sharex=True, figsize=(9, 1.6 * len(idx) + 0.8), squeeze=False)
+        panels = list(grid[:, 0])
+    else:
+        panels = list(np.ravel(np.asarray(ax, dtype=object)))
+        panels = panels * len(idx) if len(panels) == 1 else panels
+        if len(panels) != len(idx):
+            from fdikit.errors import ParameterError
+
+            raise ParameterError(f"ax has {len(panels)} axes for {len(idx)} residuals; give one, or one per residual")
+        fig = panels[0].figure
+    for ax, j in zip(panels, idx):
         ax.plot(residuals.t, residuals.r[:, j], lw=0.7, color="tab:blue")
         c = 0.0 if center is None else float(np.broadcast_to(center, (len(residuals.names),))[j])
         if thresholds is not None:
@@ -77,9 +98,13 @@ def plot_residuals(
             ax.axvline(onset, color="k", lw=0.8, ls=":")
         ax.set_ylabel(residuals.names[j], rotation=0, ha="right", fontsize=8)
         ax.tick_params(labelsize=7)
-    axes[-1, 0].set_xlabel("time [s]")
+    panels[-1].set_xlabel("time [s]")
     if title:
         fig.suptitle(title, fontsize=10)
+    if given is not None:
+        if path is not None:
+            save_figure(fig, path)
+        return given
     fig.tight_layout()
     if path is not None:
         save_figure(fig, path)

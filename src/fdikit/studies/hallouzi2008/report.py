@@ -32,10 +32,7 @@ def _table(header: list[str], rows: list[list[str]]) -> str:
 
 
 def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # the backend is the caller's (Agg when there is no display)
 
     return plt
 

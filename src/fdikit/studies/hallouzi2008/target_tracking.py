@@ -274,12 +274,9 @@ def plot_target_tracking(result: TargetTrackingResult, path) -> None:
 
     ``path`` is written atomically (:func:`fdikit.plots.save_figure`); a binary file object also works.
     """
-    import matplotlib
+    import matplotlib.pyplot as plt
 
     from fdikit.plots import save_figure
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(4, 1, figsize=(8, 10), sharex=True)
     panels = (("position RMSE [m]", result.rmse_position), ("velocity RMSE [m/s]", result.rmse_velocity),

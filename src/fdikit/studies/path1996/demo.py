@@ -212,9 +212,6 @@ def run_demo(
 
 def _bank_report(panels, evaluator, onset, path: Path) -> Path:
     """One column per scenario: the residuals of the filter that holds the fault, with thresholds."""
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
 
     rows = max(len(p[3]) for p in panels)
