@@ -62,6 +62,28 @@ __all__ = ["SprtEvaluator", "sprt_asn", "sprt_thresholds"]
 def sprt_thresholds(alpha: float, beta: float) -> tuple[float, float]:
     """Wald's thresholds ``(A, B) = (log((1−β)/α), log(β/(1−α)))``.
 
+    Parameters
+    ----------
+    alpha : float
+        Target false-alarm probability ``α`` of one test.
+    beta : float
+        Target missed-detection probability ``β``; ``0 < α, β < 1`` and ``α + β < 1``.
+
+    Returns
+    -------
+    (A, B) : tuple of float
+        The upper (accept H1: alarm) and lower (accept H0) thresholds on the log-likelihood ratio ``Λ``.
+
+    Raises
+    ------
+    ParameterError
+        When ``α`` or ``β`` is not in (0, 1), or ``α + β >= 1``.
+
+    References
+    ----------
+    Wald 1947 (the SPRT, its thresholds and expected sample numbers); Basseville & Nikiforov 1993, §2.2 and §4.3;
+    Douglas et al. 1996, Ch. 7 introduction (the Wald SPRT compared with the Shiryayev SPRT).
+
     Examples
     --------
     >>> [round(x, 4) for x in sprt_thresholds(0.01, 0.01)]
@@ -78,6 +100,36 @@ def sprt_asn(alpha: float, beta: float, divergence: float, hypothesis: int = 1) 
     ``divergence`` is ``D = ½ δᵀ Σ⁻¹ δ``; ``hypothesis`` 1 gives ``E[N | H1]``, 0 gives
     ``E[N | H0]``.  The overshoot of the thresholds is neglected, so the true values are
     somewhat larger (by about ``0.583·√(2D)/D`` samples for Gaussian data).
+
+    Parameters
+    ----------
+    alpha, beta : float
+        Target false-alarm and missed-detection probabilities (:func:`sprt_thresholds`).
+    divergence : float
+        ``D = ½ δᵀ Σ⁻¹ δ > 0``, the Kullback–Leibler divergence per sample.
+    hypothesis : {1, 0}, default 1
+        The hypothesis in force: 1 gives ``E[N | H1]``, 0 gives ``E[N | H0]``.
+
+    Returns
+    -------
+    float
+        The expected number of samples to a decision.
+
+    Raises
+    ------
+    ParameterError
+        When ``divergence`` is not positive, ``hypothesis`` is not 0 or 1, or ``α``, ``β`` are invalid.
+
+    References
+    ----------
+    Wald 1947 (the SPRT, its thresholds and expected sample numbers); Basseville & Nikiforov 1993, §2.2 and §4.3;
+    Douglas et al. 1996, Ch. 7 introduction (the Wald SPRT compared with the Shiryayev SPRT).
+
+    Examples
+    --------
+    >>> from fdikit.decision.sprt import sprt_asn
+    >>> round(sprt_asn(0.01, 0.01, 0.5), 3), round(sprt_asn(0.01, 0.01, 0.5, hypothesis=0), 3)
+    (9.006, 9.006)
     """
     if not divergence > 0:
         raise ParameterError(f"the divergence must be positive, got {divergence}")
@@ -169,6 +221,11 @@ class SprtEvaluator:
     >>> d = SprtEvaluator(shift=1.0, alpha=1e-3, beta=1e-3).run(Residuals(np.arange(300.0), r, ("r",), ("f",)))
     >>> d.first_alarm().index, d.first_alarm().fault
     (207, 'f')
+
+    References
+    ----------
+    Wald 1947 (the SPRT, its thresholds and expected sample numbers); Basseville & Nikiforov 1993, §2.2 and §4.3;
+    Douglas et al. 1996, Ch. 7 introduction (the Wald SPRT compared with the Shiryayev SPRT).
     """
 
     def __init__(
