@@ -41,20 +41,39 @@ class GroupThresholdLogic:
 
     Attributes
     ----------
-    groups : mapping fault name → indices (0-based) of the models that represent that fault.
-    nominal : 0-based index of the nominal model.
-    threshold : the fault threshold ``T_f`` (Table 4.7: 0.2).
-    latch : keep the first isolated fault for the rest of a run.
-    tol : comparisons are made as ``≥ T_f − tol`` / ``< T_f − tol`` so that decimal boundary cases
+    groups : mapping of str to sequence of int
+        Fault name → indices (0-based) of the models that represent that fault.
+    nominal : int
+        0-based index of the nominal model.
+    threshold : float
+        The fault threshold ``T_f`` in (0, 1) (Table 4.7: 0.2).
+    latch : bool
+        Keep the first isolated fault for the rest of a run (default False).
+    tol : float
+        Comparisons are made as ``≥ T_f − tol`` / ``< T_f − tol`` so that decimal boundary cases
         come out as written: in doubles ``1 − 0.8 = 0.19999999999999996 < 0.2``, yet in exact arithmetic
         ``|1 − 0.8| = 0.2`` is not ``< T_f``, so Table 4.7 makes μ^(8) = 0.8 *not* nominal.
 
-    Example
-    -------
+    Raises
+    ------
+    ParameterError
+        If ``groups`` is not a non-empty mapping of non-empty index lists, uses a reserved name
+        (``'none'``, ``'unknown'``), has a negative index or contains the nominal model, or the threshold
+        is not in (0, 1).
+
+    Examples
+    --------
     >>> logic = table_4_7_logic()
     >>> mu = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]
     >>> logic.isolate([mu]).tolist(), logic.isolate([[0.3, 0, 0, 0, 0, 0, 0, 0.7]]).tolist()
     (['none'], ['rudder'])
+    >>> logic = GroupThresholdLogic(groups={"a": [1], "b": [2]}, nominal=0)
+    >>> logic.names, logic.signatures([[0.2, 0.7, 0.1]]).tolist()
+    (('none', 'a', 'b'), [[False, True, False]])
+
+    References
+    ----------
+    Hallouzi 2008, §4.4.2, Table 4.7 (with the groups of model set II, §4.3.4, Table 4.5).
     """
 
     groups: Mapping[str, Sequence[int]]
@@ -144,6 +163,28 @@ def table_4_7_logic(threshold: float = 0.2, latch: bool = False) -> GroupThresho
 
     Models (1-based in the thesis): 1, 2 rudder at ±25 deg; 3, 5, 6 elevator at −23, 17, −6 deg;
     4, 7 aileron at 15, −15 deg; 8 nominal.  Here indices are 0-based.
+
+    Parameters
+    ----------
+    threshold : float, optional
+        ``T_f`` (default 0.2, as in Table 4.7).
+    latch : bool, optional
+        Keep the first isolated fault for the rest of a run (default False).
+
+    Returns
+    -------
+    GroupThresholdLogic
+        Groups rudder (0, 1), elevator (2, 4, 5), aileron (3, 6); nominal model 7.
+
+    Examples
+    --------
+    >>> logic = table_4_7_logic()
+    >>> logic.nominal, logic.n_models, list(logic.groups)
+    (7, 8, ['rudder', 'elevator', 'aileron'])
+
+    References
+    ----------
+    Hallouzi 2008, §4.4.2, Table 4.7; §4.3.4, Table 4.5 (model set II).
     """
     return GroupThresholdLogic(
         groups={"rudder": (0, 1), "elevator": (2, 4, 5), "aileron": (3, 6)}, nominal=7, threshold=threshold, latch=latch
@@ -161,7 +202,33 @@ def _hold(out: np.ndarray, valid) -> np.ndarray:
 
 
 def most_probable_mode(mu, hypotheses: Sequence[str], nominal: int = 0, valid=None) -> np.ndarray:
-    """Isolated fault per sample as the most probable mode (``'none'`` when it is the nominal mode)."""
+    """Isolated fault per sample as the most probable mode (``'none'`` when it is the nominal mode).
+
+    Parameters
+    ----------
+    mu : array_like
+        Mode probabilities or model weights (N, M) (or one sample (M,)).
+    hypotheses : sequence of str
+        The M mode names.
+    nominal : int, optional
+        Index of the nominal mode (default 0).
+    valid : array_like of bool, optional
+        (N,); where False the previous decision is held (``'none'`` at the first sample).
+
+    Returns
+    -------
+    ndarray of str
+        (N,) isolated fault names, ``'none'`` for the nominal mode.
+
+    Examples
+    --------
+    >>> most_probable_mode([[0.9, 0.1, 0.0], [0.2, 0.7, 0.1]], ["nominal", "a", "b"]).tolist()
+    ['none', 'a']
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.1, (2.7) (the mode probabilities μ_k of the IMM filter).
+    """
     mu = np.atleast_2d(np.asarray(mu, dtype=float))
     best = np.argmax(mu, axis=1)
     names = np.array(hypotheses, dtype=object)[best]
@@ -182,6 +249,41 @@ def mode_diagnosis(
     Without ``logic`` the most probable mode is isolated; ``fired`` marks it, and the alarm is on
     when it is not the nominal mode.  With ``logic`` (e.g. :func:`table_4_7_logic`) ``fired`` holds
     the Table 4.7 signatures and the alarm is "not nominal" (held on invalid samples).
+
+    Parameters
+    ----------
+    t : array_like
+        Sample times (N,).
+    mu : array_like
+        Mode probabilities or model weights (N, M).
+    hypotheses : sequence of str
+        The M mode names.
+    nominal : int, optional
+        Index of the nominal mode (default 0); used without ``logic``.
+    logic : GroupThresholdLogic, optional
+        Group-sum threshold logic; None isolates the most probable mode.
+    valid : array_like of bool, optional
+        (N,); where False the previous decision is held.
+
+    Returns
+    -------
+    Diagnosis
+        With ``alarm``, ``fired``, ``names``, ``isolated`` and the probabilities.
+
+    Raises
+    ------
+    DataError
+        If the number of columns of ``mu`` differs from the number of hypotheses.
+
+    Examples
+    --------
+    >>> d = mode_diagnosis([0.0, 1.0], [[0.9, 0.1, 0.0], [0.2, 0.7, 0.1]], ["nominal", "a", "b"])
+    >>> d.isolated.tolist(), d.alarm.tolist()
+    (['none', 'a'], [False, True])
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.1, (2.7); §4.4.2, Table 4.7.
     """
     mu = np.atleast_2d(np.asarray(mu, dtype=float))
     hypotheses = tuple(str(h) for h in hypotheses)
