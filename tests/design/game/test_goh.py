@@ -57,7 +57,7 @@ def _random_system(seed: int):
 
 @pytest.mark.parametrize("seed", range(6))
 def test_algorithm_4_1_agrees_with_the_caisa_recursion(seed):
-    """Murray 2012 Remark 4.1 / checklist item 2: Im B̄ = W* of W_{k+1} = Im F + A(W_k ∩ Ker C); C W* = Im C B̃."""
+    """Murray 2012 Remark 4.1: Im B̄ = W* of W_{k+1} = Im F + A(W_k ∩ Ker C); C W* = Im C B̃."""
     A, C, F = _random_system(seed)
     g = goh_transformation(A, C, F)
     W = linalg.caisa(A, C, F)
@@ -149,7 +149,7 @@ def test_goh_riccati_with_a_goh_iteration_has_a_C_A_invariant_kernel():
 
 
 def test_oblique_projector_properties():
-    """Murray checklist item 3: H̄ C B̃ = 0, H̄² = H̄, V⁻¹H̄ = H̄ᵀV⁻¹H̄ (4.31)."""
+    """Murray 2012, (4.31): H̄ C B̃ = 0, H̄² = H̄, V⁻¹H̄ = H̄ᵀV⁻¹H̄ (4.31)."""
     rng = np.random.default_rng(1)
     C, B = rng.standard_normal((4, 6)), rng.standard_normal((6, 2))
     V = np.diag([0.5, 1.0, 2.0, 3.0])
@@ -220,7 +220,7 @@ def test_goh_riccati_rejects_bad_weights():
 # ----------------------------------------------------------------------------------- reduced-order detector
 @pytest.fixture(scope="module")
 def path_design():
-    return goh_detector(path_longitudinal_7(), "air_mass", path_longitudinal_7_fault_maps(), **PATH_W)
+    return goh_detector(path_longitudinal_7(), TARGET, path_longitudinal_7_fault_maps(), **PATH_W)
 
 
 def test_reduced_detector_is_third_order_stable_and_matches_PATH_9_63(path_design):
@@ -266,7 +266,7 @@ def test_reduced_detector_is_exactly_blind_to_the_nuisance_directions(path_desig
     """The error (9.68) has no μ̂ term: nuisance → residual transfer ≤ 1e-10 of the target's, at all frequencies."""
     m = path_longitudinal_7()
     maps = path_longitudinal_7_fault_maps()
-    target = resolve_faults(m, ["air_mass"])[TARGET]
+    target = resolve_faults(m, [TARGET])[TARGET]
     plant = m.add_faults(["am_rate", "am_bias", *[f"{k}{j}" for k in maps for j in (0, 1)]],
                          np.hstack([target, *maps.values()]))
     R = path_design.generator.internal_form(plant)
@@ -280,7 +280,7 @@ def test_reduced_detector_is_exactly_blind_to_the_nuisance_directions(path_desig
 def test_reduced_detector_with_exact_sensor_maps_ignores_nuisance_sensors():
     """Sensor faults on y_ω, y_ẍ (D_f = e_i) vanish from the residual; gain columns 2, 3 are 0 (cf. (9.95))."""
     m = path_longitudinal_7()
-    d = goh_detector(m, "air_mass", ["engine_speed", "accel_x"], **PATH_W)
+    d = goh_detector(m, TARGET, ["engine_speed_sensor", "accel_x_sensor"], **PATH_W)
     assert np.abs(d.gain[:, 1:3]).max() <= 1e-10 * np.abs(d.gain).max()  # measured 2.3e-12 relative
     R = d.generator.internal_form(m.with_sensor_faults(["air_mass", "engine_speed", "accel_x"]))
     G = _dc(R)
@@ -326,7 +326,7 @@ def test_reduced_detector_poles_are_the_slow_poles_of_the_small_gamma_game_filte
     d = path_design
     expect = np.array([-2.9589, -2.6696 - 6.7462j, -2.6696 + 6.7462j])
     np.testing.assert_allclose(np.sort_complex(d.poles), expect, atol=1e-4)
-    g = single_fault_game_filter(path_longitudinal_7(), "air_mass", path_longitudinal_7_fault_maps(),
+    g = single_fault_game_filter(path_longitudinal_7(), TARGET, path_longitudinal_7_fault_maps(),
                                  gamma=1.25e-8, V=0.8, Q=1.0, M=1.0, R=1.0)
     slow = np.sort_complex(g.poles[np.abs(g.poles) < 100])
     assert slow.size == 3
@@ -346,7 +346,7 @@ def test_reduced_detector_poles_are_the_slow_poles_of_the_small_gamma_game_filte
     ],
 )
 def test_white_speyer_reduced_detector_matches_murray_remarks_6_3_to_6_8(case, Q, printed):
-    """Murray 2012 §6.2, single-fault GTFDF at γ = 1e−6, V = I (note §8.2.6 for the Q of each remark).
+    """Murray 2012 §6.2, single-fault GTFDF at γ = 1e−6, V = I (the Q of each remark as stated there).
 
     The limit γ → 0 sends the fast pole to −∞ and keeps the others; measured differences to the printed
     γ = 1e−6 values ≤ 1.3e−3 relative (−4.1932 vs −4.1878), so the tolerance is 2e−3.  The unstable zero
@@ -365,7 +365,7 @@ def test_white_speyer_reduced_detector_matches_murray_remarks_6_3_to_6_8(case, Q
 def test_multi_target_filter_on_the_f16xl_isolates_each_fault_exactly():
     """Murray (4.68), Prop. 4.6, (4.85): three targets fill R⁴ (no complementary subspace)."""
     m = f16xl_longitudinal()
-    faults = resolve_faults(m, ["y_theta", "elevon"]) | {"gust": m.Bd}
+    faults = resolve_faults(m, ["y_theta_sensor", "elevon_actuator"]) | {"gust": m.Bd}
     d = goh_filter(m, faults, V=1.0, Q=0.5)
     assert d.order == 4 and np.all(d.poles.real < 0)
     assert d.separation < 1e-10  # (4.85) holds
@@ -407,17 +407,17 @@ def test_multi_target_white_speyer_needs_no_complementary_subspace():
 def test_goh_filter_rejects_bad_input():
     m = path_longitudinal_7()
     with pytest.raises(DesignError, match="discrete"):
-        goh_detector(m.discretize(0.01), "air_mass", ["engine_speed"])
-    with pytest.raises(ParameterError, match="not targets"):
+        goh_detector(m.discretize(0.01), TARGET, ["engine_speed_sensor"])
+    with pytest.raises(ParameterError, match="weight Q is given for 'f9', which is not a target"):
         goh_filter(white_speyer(), ["f1", "f2"], Q={"f1": 1e-3, "f9": 1e-3})
-    with pytest.raises(ParameterError, match="missing"):
+    with pytest.raises(ParameterError, match=r"weight Q has no entry for target\(s\) \['f2'\]"):
         goh_filter(white_speyer(), ["f1", "f2"], Q={"f1": 1e-3})
 
 
 # ----------------------------------------------------------------------------------- full-order game filter, R-GAME-1/2
 @pytest.fixture(scope="module")
 def path_game():
-    return single_fault_game_filter(path_longitudinal_7(), "air_mass", ["engine_speed", "accel_x"],
+    return single_fault_game_filter(path_longitudinal_7(), TARGET, ["engine_speed_sensor", "accel_x_sensor"],
                                     gamma=1.25e-8, V=0.8, Q=1.0, M=1.0, R=1.0)
 
 
@@ -444,7 +444,7 @@ def test_r_game_1_full_order_poles_gains_and_separation(path_game):
 def test_r_game_2_gain_falls_as_gamma_grows():
     """Gain ∝ γ^(−1/2) for small γ: measured max|L| 2.08e6, 2.08e5, 2.08e4 at γ = 1.25e−8, 1.25e−6, 1.25e−4."""
     m, maps = path_longitudinal_7(), path_longitudinal_7_fault_maps()
-    gains = [np.abs(single_fault_game_filter(m, "air_mass", maps, gamma=g, V=0.8, Q=1.0, M=1.0, R=1.0).gain).max()
+    gains = [np.abs(single_fault_game_filter(m, TARGET, maps, gamma=g, V=0.8, Q=1.0, M=1.0, R=1.0).gain).max()
              for g in (1.25e-8, 1.25e-6, 1.25e-4)]
     assert gains[0] > gains[1] > gains[2]
     np.testing.assert_allclose(np.array(gains[:2]) / np.array(gains[1:]), 10.0, rtol=0.02)

@@ -55,7 +55,7 @@ import scipy.linalg
 import scipy.optimize
 
 from fdikit import linalg, validate
-from fdikit.design.game.setup import GameProblem, game_problem, weight
+from fdikit.design.game.setup import GameProblem, game_problem, per_target, weight
 from fdikit.design.observers.full_order import observer_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
@@ -115,15 +115,9 @@ class DiscreteGameSetup:
         return (U * np.sqrt(np.clip(w, 0.0, None))) @ U.T @ self.problem.projectors[name] @ self.model.C
 
 
-def _per_target(kind: str, value, dims: Mapping[str, int]) -> dict[str, np.ndarray]:
-    if isinstance(value, Mapping):
-        missing = [nm for nm in dims if nm not in value]
-        if missing:
-            raise ParameterError(
-                f"weight {kind} has no entry for target(s) {missing}; give one per target {list(dims)}"
-            )
-        return {nm: weight(f"{kind}[{nm}]", value[nm], d) for nm, d in dims.items()}
-    return {nm: weight(f"{kind}[{nm}]", value, d) for nm, d in dims.items()}
+def _weights(kind: str, value, dims: Mapping[str, int]) -> dict[str, np.ndarray]:
+    """:func:`~fdikit.design.game.setup.per_target`, each checked as a ``dims[target]``-square :func:`weight`."""
+    return {nm: weight(f"{kind}[{nm}]", v, dims[nm]) for nm, v in per_target(kind, value, list(dims)).items()}
 
 
 def _positive(name: str, W: np.ndarray) -> np.ndarray:
@@ -185,9 +179,9 @@ def discrete_game_setup(
     return DiscreteGameSetup(
         prob, float(gamma), _positive("Vbar", weight("Vbar", Vbar, model.p)) / gamma,
         _positive("P0", weight("P0", P0, model.n)) / gamma, int(steps),
-        _per_target("Q", Q, {t: model.p for t in prob.names}),
-        {t: _positive(f"M[{t}]", Mi) for t, Mi in _per_target("M", M, kh).items()},
-        _per_target("K", K, kh), _per_target("N", N, {t: prob.targets[t].shape[1] for t in prob.names}),
+        _weights("Q", Q, {t: model.p for t in prob.names}),
+        {t: _positive(f"M[{t}]", Mi) for t, Mi in _weights("M", M, kh).items()},
+        _weights("K", K, kh), _weights("N", N, {t: prob.targets[t].shape[1] for t in prob.names}),
     )
 
 

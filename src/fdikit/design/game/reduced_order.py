@@ -43,7 +43,7 @@ import scipy.linalg
 
 from fdikit import linalg
 from fdikit.design.game.goh import GohRiccatiSolution, goh_riccati
-from fdikit.design.game.setup import GameProblem, game_problem
+from fdikit.design.game.setup import GameProblem, game_problem, per_target
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import joined_form
@@ -117,20 +117,6 @@ class GohFilterDesign:
                 "structure_residual": self.structure_residual}
 
 
-def _per_target(value, names: Sequence[str], given: Sequence[str]) -> dict[str, object]:
-    if not isinstance(value, Mapping):
-        return {t: value for t in names}
-    alias = dict(zip(given, names))
-    out = {alias.get(k, k): v for k, v in value.items()}
-    unknown = sorted(set(out) - set(names))
-    if unknown:
-        raise ParameterError(f"weight Q is given for {unknown}, which are not targets; targets are {list(names)}")
-    missing = [t for t in names if t not in out]
-    if missing:
-        raise ParameterError(f"weight Q is missing for target(s) {missing}; give one value or one per target")
-    return out
-
-
 def goh_filter(
     model: FaultModel,
     targets: Sequence[str] | Mapping[str, np.ndarray],
@@ -185,7 +171,7 @@ def goh_filter(
     prob = game_problem(model, targets, nuisance, rtol)
     names = prob.names
     given = [targets] if isinstance(targets, str) else list(targets)
-    Qs = _per_target(Q, names, [str(g) for g in given])
+    Qs = per_target("Q", Q, names, [str(g) for g in given])
     A, C, n, p = model.A, model.C, model.n, model.p
     sols = {t: goh_riccati(A, C, prob.complementary[t], V=V, Q=Qs[t], projector=prob.projectors[t], rtol=rtol)
             for t in names}

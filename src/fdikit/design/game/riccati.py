@@ -29,14 +29,14 @@ minimises.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
 
 from fdikit import validate
-from fdikit.design.game.setup import GameProblem, weight
+from fdikit.design.game.setup import GameProblem, per_target, weight
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 
@@ -192,25 +192,6 @@ def require_continuous(model: FaultModel) -> None:
             f"the steady-state game filter is continuous-time but the model is discrete (dt={model.dt}); "
             "design on the continuous model and discretise the generator, or use the discrete game filter"
         )
-
-
-def per_target(name: str, value, problem: GameProblem, given: Sequence[str]):
-    """A weight given once for every target, or as a mapping target → weight."""
-    if not isinstance(value, Mapping):
-        return {t: value for t in problem.names}
-    alias = dict(zip(given, problem.names, strict=False))
-    out = {}
-    for key, v in value.items():
-        t = alias.get(key, key)
-        if t not in problem.targets:
-            raise ParameterError(
-                f"weight {name} is given for {key!r}, which is not a target; targets are {problem.names}"
-            )
-        out[t] = v
-    missing = [t for t in problem.names if t not in out]
-    if missing:
-        raise ParameterError(f"weight {name} is missing for target(s) {missing}; give a value per target or one scalar")
-    return out
 
 
 def checked_gamma(gamma: float) -> float:

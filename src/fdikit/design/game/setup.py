@@ -20,10 +20,10 @@ import numpy as np
 
 from fdikit import linalg, validate
 from fdikit.errors import DesignError, ParameterError
-from fdikit.linalg import resolve_faults
+from fdikit.linalg import resolve_faults, resolve_nuisance
 from fdikit.model import FaultModel
 
-__all__ = ["GameProblem", "game_problem", "weight"]
+__all__ = ["GameProblem", "game_problem", "per_target", "weight"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -79,10 +79,36 @@ def weight(name: str, value, dim: int) -> np.ndarray:
     return (W + W.T) / 2
 
 
+def per_target(name: str, value, targets: GameProblem | Sequence[str], given: Sequence[str] = ()) -> dict[str, object]:
+    """A design weight given once for every target, or as a mapping target → weight, as a dict in target order.
+
+    ``targets`` is a :class:`GameProblem` (its target names) or the target names.  A mapping may be keyed by the
+    target names or by the names the caller wrote, ``given`` (aligned with the target names: the ``targets=``
+    argument of the design as given).  A key that names no target, or a target without a key, is a
+    :class:`ParameterError` naming the weight and the targets.  The values are returned as given (check them
+    with :func:`weight`).
+    """
+    names = list(targets.names if isinstance(targets, GameProblem) else targets)
+    if not isinstance(value, Mapping):
+        return {t: value for t in names}
+    alias = dict(zip(given, names, strict=False))
+    out = {}
+    for key, v in value.items():
+        t = alias.get(key, key)
+        if t not in names:
+            raise ParameterError(f"weight {name} is given for {key!r}, which is not a target; targets are {names}")
+        out[t] = v
+    missing = [t for t in names if t not in out]
+    if missing:
+        raise ParameterError(f"weight {name} has no entry for target(s) {missing}; give one value for every target "
+                             f"or a mapping with one per target {names}")
+    return {t: out[t] for t in names}
+
+
 def game_problem(
     model: FaultModel,
-    targets: Mapping[str, np.ndarray] | Sequence[str],
-    nuisance: Mapping[str, np.ndarray] | Sequence[str] = (),
+    targets: Mapping[str, np.ndarray] | Sequence[str] | str,
+    nuisance: Mapping[str, np.ndarray] | Sequence[str] | str = (),
     rtol: float | None = None,
 ) -> GameProblem:
     """Partition faults into targets and nuisance, and build ``F̂_i``, ``Ŵ_i*`` and ``Ĥ_i``.
@@ -91,10 +117,14 @@ def game_problem(
     ----------
     model : FaultModel
         The plant (continuous or discrete; only ``A`` and ``C`` are used).
-    targets, nuisance : sequence of names or mapping name → F
-        Names are resolved by :func:`fdikit.design.resolve_faults` (an output name is a
-        sensor fault ``[F¹, A F¹]``, a control name an actuator fault, a fault input its
-        column); a mapping gives explicit n x k maps.
+    targets : fault name, sequence of fault names, or mapping name → F
+        The faults to detect.  Names are resolved by :func:`fdikit.linalg.resolve_faults`
+        (``'<output>_sensor'`` is the sensor fault ``[F¹, A F¹]``, ``'<control>_actuator'`` an
+        actuator fault, a fault input of the model its column); a mapping gives explicit n x k
+        maps.  A bare signal name raises :class:`ParameterError`.
+    nuisance : as ``targets``, or ``'others'``
+        The faults to block: ``()`` (default) none, ``'others'`` every fault input of the model
+        that is not a target (:func:`fdikit.linalg.resolve_nuisance`).
     rtol : float, optional
         Relative rank tolerance of the subspace computations.
 
@@ -113,7 +143,7 @@ def game_problem(
     [1, 1]
     """
     T = resolve_faults(model, targets)
-    N = resolve_faults(model, nuisance) if (isinstance(nuisance, Mapping) or len(nuisance)) else {}
+    N = resolve_nuisance(model, nuisance, list(T))
     if not T:
         raise ParameterError("no target fault given; name at least one fault to detect")
     both = set(T) & set(N)
