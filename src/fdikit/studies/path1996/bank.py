@@ -76,6 +76,22 @@ def nominal_fault_sizes() -> dict[str, float]:
     used for the lateral and vertical accelerometers; rate gyros 0.02 rad/s; throttle 2°,
     brake 100 N·m (Fig. 5.15), steering 0.001 rad.  The air-mass fault of filter 4 is the
     0.07 kg of Fig. 5.18.
+
+    Returns
+    -------
+    dict of str to float
+        Size per fault name, for the 12 ``<output>_sensor`` faults (in the output's unit) and the 3
+        ``<control>_actuator`` faults (deg, N·m, rad).
+
+    References
+    ----------
+    Douglas et al. 1996, §5.1.1, Figs. 5.15, 5.18.
+
+    Examples
+    --------
+    >>> sizes = nominal_fault_sizes()
+    >>> len(sizes), sizes["throttle_actuator"], sizes["air_mass_sensor"], round(float(sizes["engine_speed_sensor"]), 2)
+    (15, 2.0, 0.07, 24.35)
     """
     import control
 
@@ -97,7 +113,35 @@ def nominal_fault_sizes() -> dict[str, float]:
 
 
 def path_fault_model(n_states: int = 14) -> FaultModel:
-    """The App. D model (``tiny='midpoint'``) with all 15 faults as inputs: 12 sensors, 3 actuators."""
+    """The App. D model (``tiny='midpoint'``) with all 15 faults as inputs: 12 sensors, 3 actuators.
+
+    Parameters
+    ----------
+    n_states : {12, 14}, default 14
+        Which App. D model; the 12-state model has the 12 sensor faults only (its actuators are static).
+
+    Returns
+    -------
+    FaultModel
+        Continuous model whose fault inputs are ``<control>_actuator`` (14 states only) and ``<output>_sensor``.
+
+    Raises
+    ------
+    ParameterError
+        If ``n_states`` is not 12 or 14.
+
+    References
+    ----------
+    Douglas et al. 1996, App. D; §4.1 (the fault set).
+
+    Examples
+    --------
+    >>> m = path_fault_model()
+    >>> m.n, len(m.faults), m.faults[0]
+    (14, 15, 'throttle_actuator')
+    >>> len(path_fault_model(12).faults)
+    12
+    """
     if isinstance(n_states, bool) or n_states not in (12, 14):
         raise ParameterError(f"n_states must be 12 or 14 (the PATH App. D models), got {n_states!r}")
     m = (path_vehicle_14 if n_states == 14 else path_vehicle_12)("midpoint")
@@ -112,12 +156,29 @@ class PathBank:
 
     Attributes
     ----------
-    designs : the Beard–Jones design of each filter.
-    generator : all filters stacked (block-diagonal), residuals ``'<filter>:<fault>[k]'``
+    designs : dict of str to BeardJonesDesign
+        The Beard–Jones design of each filter (``"filter1"`` … ``"filter4"``).
+    generator : ResidualGenerator
+        All filters stacked (block-diagonal), residuals ``'<filter>:<fault>[k]'``
         scaled so a nominal fault gives a steady magnitude of 1.
-    groups : the filter of each residual (for the bank isolation logic).
-    nominal : nominal fault size per fault name.
-    scales : the divisor of each (filter, fault) residual group.
+    groups : tuple of str
+        The filter of each residual (for the bank isolation logic, ``ThresholdEvaluator(groups=...)``).
+    nominal : dict of str to float
+        Nominal fault size per fault name (:func:`nominal_fault_sizes`).
+    scales : dict of (str, str) to float
+        The divisor of each (filter, fault) residual group.
+
+    References
+    ----------
+    Douglas et al. 1996, §4.1–4.2 (the filters), §5.1.1 (the scaling).
+
+    Examples
+    --------
+    Designing the bank takes about half a second (:func:`path_bank`):
+
+    >>> bank = path_bank()  # doctest: +SKIP
+    >>> len(bank.groups), sorted(bank.designs)  # doctest: +SKIP
+    (29, ['filter1', 'filter2', 'filter3', 'filter4'])
     """
 
     designs: dict[str, BeardJonesDesign]
@@ -138,12 +199,39 @@ def _dc(model: FaultModel, gen: ResidualGenerator) -> np.ndarray:
 def path_bank(dt: float | None = None, eigenvalues: dict | None = None) -> PathBank:
     """Design the PATH four-filter bank (continuous, or on the ZOH models at ``dt`` with ``e^{λ dt}``).
 
+    Parameters
+    ----------
+    dt : float, optional
+        Sample time [s]; the filters are designed on the ZOH models with the eigenvalues mapped to
+        ``e^{λ dt}``.  ``None`` (default) designs in continuous time.
+    eigenvalues : dict, optional
+        Filter name → ``(sets, complement)`` replacing entries of :data:`EIGENVALUES` (continuous-time
+        eigenvalues: one list per fault in :data:`FILTER_GROUPS` order, then Ξ_0).
+
+    Returns
+    -------
+    PathBank
+        The four designs, the stacked scaled generator, the filter of each residual, the nominal
+        sizes and the scale factors.
+
     Raises
     ------
     DesignError
         When a filter cannot be designed (the message names the filter).
     ParameterError
         For a bad ``dt`` or ``eigenvalues`` that name no filter of :data:`FILTER_GROUPS`.
+
+    References
+    ----------
+    Douglas et al. 1996, §4.1–4.2 (fault groups, eigenvalues), §5.1.1 (residual scaling).
+
+    Examples
+    --------
+    The design takes about half a second:
+
+    >>> bank = path_bank()  # doctest: +SKIP
+    >>> bank.generator.residuals[0], bank.groups[-1]  # doctest: +SKIP
+    ('filter1:engine_speed_sensor[0]', 'filter4')
     """
     if dt is not None:
         dt = validate.positive("dt", dt)
@@ -220,6 +308,51 @@ def path_runs(
     ``runs_per_fault`` times, plus ``healthy_runs`` fault-free runs; the 14-state plant
     (``tiny='midpoint'``) sampled at ``dt`` with white sensor noise of ``noise_fraction``
     times each sensor's nominal fault.  Seeds derive from ``seed``.
+
+    Parameters
+    ----------
+    bank : PathBank
+        From :func:`path_bank`.
+    runs_per_fault : int, default 1
+        Runs per fault (15 faults).
+    healthy_runs : int, default 1
+        Fault-free runs (first in the list).
+    duration : float, default 20.0
+        Length of each run [s].
+    onset : float, default 5.0
+        Fault onset [s], before ``duration``.
+    size : float, default 1.0
+        Bias size as a multiple of the nominal size.
+    noise_fraction : float, default 1e-4
+        Sensor noise standard deviation as a fraction of each sensor's nominal fault.
+    dt : float, default 0.01
+        Sample time [s] of the simulation and of the discretised generator.
+    seed : int, default 0
+        Seed from which each run's seed is drawn.
+    progress : bool, default False
+        Show a ``rich`` progress bar.
+
+    Returns
+    -------
+    list of (Trace, Residuals)
+        ``healthy_runs + 15 * runs_per_fault`` pairs: the simulated run and the bank's residuals on it.
+
+    Raises
+    ------
+    ParameterError
+        On a bad argument, or an ``onset`` not before ``duration``.
+
+    References
+    ----------
+    Douglas et al. 1996, §5.1.1 (nominal fault sizes).
+
+    Examples
+    --------
+    With a bank from :func:`path_bank` (half a second to design), one short fault-free run:
+
+    >>> runs = path_runs(path_bank(), runs_per_fault=0, duration=1.0, onset=0.5)  # doctest: +SKIP
+    >>> len(runs), runs[0][1].r.shape  # doctest: +SKIP
+    (1, (101, 29))
     """
     from fdikit.faults import Bias, FaultScenario
     from fdikit.simulate import simulate
