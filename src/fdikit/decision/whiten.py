@@ -27,7 +27,39 @@ __all__ = ["Whitened", "yule_walker"]
 
 
 def yule_walker(x: np.ndarray, order: int) -> np.ndarray:
-    """AR coefficients ``a_1 … a_p`` of a zero-mean series by the Yule–Walker equations."""
+    """AR coefficients ``a_1 … a_p`` of a zero-mean series by the Yule–Walker equations.
+
+    Parameters
+    ----------
+    x : (N,) array_like
+        The series, mean already removed.
+    order : int
+        ``p``, the AR order; ``N > 2 p`` needed.
+
+    Returns
+    -------
+    (p,) ndarray
+        ``a_1 … a_p`` of ``x_k = Σ_j a_j x_{k−j} + e_k`` (biased autocovariances, a Toeplitz solve).
+
+    Raises
+    ------
+    DataError
+        When the series has ``2 p`` samples or fewer, or is constant.
+
+    References
+    ----------
+    Basseville & Nikiforov 1993, §8.1 (innovation-based residual processing); the coloured residuals of the
+    detection filters are those of Douglas et al. 1996, Ch. 5.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import scipy.signal
+    >>> from fdikit.decision.whiten import yule_walker
+    >>> x = scipy.signal.lfilter([1.0], [1.0, -0.9], np.random.default_rng(0).standard_normal(5000))
+    >>> np.round(yule_walker(x, 1), 2).tolist()
+    [0.9]
+    """
     x = np.asarray(x, dtype=float)
     n = x.size
     if n <= 2 * order:
@@ -43,9 +75,41 @@ class Whitened:
 
     Parameters
     ----------
-    evaluator : an unfitted evaluator whose ``fit`` takes fault-free residuals (threshold, CUSUM,
-        GLR, SPRT); ``fit_kwargs`` of :meth:`fit` are passed on to it.
-    order : AR order ``p`` per residual.
+    evaluator : evaluator
+        An unfitted evaluator whose ``fit`` takes fault-free residuals (threshold, CUSUM, GLR, SPRT);
+        ``fit_kwargs`` of :meth:`fit` are passed on to it.
+    order : int, default 5
+        AR order ``p`` per residual.
+
+    Attributes
+    ----------
+    coef : (q, p) ndarray or None
+        AR coefficients per residual after :meth:`fit`.
+    center : (q,) ndarray or None
+        Fault-free mean ``c`` per residual after :meth:`fit`.
+
+    Raises
+    ------
+    ParameterError
+        When ``order`` is not a positive integer.
+
+    References
+    ----------
+    Basseville & Nikiforov 1993, §8.1 (innovation-based residual processing); the coloured residuals of the
+    detection filters are those of Douglas et al. 1996, Ch. 5.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import scipy.signal
+    >>> from fdikit.residuals import Residuals
+    >>> from fdikit.decision import ThresholdEvaluator
+    >>> from fdikit.decision.whiten import Whitened
+    >>> x = scipy.signal.lfilter([1.0], [1.0, -0.9], np.random.default_rng(0).standard_normal(5000))
+    >>> healthy = Residuals(np.arange(5000) * 0.01, x[:, None], ("r",), ("f",))
+    >>> w = Whitened(ThresholdEvaluator(), order=1).fit(healthy, false_alarm_prob=1e-3)
+    >>> np.round(w.coef, 2).tolist(), round(float(w.evaluator.thresholds[0]), 1)
+    ([[0.9]], 3.3)
     """
 
     def __init__(self, evaluator, order: int = 5) -> None:
