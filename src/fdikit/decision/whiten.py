@@ -48,8 +48,7 @@ def yule_walker(x: np.ndarray, order: int) -> np.ndarray:
 
     References
     ----------
-    Basseville & Nikiforov 1993, §8.1 (innovation-based residual processing); the coloured residuals of the
-    detection filters are those of Douglas et al. 1996, Ch. 5.
+    Basseville & Nikiforov 1993, §8.1 (innovation-based residual processing).
 
     Examples
     --------
@@ -95,8 +94,7 @@ class Whitened:
 
     References
     ----------
-    Basseville & Nikiforov 1993, §8.1 (innovation-based residual processing); the coloured residuals of the
-    detection filters are those of Douglas et al. 1996, Ch. 5.
+    Basseville & Nikiforov 1993, §8.1 (innovation-based residual processing).
 
     Examples
     --------
