@@ -1,10 +1,10 @@
 """Steering-fault isolation: moving-window LS, its bound, the pre-filter (van der Ploeg 2018, Ch. 3, Sec. 4-3-2/4-3-3).
 
 Oracles: brute-force least squares per window (numpy.linalg.lstsq), scipy.signal for the filters and
-frequency responses, dense SVDs for the operator norms, and the numbers of the research note
-(§5.6, derived with independent throw-away scripts) next to the thesis' printed statements.
+frequency responses, dense SVDs for the operator norms, and numbers from an independent
+reproduction (separate scripts) next to the thesis' printed statements.
 Residuals are ``r = G(q)[f_a + (f_m − 1) δ_set]`` with the thesis' fault map at 70 km/h,
-``G(q) = K (q − z_0)/(q − p)^3`` (note §5.2), as the parity filter gives after disturbance rejection.
+``G(q) = K (q − z_0)/(q − p)^3``, as the parity filter gives after disturbance rejection.
 """
 
 from __future__ import annotations
@@ -123,7 +123,7 @@ def test_bad_input_raises_clear_errors():
 
 
 def test_lateral_fault_map_unit_dc_and_printed_frequency_response():
-    # note §5.2: G(e^{jωh}) at 0.3 Hz, 70 km/h = 0.79491 - 0.51841j (p = 0.9048), 0.98891 - 0.13341j (p = 0.6065)
+    # independent: G(e^{jωh}) at 0.3 Hz, 70 km/h = 0.79491 - 0.51841j (p = 0.9048), 0.98891 - 0.13341j (p = 0.6065)
     for pole, printed in ((0.9048, 0.79491 - 0.51841j), (0.6065, 0.98891 - 0.13341j), (0.9, 0.81302 - 0.49882j)):
         num, den = fault_map_coefficients(lateral_fault_map(pole=pole))
         assert np.polyval(num, 1.0) / np.polyval(den, 1.0) == pytest.approx(1.0, abs=1e-12)
@@ -131,11 +131,11 @@ def test_lateral_fault_map_unit_dc_and_printed_frequency_response():
         assert g[0] == pytest.approx(printed, abs=1e-5)
 
 
-# ---------------------------------------------------------------- Thm 3-1.3 and checklist 8
+# ---------------------------------------------------------------- Thm 3-1.3
 
 
 def test_fm_estimate_biased_toward_real_part_of_G_and_fa_unbiased():
-    """Checklist 8 / issue acceptance: f̂_m -> 1 + (f_m - 1) Re G(e^{jω0 h}) = 0.6025 for f_m = 0.5, p = 0.9048.
+    """Thm 3-1.3, Sec. 4-3-2: f̂_m -> 1 + (f_m - 1) Re G(e^{jω0 h}) = 0.6025 for f_m = 0.5, p = 0.9048.
 
     Thesis Sec. 4-3-2 Case 1 (Fig. 4-6): at n = 500 "f̂_a converges to the true f_a" but "the multiplicative
     fault has an offset".  Note §5.6 table: 0.6025 / 0.5055 / 0.5019 for p = 0.9048 / 0.6065 / 0.3679.
@@ -219,7 +219,7 @@ def test_e1_equals_restricted_matrix_form_of_G_minus_identity():
 
 
 def test_regressor_norm_is_exact_and_printed_lemma_a11_fails_for_large_sigma():
-    """Lemma A-1.1 erratum (note §8 item 14): sqrt((1+|μ|)/(nV)) bounds ‖Φ_n‖_2 only when σ_n² <= 1."""
+    """Lemma A-1.1 erratum: sqrt((1+|μ|)/(nV)) bounds ‖Φ_n‖_2 only when σ_n² <= 1."""
     k = np.arange(400)
     e = 3.0 + np.sin(0.05 * k)  # σ² ≈ 9.5 > 1
     r = 0.2 + 0.5 * e + 0.01 * np.cos(0.3 * k)
@@ -235,11 +235,11 @@ def test_regressor_norm_is_exact_and_printed_lemma_a11_fails_for_large_sigma():
     assert np.all(b.theta[est.valid] <= b.bound[est.valid])
 
 
-# ---------------------------------------------------------------- Sec. 3-2: the pre-filter and checklist 9
+# ---------------------------------------------------------------- Sec. 3-2: the pre-filter
 
 
 def test_prefilter_exact_for_constant_faults():
-    """Cor. 3-2.2 / checklist 9: constant faults are estimated exactly (<= 1e-8) after the transient."""
+    """Cor. 3-2.2: constant faults are estimated exactly (<= 1e-8) after the transient."""
     f_a, f_m = constant_faults()
     late = T >= 20
     for pole in (0.9048, 0.6065, 0.3679):

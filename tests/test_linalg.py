@@ -4,8 +4,8 @@ Oracles: ``scipy.linalg.orth``/``null_space``/``subspace_angles``; brute-force d
 plain re-implementation of the CAISA recursion and of Wonham's unobservability-subspace algorithm
 (UOSA) on scipy primitives; the finite generalised eigenvalues of the Rosenbrock pencil
 (``scipy.linalg.eig``) for square systems; planted zeros (unobservable modes, exact by
-construction) for non-square ones; Murray (2012) Example 2, whose zeros the research note
-verified exactly with sympy (note §8.2.5); and the PATH checklist R-GEO-1…4 (research note §4.2)
+construction) for non-square ones; Murray (2012) Example 2, whose zeros are
+checked against the printed ones; and the PATH properties R-GEO-1…4
 on the reconstructed App. D data.
 """
 
@@ -335,7 +335,7 @@ EX2_CASES = {
 
 @pytest.mark.parametrize("case", sorted(EX2_CASES))
 def test_murray_example2_zeros_directions_and_mutual_detectability(case):
-    """Murray (2012) §6.2 (seed L2428ff; note §8.2.5, verified exactly with sympy there).
+    """Murray (2012) §6.2, Example 2 (zeros as printed in §6.2.1–6.2.4).
 
     Data as printed: A = [0 3 4; 1 2 3; 0 2 5], C = [0 1 0; 0 0 1], F_1 = [1, −0.5, 0.5]ᵀ; the
     zero direction is ν ∝ e_1 in all four cases.
@@ -358,14 +358,14 @@ def test_murray_example2_zeros_directions_and_mutual_detectability(case):
     assert ok is md
     np.testing.assert_allclose(joint.real, zj, atol=1e-10)
     np.testing.assert_allclose(np.sort(union.real), z2, atol=1e-10)
-    # detection spaces (note §8.2.1–8.2.4): T_1 = Im F_1; T_2 = span{e1, e2} when F_2 has the zero, else Im F_2
+    # detection spaces: T_1 = Im F_1; T_2 = span{e1, e2} when F_2 has the zero, else Im F_2
     T1, T2 = la.detection_space(A, C, F1), la.detection_space(A, C, F2)
     assert _angle(T1, F1) < 1e-12
     assert _angle(T2, np.eye(3)[:, :2] if z2 else F2) < 1e-10
     assert la.output_separable(C, [T1, T2]) == (True, [])
 
 
-# ---------------------------------------------------------------------- PATH, research note §4.2
+# ---------------------------------------------------------------------- PATH
 M12 = path_vehicle_12("midpoint")
 M14 = path_vehicle_14()
 GROUPS_12 = {
@@ -504,10 +504,10 @@ def test_r_geo_4_group_4_reconstructed_data():
     assert ok and joint.size == 0 and union.size == 0
 
 
-# ---------------------------------------------------------------------- PATH App. C: F-16XL (R-GEO-5)
+# ---------------------------------------------------------------------- PATH App. C: F-16XL
 def _f16xl(sign_bdelta: float):
-    """F-16XL longitudinal data of Douglas et al. 1996 App. C as reconstructed in the research note §3.6:
-    C(2,4) = 0 (the printed extra 1.0000 is an OCR slip: the printed F_Az needs C(:,4) ∝ e_3) and A(1,5) = 0.0430."""
+    """F-16XL longitudinal data of Douglas et al. 1996 App. C.5 as reconstructed in fdikit.plants.f16xl:
+    C(2,4) = 0 (the printed extra 1.0000 is a print slip: the printed F_Az needs C(:,4) ∝ e_3) and A(1,5) = 0.0430."""
     A = np.array([
         [-0.0674, 0.0430, -0.8886, -0.5587, 0.0430],
         [0.0205, -1.4666, 16.5800, -0.0299, -1.4666],
@@ -527,7 +527,7 @@ def _f16xl(sign_bdelta: float):
 
 @pytest.mark.parametrize("sign", [1.0, -1.0])
 def test_f16xl_fault_triples_have_no_zeros_and_minimal_spaces(sign):
-    """R-GEO-5: (C, A, F¹_Az), (C, A, F²_Az) and (C, A, F_δ) have no invariant zeros and T* = Im F.
+    """App. C.5: (C, A, F¹_Az), (C, A, F²_Az) and (C, A, F_δ) have no invariant zeros and T* = Im F.
 
     F¹_Az = e_4 / C(3,4) (C F¹ = e_3), F²_Az = A F¹ ∝ [0.9986, 0.0534, 0, 0, 0] (the printed normalised column);
     the first entry of B_δ has an uncertain sign (G17), so both are checked.

@@ -2,7 +2,7 @@
 
 Oracles: closed-form transfer functions of a diagonal plant with a diagonal observer gain (each
 residual sees one actuator and one sensor fault), continuous and discrete; the PATH group-4 geometry
-(research note §1.4.2, R-GEO-3/4) and Murray (2012) Example 2 (note §8.2.5) for the reports.
+(Douglas et al. 1996, §4.1–4.2) and Murray (2012) Example 2 for the reports.
 """
 
 from __future__ import annotations
@@ -162,7 +162,7 @@ def test_default_freqs():
 
 # ---------------------------------------------------------------------- FDI report
 M14 = path_vehicle_14()
-GROUP_4 = ["throttle", "brake", "steering", "air_mass:magnitude"]
+GROUP_4 = ["throttle_actuator", "brake_actuator", "steering_actuator", "air_mass_sensor:magnitude"]
 
 
 def test_fdi_report_group_4():
@@ -178,26 +178,26 @@ def test_fdi_report_group_4():
     assert rep.nu_total == 6 and rep.nu_0 == 8
     assert not rep.output_separable and rep.separation < 1e-12
     assert rep.inseparable_pairs == ()
-    assert rep.dependent_sets == (("throttle", "brake", "air_mass:magnitude"),)
+    assert rep.dependent_sets == (("throttle_actuator", "brake_actuator", "air_mass_sensor:magnitude"),)
     assert rep.mutually_detectable is None  # the joint system is not left invertible
     assert any("dependent" in s and "another filter" in s for s in rep.advice)
     df = rep.to_pandas()
     assert list(df["nu"]) == [2, 2, 1, 1] and list(df["dim_CT"]) == [1, 1, 1, 1]
     assert df.attrs["nu_total"] == 6
     text = str(rep)
-    for word in ("throttle", "air_mass:magnitude", "Σν = 6", "ν₀ = 8", "dependent"):
+    for word in ("throttle_actuator", "air_mass_sensor:magnitude", "Σν = 6", "ν₀ = 8", "dependent"):
         assert word in text
 
 
 def test_fdi_report_flags_throttle_and_two_dimensional_air_mass():
-    rep = fdi_report(M14, ["throttle", "brake", "steering", "air_mass"])
-    assert ("throttle", "air_mass") in rep.inseparable_pairs
-    assert ("brake", "air_mass") in rep.inseparable_pairs
+    rep = fdi_report(M14, ["throttle_actuator", "brake_actuator", "steering_actuator", "air_mass_sensor"])
+    assert ("throttle_actuator", "air_mass_sensor") in rep.inseparable_pairs
+    assert ("brake_actuator", "air_mass_sensor") in rep.inseparable_pairs
     am = rep.faults[3]
     assert am.kind == "sensor" and am.F.shape == (14, 2) and am.nu == 4 and am.output_dim == 2
     np.testing.assert_allclose(np.sort(am.zeros.real), [-90.91, -1.25], rtol=1e-12)
     advice = " ".join(rep.advice)
-    assert "air_mass:magnitude" in advice and "magnitude direction A F¹" in advice
+    assert "'air_mass_sensor:magnitude'" in advice and "magnitude direction A F¹" in advice
     assert "another filter" in advice
 
 
@@ -222,10 +222,10 @@ def test_fdi_report_midpoint_group_4_is_clean():
 
 def test_fdi_report_too_many_faults_for_one_filter():
     m = path_vehicle_12("midpoint")
-    rep = fdi_report(m, list(m.outputs[:7]))
+    rep = fdi_report(m, [f"{o}_sensor" for o in m.outputs[:7]])
     assert rep.nu_total == 14 and rep.nu_0 == -2
     assert any("Σν = 14 > n = 12" in s and "split" in s for s in rep.advice)
-    rep = fdi_report(m, ["engine_speed", "accel_y", "accel_z", "pitch_rate"])  # group 1
+    rep = fdi_report(m, ["engine_speed_sensor", "accel_y_sensor", "accel_z_sensor", "pitch_rate_sensor"])  # group 1
     assert rep.output_separable and rep.mutually_detectable and rep.nu_0 == 4 and rep.advice == ()
 
 
@@ -262,8 +262,8 @@ def test_fdi_report_murray_example2(f2, md, extra, unstable):
 def test_fdi_report_inseparable_actuators_and_undetectable_fault():
     m = FaultModel(A=-np.eye(3), C=np.eye(2, 3), Bu=np.array([[1.0, 2.0], [0.0, 0.0], [0.0, 0.0]]),
                    controls=["a", "b"])
-    rep = fdi_report(m, ["a", "b"])
-    assert rep.inseparable_pairs == (("a", "b"),)
+    rep = fdi_report(m, ["a_actuator", "b_actuator"])
+    assert rep.inseparable_pairs == (("a_actuator", "b_actuator"),)
     assert any("move one of them" in s for s in rep.advice)
     rep = fdi_report(m, {"hidden": np.array([0.0, 0.0, 1.0])})
     assert rep.faults[0].output_dim == 0
@@ -272,26 +272,32 @@ def test_fdi_report_inseparable_actuators_and_undetectable_fault():
 
 def test_resolve_fault_names():
     m = path_vehicle_14().with_sensor_faults(["air_mass"]).with_actuator_faults(["throttle"])
-    F, kind = resolve_fault(m, "air_mass")
+    F, kind = resolve_fault(m, "air_mass_sensor")
     np.testing.assert_array_equal(F, la.sensor_fault_map(m, "air_mass"))
     assert kind == "sensor"
-    F, kind = resolve_fault(m, "air_mass:magnitude")
+    F, kind = resolve_fault(m, "air_mass_sensor:magnitude")
     np.testing.assert_array_equal(F, la.sensor_fault_map(m, "air_mass")[:, 1:])
     assert kind == "sensor:magnitude"
-    assert resolve_fault(m, "air_mass:rate")[0].shape == (14, 1)
-    np.testing.assert_array_equal(resolve_fault(m, "air_mass_sensor")[0], la.sensor_fault_map(m, "air_mass"))
+    assert resolve_fault(m, "air_mass_sensor:rate")[0].shape == (14, 1)
+    # the same names on a model without the fault inputs: <output>_sensor and <control>_actuator still resolve
+    plain = path_vehicle_14()
+    np.testing.assert_array_equal(resolve_fault(plain, "air_mass_sensor")[0], la.sensor_fault_map(m, "air_mass"))
+    np.testing.assert_array_equal(resolve_fault(plain, "throttle_actuator")[0], m.Bu[:, [0]])
     F, kind = resolve_fault(m, "throttle_actuator")
     np.testing.assert_array_equal(F, m.Bu[:, [0]])
     assert kind == "fault input"
-    np.testing.assert_array_equal(resolve_fault(m, "throttle")[0], m.Bu[:, [0]])
-    with pytest.raises(ModelError, match="not an output, control or fault"):
+    with pytest.raises(ParameterError, match="'throttle' is a control; its actuator fault is 'throttle_actuator'"):
+        resolve_fault(m, "throttle")
+    with pytest.raises(ParameterError, match="'air_mass' is an output; its sensor fault is 'air_mass_sensor'"):
+        resolve_fault(m, "air_mass")
+    with pytest.raises(ModelError, match="not a fault of the model"):
         resolve_fault(m, "nope")
     with pytest.raises(ModelError, match="sensor faults only"):
-        resolve_fault(m, "throttle:magnitude")
+        resolve_fault(m, "throttle_actuator:magnitude")
     with pytest.raises(ParameterError, match="suffix"):
-        resolve_fault(m, "air_mass:bias")
+        resolve_fault(m, "air_mass_sensor:bias")
     with pytest.raises(DesignError):  # 12-state steering has a feedthrough
-        resolve_fault(path_vehicle_12("midpoint"), "steering")
+        resolve_fault(path_vehicle_12("midpoint"), "steering_actuator")
     with pytest.raises(ModelError):
         fdi_report(m, {"bad": np.ones((3, 1))})
     with pytest.raises(ModelError):

@@ -1,4 +1,4 @@
-"""Multiple-hypothesis Shiryayev SPRT (Douglas et al. 1996, Ch. 7): checklist R-SPRT-1…7 of the research note,
+"""Multiple-hypothesis Shiryayev SPRT (Douglas et al. 1996, Ch. 7): properties R-SPRT-1…7 below,
 Prop. 7.2 for the corrected recursion (and its failure for the printed one), the unknown-mean densities of
 Props. 7.4/7.5, the dynamic-programming thresholds, batch == online and bad input."""
 
@@ -21,7 +21,7 @@ from fdikit.errors import DataError, ParameterError
 from fdikit.residuals import Residuals
 
 EPS = np.finfo(float).eps
-T5 = np.round(np.arange(501) * 0.01, 10)  # Example 1/2 time base: dt = 0.01 s on [0, 5] s (note G10)
+T5 = np.round(np.arange(501) * 0.01, 10)  # Example 1/2 time base: dt = 0.01 s on [0, 5] s
 
 
 def _res(x, t=None, valid=None):
@@ -141,7 +141,7 @@ def test_example1_detection_time(example1_stats):
     """R-SPRT-4, §7.3.1: N(0.5 i, 1), H_0 → H_2 at t = 1 s, dt = 0.01 s, p_i = π_i = 1e−3, 100 seeded runs.
 
     Measured (seeds 0–99): detection delay quantiles 5/25/50/75/95 % = 0.31/0.36/0.44/0.58/0.79 s, max 1.59 s
-    (note §6.4: 0.34–0.45 s in 3 seeds); the issue's criterion is a median under 1 s.
+    (an independent reproduction: 0.34–0.45 s in 3 seeds); the issue's criterion is a median under 1 s.
     """
     delay = example1_stats["delay"]
     assert np.all(np.isfinite(delay))
@@ -517,7 +517,7 @@ def test_one_row_logpdf_is_bitwise_the_batch_row():
 
 
 def test_batch_equals_online_with_magnitude_blocks():
-    """Note G9 option: each fault's residual block reduced to its magnitude, online as in batch."""
+    """The magnitude-input option: each fault's residual block reduced to its magnitude, online as in batch."""
     rng = np.random.default_rng(10)
     res = Residuals(np.arange(300) * 0.01, rng.standard_normal((300, 4)) * 0.1 + np.where(
         np.arange(300)[:, None] >= 150, [1.0, 0.0, 0.0, 0.0], 0.0), ("a[0]", "a[1]", "b[0]", "b[1]"),

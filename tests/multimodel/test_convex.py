@@ -45,7 +45,7 @@ def _sort_simplex(v):
 
 
 def test_srcf_step_equals_conventional_kalman_filter():
-    """Checklist item 2: (2.29)–(2.32) = KF (filtered and predicted mean and covariance) to ~1e-12."""
+    """Hallouzi 2008, (2.29)–(2.32) = KF (filtered and predicted mean and covariance) to ~1e-12."""
     rng = np.random.default_rng(0)
     ms = _random_set(rng)
     mu = np.array([0.2, 0.5, 0.3])
@@ -88,7 +88,7 @@ def test_dual_filter_with_frozen_weights_is_a_kalman_filter(form):
 
 
 def test_sri_rls_equals_batch_weighted_least_squares():
-    """Checklist item 3: (2.35)–(2.36) = batch LS with weights λ^{k−τ} and the T_0 regularisation."""
+    """Hallouzi 2008, (2.35)–(2.36) = batch LS with weights λ^{k−τ} and the T_0 regularisation."""
     rng = np.random.default_rng(2)
     N, lam, delta = 3, 0.9, 1e-3
     mu0 = np.full(N, 1 / N)
@@ -136,7 +136,7 @@ def test_simplex_projection_michelot_equals_sort_based_projection():
         assert np.isclose(pt.sum(), 1.0) and pt.min() >= 0
         differ += not np.allclose(pm, pt)
     assert worst < 1e-14
-    assert differ > 0  # the thesis' ordering is not the Euclidean projection in general (note §2.5)
+    assert differ > 0  # the thesis' ordering is not the Euclidean projection in general
     assert np.allclose(project_to_simplex([0.75, 0.25]), [0.75, 0.25])
     assert np.allclose(project_to_simplex([1.2, 0.2]), [1.0, 0.0])
 

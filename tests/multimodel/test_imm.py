@@ -1,4 +1,4 @@
-"""IMM filter (Hallouzi 2008, §2.3.1, Table 2.1 with the research-note corrections); checklist §4.1 item 1.
+"""IMM filter (Hallouzi 2008, §2.3.1, Table 2.1 with the corrections stated in fdikit.multimodel.imm).
 
 Oracles: a plain Kalman filter written here, filterpy 1.4.5's IMMEstimator on the same data, the
 prior μ0 Πᵏ, and a simulated two-mode jump-Markov system (fixed seed).

@@ -1,4 +1,4 @@
-"""Table 4.7 decision logic (Hallouzi 2008, §4.4.2, T_f = 0.2); checklist §4.1 item 16.
+"""Table 4.7 decision logic (Hallouzi 2008, §4.4.2, T_f = 0.2).
 
 Model set II (Table 4.5) + nominal model 8: rudder {1, 2}, elevator {3, 5, 6}, aileron {4, 7}
 (1-based in the thesis, 0-based here).
@@ -46,7 +46,7 @@ def test_group_sum_boundary_and_unknown():
     mu = np.array([_mu(m8=0.55, m1=0.15, m3=0.15, m4=0.15), _mu(m8=0.6, m4=0.2, m7=0.0, m1=0.2),
                    _mu(m8=0.0, m4=0.5, m7=0.5)])
     assert logic.signatures(mu).tolist() == [[False] * 4, [False, True, False, True], [False, False, False, True]]
-    # tie rule [GAP, note §2.12]: largest group sum; on an exact tie the first group (rudder)
+    # tie rule (Table 4.7 gives none; fdikit's choice): largest group sum; on an exact tie the first group (rudder)
     assert logic.isolate(mu).tolist() == ["unknown", "rudder", "aileron"]
     mu2 = np.array([_mu(m8=0.5, m4=0.3, m1=0.2)])
     assert logic.isolate(mu2).tolist() == ["aileron"]

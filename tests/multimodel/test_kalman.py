@@ -362,7 +362,7 @@ def test_online_ekf_nan_handling_and_update_oracle():
 
 
 def test_srkf_update_identities():
-    """Hallouzi 2008 (2.29): R_e R_eᵀ = C P Cᵀ + R and S⁺S⁺ᵀ = P − P Cᵀ (C P Cᵀ + R)⁻¹ C P (research note §2.5)."""
+    """Hallouzi 2008 (2.29): R_e R_eᵀ = C P Cᵀ + R and S⁺S⁺ᵀ = P − P Cᵀ (C P Cᵀ + R)⁻¹ C P."""
     rng = np.random.default_rng(9)
     M = rng.standard_normal((3, 3))
     P, C, R = M @ M.T + np.eye(3), rng.standard_normal((2, 3)), np.diag([0.2, 0.4])

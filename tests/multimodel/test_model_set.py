@@ -1,4 +1,4 @@
-"""Model-set design, Hallouzi 2008, Ch. 3 and App. B (research note §2.9–2.10, checklist §4.1 items 5–9, §4.2 19–20)."""
+"""Model-set design, Hallouzi 2008, Ch. 3 (§3.3–3.6) and App. B."""
 
 from __future__ import annotations
 
@@ -214,7 +214,7 @@ def test_msd_od_rank_five_and_six_models(msd_large_set):
     assert gap_rank(od.singular_values) == 5 and od.rank == 5
     assert od.singular_values[4] / od.singular_values[5] > 1e9
     assert od.diag_r[4] / od.diag_r[5] > 1e11
-    # |diag R| of (3.19) (research note §3.5, grid-independent): 3.0, 0.943, 0.0222, 0.00739, 0.00237
+    # |diag R| of (3.19) (independent computation, grid-independent): 3.0, 0.943, 0.0222, 0.00739, 0.00237
     np.testing.assert_allclose(od.diag_r[:5], [3.0, 0.943, 0.0222, 0.00739, 0.00237], rtol=3e-3)
     assert len(od.indices) == 6
     chosen = params[list(od.indices)]
@@ -308,7 +308,7 @@ def test_lv_weights_reproduce_exact_msd_matrices():
         np.testing.assert_allclose(Ad, np.eye(6) + 2.5e-3 * A, atol=1e-15)
         np.testing.assert_allclose(Bd, 2.5e-3 * B, atol=1e-15)
         np.testing.assert_allclose(msd_weights_to_parameters(mu), (k1, m3, f1, f2), rtol=1e-12)
-    # interval centres (research note §3.10): μ_k1 = 0.5, μ_m3 = 0.1 at k1 = m3 = 1
+    # interval centres: μ_k1 = 0.5, μ_m3 = 0.1 at k1 = m3 = 1
     np.testing.assert_allclose(msd_parameters_to_weights(1.0, 1.0, 1.0, 1.0), [0.5, 0.1, 0.0, 0.0], atol=1e-15)
     with pytest.raises(DesignError, match=r"\[0, 1\]"):
         lv.model([0.5, 1.5, 0.0, 0.0])

@@ -1,4 +1,4 @@
-"""B747 linear longitudinal example, Hallouzi 2008, §2.4.1 (research note §3.1)."""
+"""B747 linear longitudinal example, Hallouzi 2008, §2.4.1."""
 
 from __future__ import annotations
 
@@ -11,8 +11,8 @@ from fdikit.plants.b747 import B747_FAULT_SCHEDULE, B747_MODEL_NAMES, B747_TRANS
 
 
 def test_eigenvalues_corrected_and_printed_a35():
-    """Research note §3.10: A(3,5) = 6.83e-7 → −0.634±1.154j, −0.00234±0.0929j, +0.00065; printed 6.83e-1 →
-    −0.341±9.560j, −0.291±1.130j, −0.00815."""
+    """Hallouzi 2008, (2.56) erratum (spectra computed independently): A(3,5) = 6.83e-7 → −0.634±1.154j,
+    −0.00234±0.0929j, +0.00065; printed 6.83e-1 → −0.341±9.560j, −0.291±1.130j, −0.00815."""
     ev = np.sort_complex(np.linalg.eigvals(b747_longitudinal().A))
     np.testing.assert_allclose(ev, np.sort_complex([-0.634 + 1.154j, -0.634 - 1.154j, -0.00234 + 0.0929j,
                                                     -0.00234 - 0.0929j, 0.00065]), atol=6e-4)

@@ -1,7 +1,7 @@
 """F-16XL plants: Murray 2012 §6.1 (4 states) and Douglas et al. 1996 App. C.5 (5 states with a Dryden gust).
 
-The App. C.5 data are OCR-reconstructed; these tests pin the reconstruction to the numbers the
-report prints elsewhere (F_Az, Murray's model of the same airframe, R-GEO-5).
+The App. C.5 data are reconstructed from a damaged print; these tests pin the reconstruction to the numbers the
+report prints elsewhere (F_Az, Murray's model of the same airframe).
 """
 
 import numpy as np
@@ -32,12 +32,12 @@ def test_gust_model_contains_murrays_airframe():
 
 
 def test_printed_accelerometer_fault_map():
-    """App. C.5 (L4950): F_Az normalised = [[0, 0.9986], [0, 0.0534], [0, 0], [1, 0], [0, 0]].
+    """Douglas et al. 1996, App. C.5: F_Az normalised = [[0, 0.9986], [0, 0.0534], [0, 0], [1, 0], [0, 0]].
 
     This pins C(2,4) = 0 (C e_4 must be ∝ e_3) and C(3,4) = −0.0299 (F¹ = e_4/C(3,4)).
     """
     m = f16xl_gust()
-    F, kind = linalg.resolve_fault(m, "y_Az")
+    F, kind = linalg.resolve_fault(m, "y_Az_sensor")
     assert kind == "sensor"
     np.testing.assert_allclose(m.C @ F[:, 0], [0, 0, 1, 0], atol=1e-12)
     np.testing.assert_allclose(F[:, 0], [0, 0, 0, 1 / -0.0299, 0], rtol=1e-12, atol=1e-12)
@@ -48,10 +48,10 @@ def test_printed_accelerometer_fault_map():
 
 
 def test_faults_have_no_invariant_zeros_and_are_mutually_detectable():
-    """R-GEO-5 (App. C.5): (C, A, F¹_Az), (C, A, F²_Az), (C, A, F_δ) have no invariant zeros, the minimal
+    """App. C.5: (C, A, F¹_Az), (C, A, F²_Az), (C, A, F_δ) have no invariant zeros, the minimal
     unobservability subspaces are the fault directions, and the faults are mutually detectable."""
     m = f16xl_gust()
-    F_az = linalg.resolve_fault(m, "y_Az")[0]
+    F_az = linalg.resolve_fault(m, "y_Az_sensor")[0]
     F_d = m.Bu
     for F in (F_az[:, [0]], F_az[:, [1]], F_d, F_az):
         zeros, _ = linalg.invariant_zeros(m.A, m.C, F)

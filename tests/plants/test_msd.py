@@ -1,4 +1,4 @@
-"""Mass–spring–damper LPV benchmark, Hallouzi 2008, §3.6 (research note §3.5)."""
+"""Mass–spring–damper LPV benchmark, Hallouzi 2008, §3.6."""
 
 from __future__ import annotations
 

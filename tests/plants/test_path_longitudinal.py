@@ -1,7 +1,7 @@
-"""PATH Ch. 9 7-state longitudinal model (Douglas et al. 1996, §9.6, (9.86)–(9.89); L3953–4077 of the seed).
+"""PATH Ch. 9 7-state longitudinal model (Douglas et al. 1996, §9.6, (9.84)–(9.89)).
 
 Oracles: the printed fault maps ``F = [f, A f]`` and their defining equations ``C f = e_i``, and the
-spectrum derived in the PATH research note §6.2 after the A(2,3) sign fix.
+spectrum computed independently after the A(2,3) sign fix (see fdikit.plants.path_longitudinal).
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from fdikit.plants.path_longitudinal import (
     path_longitudinal_7_fault_maps,
 )
 
-#: Research note §6.2: eig(A) after A(2,3) := +19.0734, printed to 3 decimals (4 for the slow pole).
+#: Independent computation: eig(A) after A(2,3) := +19.0734, printed to 3 decimals (4 for the slow pole).
 EIG_FIXED = np.array([-31.585, -26.229, -2.319 + 6.649j, -2.319 - 6.649j, -1.535 + 5.693j, -1.535 - 5.693j, -0.0449])
 
 
@@ -36,7 +36,7 @@ def test_corrected_spectrum_matches_the_note_to_the_printed_decimals():
 
 
 def test_printed_a23_sign_gives_an_unstable_eigenvalue_and_inconsistent_fault_maps():
-    """As printed, eig(A) has +0.169 (note §6.2) and A f − F(:,2) has row-2 errors −14.46 and −9.71."""
+    """As printed, eig(A) has +0.169 and A f − F(:,2) has row-2 errors −14.46 and −9.71."""
     ev = np.linalg.eigvals(PATH7_A_PRINTED)
     assert ev.real.max() == pytest.approx(0.169, abs=1e-3)
     err_w = PATH7_A_PRINTED @ PATH7_F_ENGINE_SPEED[:, 0] - PATH7_F_ENGINE_SPEED[:, 1]
@@ -80,7 +80,7 @@ def test_model_structure_and_names():
 def test_exact_sensor_maps_of_the_model_agree_with_the_printed_maps_to_the_rounding():
     """resolve_faults gives [C⁻¹e_i, A C⁻¹e_i]; printed maps differ by the 4-decimal rounding amplified by cond(C)."""
     m = path_longitudinal_7()
-    exact = resolve_faults(m, ["engine_speed", "accel_x"])
+    exact = resolve_faults(m, ["engine_speed_sensor", "accel_x_sensor"])
     printed = path_longitudinal_7_fault_maps()
     assert list(printed) == list(exact) == ["engine_speed_sensor", "accel_x_sensor"]
     for name in exact:

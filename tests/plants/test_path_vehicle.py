@@ -100,7 +100,7 @@ def test_spectrum_matches_table_2_1_within_the_rounding_of_the_data(build, n, ta
 
 
 def test_spectrum_of_rounded_data_as_recomputed_in_the_research_note():
-    """Research note §3.3/§6.1 recomputed eig(A12) from the same transcription; pin it to 3 decimals."""
+    """eig(A12) recomputed independently from the same transcription of App. D; pin it to 3 decimals."""
     expected = np.array([
         -26.467 + 4.395j, -26.467 - 4.395j, -7.527 + 2.956j, -7.527 - 2.956j, -2.822 + 5.604j, -2.822 - 5.604j,
         -2.064 + 6.530j, -2.064 - 6.530j, -1.437 + 5.498j, -1.437 - 5.498j, -1.25, -0.0550,

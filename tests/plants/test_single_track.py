@@ -1,4 +1,4 @@
-"""Single-track lateral model with lane errors (van der Ploeg 2018, App. B; research note §3.9, §5.1)."""
+"""Single-track lateral model with lane errors (van der Ploeg 2018, App. B)."""
 
 from __future__ import annotations
 
@@ -57,7 +57,7 @@ def test_understeer_gradient():
     [(30, (-20.196, 1.872)), (40, (-15.147, 4.115)), (70, (-8.655, 5.345)), (120, (-5.049, 5.682))],
 )
 def test_continuous_eigenvalues(kmh, printed):
-    """Lateral/yaw pair vs note §5.1 (printed to 3 decimals) plus the two lane-error integrators at 0.
+    """Lateral/yaw pair vs an independent computation (Table 4-1, 3 decimals) plus the two lane-error integrators at 0.
 
     Tolerance 0.55e-3: half a unit of the 3rd decimal, plus 0.05e-3 for a printed value
     that was rounded twice (via 4 decimals).  That case occurs: at 30 km/h the imaginary part
@@ -73,7 +73,7 @@ def test_continuous_eigenvalues(kmh, printed):
 
 
 def test_continuous_matrices_are_b12():
-    """Structure of (B.12) reconstructed (note §3.9) at 70 km/h, with values from the formulas."""
+    """Structure of (B.12) reconstructed at 70 km/h, with values from the formulas."""
     v, p = 70 * KMH, PRIUS_2010
     m = single_track(v)
     assert m.A[0, 0] == pytest.approx((p.C_f + p.C_r) / (p.m * v))

@@ -1,7 +1,7 @@
-"""Renault Scénic LPV lateral model (Varrier, Koenig & Martinez 2014, §5.1, (47)–(48); research note M19, §5 items 1–2).
+"""Renault Scénic LPV lateral model (Varrier, Koenig & Martinez 2014, §5.1, (47)–(48)).
 
 Oracles: the parameter table of §5.1; the entries of (48) written out by hand from the table
-(the note's §3.1 numbers, six significant digits); forward Euler of the continuous model;
+(six significant digits); forward Euler of the continuous model;
 the kinematic identity a_y = v (β' + r); eigenvalues computed with numpy.
 """
 
@@ -120,7 +120,7 @@ def test_forward_euler_stability_limit():
 
 
 def test_uncertainty_readings():
-    """§5.3 A1 = 0.2 A0(0.048), literal (note §3.2 value) and the 'continuous' reading 0.2 (A0 − I)."""
+    """§5.3 A1 = 0.2 A0(0.048), literal (value computed by hand) and the 'continuous' reading 0.2 (A0 − I)."""
     lit = varrier_uncertainty()
     np.testing.assert_allclose(lit.A[0], [[0.18359, -0.0037348], [0.094465, 0.17759]], atol=5e-6)
     np.testing.assert_array_equal(lit.C[0], np.zeros((2, 2)))

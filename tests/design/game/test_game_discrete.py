@@ -40,7 +40,7 @@ def _ws_single(dt, gamma=1e-6, Qc=0.002, Mc=0.05, steps=400, target="f1"):
 
 
 def _random_problem(seed, steps=40):
-    """The note's §7.4 test shape: 3 states, 2 outputs, two targets, γ = 1."""
+    """A small test shape: 3 states, 2 outputs, two targets, γ = 1."""
     rng = np.random.default_rng(seed)
     A = rng.standard_normal((3, 3))
     A = 0.9 * A / np.abs(np.linalg.eigvals(A)).max()
@@ -76,7 +76,7 @@ def test_generator_is_the_a_priori_observer_of_5_3():
     assert err < 1e-12
 
 
-# ---------------------------------------------------------------------- DARI forms (note §9 item 5)
+# ---------------------------------------------------------------------- DARI forms
 def test_dari_propagation_equals_5_29_5_30_and_5_44b_and_schur_form_5_23():
     rng = np.random.default_rng(11)
     n, p, gamma = 4, 3, 0.5
@@ -115,7 +115,7 @@ def test_dari_propagation_equals_5_29_5_30_and_5_44b_and_schur_form_5_23():
 
 
 def test_printed_5_38_is_not_the_inverse_of_5_35_but_the_transposed_form_is():
-    """Research note §7.4 erratum: Δ̃ = (I + Γ̂G)ᵀΦ̂ΛΦ̂ᵀ(I + Γ̂G) inverts (5.35); the printed (5.38) does not."""
+    """Erratum: Δ̃ = (I + Γ̂G)ᵀΦ̂ΛΦ̂ᵀ(I + Γ̂G) inverts (5.35); the printed (5.38) does not."""
     rng = np.random.default_rng(5)
     n = 4
     Phat, Gh, G, D = (rng.standard_normal((n, n)) for _ in range(4))
@@ -126,7 +126,7 @@ def test_printed_5_38_is_not_the_inverse_of_5_35_but_the_transposed_form_is():
     assert _rel(E @ Phat.T @ Lam @ Phat @ E.T, Dt) > 0.1
 
 
-# ---------------------------------------------------------------------- DGTFDF (5.42)–(5.43), note §9 item 14
+# ---------------------------------------------------------------------- DGTFDF (5.42)–(5.43)
 def test_dgtfdf_is_5_42_and_the_recursion_at_its_gain_reproduces_it():
     st = _ws_single(0.01, steps=400)
     d = dgtfdf(st)

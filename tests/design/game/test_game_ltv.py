@@ -56,7 +56,7 @@ def _first_escape(Acl, R, Qbar, P_start, T):
 def test_white_speyer_converges_to_care_and_remark_6_6_eigenvalues():
     """Murray 2012 §6.2.3, Remark 6.6: F2 = [5, 1, 1], M = 0.05, Q = 1e-3 I, V = I, γ = 1e-6, target f1.
 
-    Printed single-fault GTFDF eigenvalues −3.5305 ± 1.7895j, −316.27 (note §8.2.6); the Riccati DE
+    Printed single-fault GTFDF eigenvalues −3.5305 ± 1.7895j, −316.27; the Riccati DE
     started at P0/γ = 1e6 I must settle on the stabilizing solution of the P-form CARE."""
     ws = white_speyer("stable-extra-zero")
     model = LTVModel.from_lti(ws, ["f1", "f2"])
@@ -158,7 +158,8 @@ def test_lti_recursion_agrees_with_caisa_and_game_setup():
 def test_single_track_family_geometry():
     """van der Ploeg (B.12) at V_x(t): the bank force g e1 is in Ker C, so W*(t) = [g e1, g A(t) e1] (β = 1)
     and Ĥ(t) must annihilate C A(t) e1 = [a21(t), −1, 0]; the yaw-rate sensor fault is [e2, A(t) e2]."""
-    model = LTVModel.from_family(lambda t: single_track(10.0 + t), ["steering", "bank", "curvature", "yaw_rate"])
+    model = LTVModel.from_family(lambda t: single_track(10.0 + t), ["steering_actuator", "bank", "curvature",
+                                                                     "yaw_rate_sensor"])
     assert set(model.faults) == {"steering_actuator", "bank", "curvature", "yaw_rate_sensor"}
     for t in (0.0, 7.5):
         st = single_track(10.0 + t)
@@ -191,7 +192,7 @@ def test_large_output_weight_is_infeasible_for_white_speyer():
 
 # ------------------------------------------------------------------ multi-target feasibility (3.32)
 def _bjdf_gain(ws):
-    """Exact Beard–Jones gain of White–Speyer §6.2.1 (note §8.2.7): λ_a = −0.6779 on T1 = Im F1, λ_b, λ_c on
+    """Exact Beard–Jones gain of White–Speyer §6.2.1: λ_a = −0.6779 on T1 = Im F1, λ_b, λ_c on
     T2 = span{e1, e2}; these are the GTMFDF eigenvalues printed in Murray 2012 §6.2.1."""
     la, lb, lc = -0.6779, -5.1079, -6.8872
     F1 = ws.Bf[:, 0]
@@ -324,7 +325,7 @@ def _single_track_ltv() -> LTVModel:
 
 
 def test_analytic_single_track_model_matches_from_family():
-    fam = LTVModel.from_family(lambda s: single_track(_speed(s)), ["steering", "curvature", "bank"])
+    fam = LTVModel.from_family(lambda s: single_track(_speed(s)), ["steering_actuator", "curvature", "bank"])
     fast = _single_track_ltv()
     for t in (0.0, 6.5, 20.0):
         for key in ("A", "curvature", "bank", "steering_actuator"):
@@ -410,6 +411,6 @@ def test_bad_inputs_raise_clear_errors():
     with pytest.raises(DataError, match="y has shape"):
         ltv_detection_filter(m, ["f1"], ["f2"], lambda s: np.zeros((3, 2))).run([0.0, 1.0], np.zeros((2, 3)))
     # yaw-rate sensor nuisance hides the steering actuator: both reach only the yaw-rate output direction
-    st = LTVModel.from_family(lambda s: single_track(10.0 + s), ["steering", "yaw_rate"])
+    st = LTVModel.from_family(lambda s: single_track(10.0 + s), ["steering_actuator", "yaw_rate_sensor"])
     with pytest.raises(DesignError, match="not output separable"):
         ltv_game_filter(st, "steering_actuator", ["yaw_rate_sensor"], [0.0, 1.0], gamma=1e-4)

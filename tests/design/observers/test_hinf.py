@@ -17,7 +17,7 @@ from fdikit.faults import Bias, FaultScenario
 from fdikit.plants.f16xl import F16XL_DRYDEN_GAIN, f16xl_gust
 from fdikit.simulate import simulate
 
-FAULTS = ["y_Az", "elevon"]
+FAULTS = ["y_Az_sensor", "elevon_actuator"]
 AZ, DELTA = "y_Az_sensor", "elevon_actuator"
 #: App. C.5: "Choosing γ = 1.2 results in a filter with eigenvalues −29.4629, −1.6062, −0.4351, −0.0032, −1.1013"
 PRINTED_POLES = np.sort([-29.4629, -1.6062, -0.4351, -0.0032, -1.1013])
@@ -131,7 +131,7 @@ def test_family_rejects_bad_specifications():
 def test_rhinf1_printed_form_reproduces_the_report(printed):
     """R-HINF-1 (App. C.5, γ = 1.2): the modified DRE settles at Y > 0 with a tiny (c.18) residual and the filter is
     stable.  Obtained −26.78, −1.670, −1.077, −0.389, −0.0044 against the printed −29.46, −1.606, −1.101, −0.435,
-    −0.0032 (OCR-reconstructed data, d_q fitted): the four faster poles within 12 %, the slow one within 1.5x."""
+    −0.0032 (reconstructed App. C.5 data, d_q fitted): the four faster poles within 12 %, the slow one within 1.5x."""
     d = printed
     assert np.linalg.eigvalsh(d.riccati)[0] > 1e-4 and d.riccati_residual < 1e-12
     assert d.settling_time > 100  # the −0.004 pole: the flow needs several of its time constants
@@ -189,7 +189,7 @@ def test_residual_directions_are_decoupled(plant, corrected):
 
 def test_column_signs_do_not_change_the_filter(plant, corrected):
     """Flipping fault columns flips residual signs only: Y, L and the poles are unchanged."""
-    F = linalg.resolve_fault(plant, "y_Az")[0] * [-1.0, 1.0]
+    F = linalg.resolve_fault(plant, AZ)[0] * [-1.0, 1.0]
     d = hinf_detection_filter(plant, {AZ: F, DELTA: -plant.Bu}, gamma=1.2)
     np.testing.assert_allclose(d.gain, corrected.gain, rtol=1e-7, atol=1e-9 * np.abs(corrected.gain).max())
     np.testing.assert_allclose(np.sort(d.poles.real), np.sort(corrected.poles.real), rtol=1e-7)
@@ -221,7 +221,7 @@ def test_bad_input_is_rejected(plant):
 def test_enhancement_direction_matches_the_report(plant, printed):
     """App. C.5: q = [−0.126, −0.992] for the A_z residual.  In the coordinates of the printed F_Az columns
     (F¹ ∝ +e_4) we get ±[0.068, 0.998]: |cos| = 0.9986 (3.3°)."""
-    F = linalg.resolve_fault(plant, "y_Az")[0] * [-1.0, 1.0]  # positive multiples of the printed columns
+    F = linalg.resolve_fault(plant, AZ)[0] * [-1.0, 1.0]  # positive multiples of the printed columns
     d = hinf_detection_filter(plant, {AZ: F, DELTA: plant.Bu}, gamma=1.2, form="printed")
     np.testing.assert_allclose(np.sort(d.poles.real), np.sort(printed.poles.real), rtol=1e-7)
     e = enhancement_direction(d, AZ)

@@ -70,7 +70,7 @@ def _zero_model(z0: float, seed: int = 3, dt: float | None = None) -> FaultModel
 @pytest.mark.parametrize("dt", [None, 0.05])
 def test_nuisance_disturbance_and_controls_do_not_reach_the_residual(seed, dt):
     m = _random_model(seed, dt)
-    d = uio(m, "u1_actuator")
+    d = uio(m, "u1_actuator", nuisance="others")
     assert d.decoupled == ("u0_actuator", "y6_sensor", "gust")
     G = d.generator.internal_form(m)
     w = _grid(m)
@@ -94,7 +94,7 @@ def test_nuisance_disturbance_and_controls_do_not_reach_the_residual(seed, dt):
 @pytest.mark.parametrize("dt", [None, 0.05])
 def test_uio_equations_and_generator_matrices(dt):
     m = _random_model(4, dt)
-    d = uio(m, "u1_actuator")
+    d = uio(m, "u1_actuator", nuisance="others")
     A, C, Bu, Du = m.A, m.C, m.Bu, m.Du
     E = d.E
     assert E.shape == (8, 5)  # u0 actuator (Bf and Df nonzero): 2 columns; y6 sensor: 2; gust: 1
@@ -141,19 +141,19 @@ def test_unknown_input_directions():
 def test_user_poles_are_placed():
     m = _random_model(6)
     poles = [-2.0, -3.0, -4.0, -5.0 + 1.0j, -5.0 - 1.0j, -6.0, -7.0, -8.0]
-    d = uio(m, "u1_actuator", poles=poles)
+    d = uio(m, "u1_actuator", nuisance="others", poles=poles)
     np.testing.assert_allclose(np.sort_complex(d.poles), np.sort_complex(np.array(poles)), atol=1e-8)
     assert max(d.decoupling.values()) < 1e-10
     md = m.discretize(0.1)
-    dd = uio(md, "u1_actuator", poles=np.linspace(0.1, 0.8, 8))
+    dd = uio(md, "u1_actuator", nuisance="others", poles=np.linspace(0.1, 0.8, 8))
     np.testing.assert_allclose(np.sort(dd.poles.real), np.linspace(0.1, 0.8, 8), atol=1e-8)
     assert np.abs(dd.poles.imag).max() < 1e-8
     with pytest.raises(DesignError, match=r"need 8 UIO poles .* got 3"):
-        uio(m, "u1_actuator", poles=[-1.0, -2.0, -3.0])
+        uio(m, "u1_actuator", nuisance="others", poles=[-1.0, -2.0, -3.0])
     with pytest.raises(DesignError, match=r"not stable"):
-        uio(m, "u1_actuator", poles=[0.5, -2.0, -3.0, -4.0, -5.0, -6.0, -7.0, -8.0])
+        uio(m, "u1_actuator", nuisance="others", poles=[0.5, -2.0, -3.0, -4.0, -5.0, -6.0, -7.0, -8.0])
     with pytest.raises(DesignError, match=r"not stable"):
-        uio(md, "u1_actuator", poles=[1.2, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7])
+        uio(md, "u1_actuator", nuisance="others", poles=[1.2, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7])
 
 
 # ---------------------------------------------------------------------------------------------- simulation
@@ -161,7 +161,7 @@ def test_user_poles_are_placed():
 
 def test_discrete_residual_decays_and_ignores_nuisance_faults():
     m = _random_model(7, dt=0.05)
-    d = uio(m, "u1_actuator")
+    d = uio(m, "u1_actuator", nuisance="others")
     rng = np.random.default_rng(11)
     N = 400
     t = np.arange(N) * m.dt
@@ -186,7 +186,7 @@ def test_discrete_residual_decays_and_ignores_nuisance_faults():
 
 def test_continuous_residual_decays_from_a_wrong_initial_state():
     m = _random_model(8)
-    d = uio(m, "u1_actuator")
+    d = uio(m, "u1_actuator", nuisance="others")
     G = d.generator.internal_form(m)  # plant + filter, simulated exactly (ZOH inputs)
     rng = np.random.default_rng(12)
     dt, T = 0.02, 60.0
@@ -211,7 +211,7 @@ def test_sensor_fault_nuisance_with_actuator_target():
     m = FaultModel(A=_stable_a(rng, 4), C=rng.standard_normal((3, 4)), Bu=rng.standard_normal((4, 1)),
                    outputs=["a", "b", "c"], controls=["thr"], dt=None)
     m = m.with_sensor_faults(["b"]).with_actuator_faults(["thr"])
-    d = uio(m, "thr_actuator")
+    d = uio(m, "thr_actuator", nuisance="others")
     assert d.decoupled == ("b_sensor",) and d.generator.residuals == ("thr_actuator[0]",)
     np.testing.assert_allclose(d.E, sensor_fault_map(m, "b"), atol=1e-13)
     w = W_CONT
@@ -219,7 +219,7 @@ def test_sensor_fault_nuisance_with_actuator_target():
     assert np.all(Rf[:, 0] <= 1e-9 * Rf[:, 1]) and np.all(Rf[:, 1] > 1e-4)
     # in time (discretised plant): a sensor bias leaves r at zero, an actuator bias does not
     md = m.discretize(0.05)
-    dd = uio(md, "thr_actuator")
+    dd = uio(md, "thr_actuator", nuisance="others")
     t = np.arange(300) * 0.05
     u = np.sin(t)[:, None]
     quiet = dd.generator.run(simulate(md, FaultScenario([Bias("b", 2.0, onset=3.0)]), t=t, u=u)).r
@@ -234,14 +234,14 @@ def test_path_vehicle_14_actuator_faults():
     # throttle and brake act through actuator-lag states that C does not measure (C B = 0):
     # every UIO of the three-fault bank has a nuisance direction the outputs cannot see
     with pytest.raises(DesignError, match=r"rank\(C E\) = 1 < rank\(E\) = 2.*\['brake_actuator'\]"):
-        uio(m, "throttle_actuator")
+        uio(m, "throttle_actuator", nuisance="others")
     both = r"rank\(C E\) = 0 < rank\(E\) = 2.*\['throttle_actuator', 'brake_actuator'\]"
     with pytest.raises(DesignError, match=both):
-        uio(m, "steering_actuator")
+        uio(m, "steering_actuator", nuisance="others")
     with pytest.raises(DesignError, match=r"target 'throttle_actuator': rank\(C E\) = 1 < rank\(E\) = 2.*\['brake_"):
         uio_bank(m)
     with pytest.raises(DesignError, match=r"rank\(C E\) = 1 < rank\(E\) = 2.*\['throttle_actuator'\]"):
-        uio(m, "brake_actuator")
+        uio(m, "brake_actuator", nuisance="others")
     # the steering actuator alone is visible (rank C B = 1) and (A, B_steer, C) has no invariant zeros
     assert invariant_zeros(m.A, m.C, m.Bu[:, [2]])[0].size == 0
     w = np.logspace(-2, 3, 100)
@@ -270,24 +270,24 @@ def test_invisible_nuisance_is_a_rank_error():
     m = FaultModel(A=_stable_a(rng, 5), C=C, Bf=np.column_stack([hidden, rng.standard_normal(5)]),
                    faults=["ghost", "real"])
     with pytest.raises(DesignError, match=r"rank\(C E\) = 0 < rank\(E\) = 1.*\['ghost'\]"):
-        uio(m, "real")
+        uio(m, "real", nuisance="others")
     # jointly invisible: two directions whose output images are parallel
     v = rng.standard_normal(5)
     m2 = FaultModel(A=m.A, C=C, Bf=np.column_stack([v, v + hidden, rng.standard_normal(5)]), faults=["a", "b", "t"])
     with pytest.raises(DesignError, match=r"rank\(C E\) = 1 < rank\(E\) = 2.*jointly.*\['a', 'b'\]"):
-        uio(m2, "t")
+        uio(m2, "t", nuisance="others")
 
 
 def test_stable_invariant_zero_is_kept_and_the_rest_placed():
     m = _zero_model(-0.7)
     np.testing.assert_allclose(invariant_zeros(m.A, m.C, m.Bf[:, :1])[0], [-0.7], atol=1e-10)
-    d = uio(m, "tg")
+    d = uio(m, "tg", nuisance="others")
     np.testing.assert_allclose(d.fixed_modes, [-0.7], atol=1e-10)
     assert "4 of 5 poles assignable" in d.notes[0] and "-0.7" in d.notes[0]
     assert max(d.decoupling.values()) < 1e-11
     with pytest.raises(DesignError, match=r"need 4 UIO poles \(n = 5 minus 1 fixed modes \[-0\.7\]\), got 5"):
-        uio(m, "tg", poles=[-1.0, -2.0, -3.0, -4.0, -5.0])
-    d2 = uio(m, "tg", poles=[-2.0, -3.0, -4.0, -5.0])
+        uio(m, "tg", nuisance="others", poles=[-1.0, -2.0, -3.0, -4.0, -5.0])
+    d2 = uio(m, "tg", nuisance="others", poles=[-2.0, -3.0, -4.0, -5.0])
     np.testing.assert_allclose(np.sort(d2.poles.real), [-5.0, -4.0, -3.0, -2.0, -0.7], atol=1e-8)
     # the fixed mode is the slowest pole: the error decays like exp(-0.7 t), and still decouples 'nu'
     Rf = _gains(d2.generator.internal_form(m).freqresp(W_CONT, "f"))
@@ -297,11 +297,11 @@ def test_stable_invariant_zero_is_kept_and_the_rest_placed():
 def test_unstable_invariant_zero_is_named():
     m = _zero_model(0.5)
     with pytest.raises(DesignError, match=r"not detectable: its unobservable modes \[0\.5\].*invariant zeros"):
-        uio(m, "tg")
+        uio(m, "tg", nuisance="others")
     with pytest.raises(DesignError, match=r"modes \[-1\.2\].*\|z\| < 1"):
-        uio(_zero_model(-1.2, dt=0.1), "tg")
+        uio(_zero_model(-1.2, dt=0.1), "tg", nuisance="others")
     # the same structure with |z| < 1 is a fixed mode of a working discrete UIO
-    d = uio(_zero_model(-0.6, dt=0.1), "tg")
+    d = uio(_zero_model(-0.6, dt=0.1), "tg", nuisance="others")
     np.testing.assert_allclose(d.fixed_modes, [-0.6], atol=1e-10)
     assert np.all(np.abs(d.poles) < 1)
 
@@ -309,7 +309,7 @@ def test_unstable_invariant_zero_is_named():
 def test_bad_names_and_other_infeasible_specifications():
     m = _random_model(9)
     with pytest.raises(ModelError, match=r"no faults input named 'nope'"):
-        uio(m, "nope")
+        uio(m, "nope", nuisance="others")
     with pytest.raises(ModelError, match=r"no faults input named 'nope'"):
         uio(m, "u1_actuator", nuisance=["nope"])
     with pytest.raises(ModelError, match=r"also listed as a nuisance"):
@@ -321,17 +321,17 @@ def test_bad_names_and_other_infeasible_specifications():
     # decoupling as many directions as outputs leaves no residual
     small = _random_model(9, n=8, p=5)
     with pytest.raises(DesignError, match=r"uses rank\(C E\) = 5 of the 5 outputs; no residual is left"):
-        uio(small, "u1_actuator")
+        uio(small, "u1_actuator", nuisance="others")
     # disturbances on the outputs are refused
     with pytest.raises(DesignError, match=r"disturbances \['gust'\] reach the outputs directly"):
-        uio(m.replace(Dd=np.ones((7, 1))), "u1_actuator")
+        uio(m.replace(Dd=np.ones((7, 1))), "u1_actuator", nuisance="others")
     # a sensor direction outside Im C (C rank deficient) cannot be turned into a state fault
     rng = np.random.default_rng(2)
     Cd = np.vstack([rng.standard_normal((2, 4)), np.zeros((1, 4))])
     md = FaultModel(A=_stable_a(rng, 4), C=Cd, Bu=rng.standard_normal((4, 1))).with_sensor_faults(["y2"])
     md = md.with_actuator_faults(["u0"])
     with pytest.raises(DesignError, match=r"'y2_sensor' reaches the outputs along a direction outside the range of C"):
-        uio(md, "u0_actuator")
+        uio(md, "u0_actuator", nuisance="others")
 
 
 # ---------------------------------------------------------------------------------------------- bank and stacking
@@ -379,7 +379,7 @@ def test_stacked_generator_runs_like_its_parts():
 
 def test_bank_subset_and_extra_nuisance():
     m = _random_model(10)
-    bank = uio_bank(m, ["u0_actuator", "u1_actuator"], also_decouple=["y6_sensor"])
+    bank = uio_bank(m, ["u0_actuator", "u1_actuator"], nuisance=["y6_sensor"])
     assert [d.decoupled for d in bank] == [("u1_actuator", "y6_sensor", "gust"), ("u0_actuator", "y6_sensor", "gust")]
     with pytest.raises(ModelError):
         uio_bank(m, ["u0_actuator", "nope"])
@@ -394,7 +394,7 @@ def test_stack_generators_rejects_mismatches():
         stack_generators([])
     with pytest.raises(ModelError, match="same signals"):
         sub = m.submodel(outputs=list(m.outputs[::-1]))
-        stack_generators([a, uio(sub, "b_actuator").generator])
+        stack_generators([a, uio(sub, "b_actuator", nuisance="others").generator])
     with pytest.raises(ModelError, match="dt="):
         stack_generators([a, b.discretize(0.1)])
     with pytest.raises(ModelError, match=r"residual names \['a_actuator\[0\]', 'a_actuator\[1\]'\]"):
@@ -407,22 +407,22 @@ def test_stack_generators_rejects_mismatches():
 
 
 def test_f16xl_bank_matches_the_seed_structure():
-    """Murray (2012) Example 1 (research note §8.1): C = I, faults θ sensor, elevon δ, wind gust wg."""
+    """Murray (2012) Example 1: C = I, faults θ sensor, elevon δ, wind gust wg."""
     A = np.array([[-0.0674, 0.0430, -0.8886, -0.5587], [0.0205, -1.4666, 16.5800, -0.0299],
                   [0.1377, -1.6788, -0.6819, 0.0], [0.0, 0.0, 1.0, 0.0]])
     m = FaultModel(A=A, C=np.eye(4), Bu=[[-0.1672], [-1.5179], [-9.7842], [0.0]], controls=["elevon"],
                    states=["u", "w", "q", "theta"], outputs=["u", "w", "q", "theta"])
     m = m.with_sensor_faults(["theta"]).with_actuator_faults(["elevon"]).add_faults(["gust"], A[:, [1]])
     bank = uio_bank(m)
-    # sensor-fault directions span the note's F_θ = [e4, −A e4]
+    # sensor-fault directions span F_θ = [e4, −A e4] (C = I, so F¹ = e4)
     F_theta = np.array([[0, 0.5587], [0, 0.0299], [0, 0], [1.0, 0]])
     assert rank(np.hstack([bank[1].E[:, :2], F_theta])) == 2
-    # residual counts = ranks of the note's projectors: Ĥ_θ rank 2, Ĥ_δ and Ĥ_wg rank 1
+    # residual counts = ranks of the projectors (3.10): Ĥ_θ rank 2, Ĥ_δ and Ĥ_wg rank 1
     assert [len(d.generator.residuals) for d in bank] == [2, 1, 1]
     g = stack_generators([d.generator for d in bank])
     R = g.internal_form(m).freqresp(W_CONT, "f")
     rows = {0: [0, 1], 1: [2], 2: [3]}
     for i in range(3):
         block = np.linalg.norm(R[:, rows[i], :], axis=1)
-        # exact isolation, where the seed's game-theoretic bank reaches a ratio of 450-1200 (note §8.1.1)
+        # exact isolation, where the seed's game-theoretic bank reaches a ratio of 450-1200
         assert np.all(np.delete(block, i, axis=1) <= 1e-10 * block[:, [i]])

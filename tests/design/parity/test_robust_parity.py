@@ -1,10 +1,10 @@
-"""Robust uncertain-LPV parity design (Varrier, Koenig & Martinez 2014, §4; research note §5 items 8–12).
+"""Robust uncertain-LPV parity design (Varrier, Koenig & Martinez 2014, §4).
 
 Oracles: random and optimised Rayleigh quotients (scipy.optimize), an orthonormal null-space
 basis (scipy), the closed-form minimisers of 𝒫₂ (Lagrange) and of the sign-enumerated ‖W₂‖₁
 constraint, eigenvalue checks of every returned LMI matrix, det·inv for the adjugate, and the
-moment-curve identity of the Property-1 simplex.  Where the note's scratch reconstruction (§4)
-printed a number, it is quoted as such.
+moment-curve identity of the Property-1 simplex.  Where an independent reconstruction of the
+example gave a number, it is quoted as such.
 """
 
 from __future__ import annotations
@@ -76,7 +76,7 @@ def test_gammas_are_symmetric_psd_with_the_expected_ranks(crit48):
 def test_theorem1_attains_the_minimum(crit48):
     """Note item 8: J(W₂*) = λ_min; random and locally optimised W₂ never do better.
 
-    λ_min(0.048) = 0.040359 and W₂* as in the note's reconstruction (§4.1)."""
+    λ_min(0.048) = 0.040359 and W₂* as in an independent reconstruction."""
     c = crit48
     e = theorem1(c.gamma1, c.gamma2, sign_ref=c.fault_direction)
     assert _J(e.W2, c) == pytest.approx(e.lambda_min, rel=1e-10)
@@ -134,10 +134,10 @@ def test_gamma_kappa_is_pd_iff_kappa_squared_below_lambda_min():
 
 
 def test_paper_kappa_27_is_refused_with_the_largest_valid_kappa():
-    """§5.3 κ = 27 makes Γ_κ indefinite for every ρ (note §4.3); κ_max = sqrt(min λ_min) = 0.149 on [0, 0.2]."""
+    """§5.3 κ = 27 makes Γ_κ indefinite for every ρ; κ_max = sqrt(min λ_min) = 0.149 on [0, 0.2]."""
     grid = robust_criteria(LPV, UNC, np.linspace(0, 0.2, 41), 3)
     k_max = kappa_max(grid.gamma1, grid.gamma2)
-    assert k_max == pytest.approx(np.sqrt(0.0222147), rel=1e-4)  # λ_min at ρ = 0 (note §4.2: 0.0222)
+    assert k_max == pytest.approx(np.sqrt(0.0222147), rel=1e-4)  # λ_min at ρ = 0 (independent reconstruction: 0.0222)
     with pytest.raises(DesignError, match=r"largest valid κ is 0\.1490"):
         robust_lpv_parity(LPV, UNC, 3, kappa=27.0, rho_max=0.2)
     c = robust_criteria(LPV, UNC, 0.048, 3)
@@ -260,7 +260,7 @@ def test_scheduled_w2_is_continuous_nonzero_and_decouples(design):
     """Note item 12 and the LMI feasibility check: cᵀW₂(ρ) = 1, Lipschitz in ρ, W(ρ)ᵀH_os(ρ) = 0."""
     d = design
     assert d.order == 5 and d.W_vertices.shape == (6, 6) and len(d.vertices) == 6
-    assert d.n_repaired == (0, 3, 1, 4, 0, 4)  # note §4.2: vertex minimum eigenvalues 41, −2.0e7, −1.3e4, …
+    assert d.n_repaired == (0, 3, 1, 4, 0, 4)  # independent: vertex minimum eigenvalues 41, −2.0e7, −1.3e4, …
     np.testing.assert_allclose([np.linalg.eigvalsh(V)[0] for V in d.vertices[[0, 1, 4]]], [41.24, -1.994e7, 3985.0],
                                rtol=1e-3)
     for V, W, g in zip(d.repaired, d.W_vertices, d.gamma):  # every vertex LMI (39) holds at the returned point
@@ -316,9 +316,9 @@ def test_design_report_counts_and_adjugate_variant(design):
 
 def test_bad_criteria_input_is_refused():
     with pytest.raises(DesignError, match="no target fault"):
-        robust_criteria(LPV, UNC, 0.048, 3, nuisance_faults=["lateral_acceleration_sensor"])
+        robust_criteria(LPV, UNC, 0.048, 3, nuisance=["lateral_acceleration_sensor"])
     with pytest.raises(ModelError, match="no fault named"):
-        robust_criteria(LPV, UNC, 0.048, 3, nuisance_faults=["yaw_rate_sensor"])
+        robust_criteria(LPV, UNC, 0.048, 3, nuisance=["yaw_rate_sensor"])
     with pytest.raises(ModelError, match="fault_model"):
         robust_criteria(LPV, UNC, 0.048, 3, fault_model="ramp")
     with pytest.raises(ModelError, match="rho_min < rho_max"):

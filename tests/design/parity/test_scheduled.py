@@ -1,4 +1,4 @@
-"""Speed-scheduled (LPV) parity filter: van der Ploeg 2018, Lemma 3-3.2, Thm 3-3.4, Sec. 4-3-4; note §6 item 10."""
+"""Speed-scheduled (LPV) parity filter: van der Ploeg 2018, Lemma 3-3.2, Thm 3-3.4, Sec. 4-3-4."""
 
 from __future__ import annotations
 
@@ -52,7 +52,7 @@ def test_family_is_the_sampled_single_track():
 
 
 def test_lpv_bar_matrices_follow_the_window():
-    """Lemma 3-3.2 (time-consistent, note §4 A13): block row i holds H_0(ρ(τ_i)) at column i and H_1 at i + 1."""
+    """Lemma 3-3.2 (time-consistent A13): block row i holds H_0(ρ(τ_i)) at column i and H_1 at i + 1."""
     gen = scheduled_parity_filter(FAMILY, V70)
     rhos = np.array([70.0, 95.0, 120.0]) * KMH
     Hb, Lb, Fb = lpv_bar_matrices([gen.dae(r) for r in rhos])
@@ -94,9 +94,9 @@ def test_closed_form_tends_to_the_projection_and_solves_the_qp():
         assert np.abs(row - ref).max() <= 1e-15 * gamma * np.abs(ref).max()  # forming γ H̄H̄ᵀ costs ~ γ eps ‖H̄‖²
         gaps.append(np.linalg.norm(row - proj) / np.linalg.norm(proj))
         cosines.append(row @ proj / (np.linalg.norm(row) * np.linalg.norm(proj)))
-    # slow convergence: the smallest non-zero singular value 3.2e-6 needs γ ≫ 1/σ² ≈ 1e11 (note §5.2)
+    # slow convergence: the smallest non-zero singular value 3.2e-6 needs γ ≫ 1/σ² ≈ 1e11
     assert all(a > b for a, b in zip(gaps, gaps[1:])) and gaps[-1] < 0.1
-    assert cosines[1] == pytest.approx(0.77, abs=0.005)  # note §5.6 [D]: cosine ≈ 0.77 at γ = 1e7
+    assert cosines[1] == pytest.approx(0.77, abs=0.005)  # independent reproduction: cosine ≈ 0.77 at γ = 1e7
     assert cosines[-1] > 0.99
     # independent convex solve of (3.16): max N̄F̄_j s.t. N̄H̄ = 0, ‖N̄‖ ≤ 1 (Clarabel via cvxpy)
     n = cp.Variable(Hb.shape[0])
@@ -106,7 +106,7 @@ def test_closed_form_tends_to_the_projection_and_solves_the_qp():
 
 
 def test_q2_column_is_degenerate():
-    """Sec. 4-3-4 / note §5.2: the q² column of F̄ lies in the range of H̄, so (3.17) gives N̄ ≈ 0 there."""
+    """Sec. 4-3-4: the q² column of F̄ lies in the range of H̄, so (3.17) gives N̄ ≈ 0 there."""
     Hb, _, Fb = bar_matrices(dae_form(FAMILY(V70)), 2)
     assert np.linalg.norm(lpv_parity_row(Hb, Fb[:, 2])) <= 1e-14 * np.linalg.norm(Fb[:, 2])
     ratios = [np.linalg.norm(lpv_parity_row(Hb, Fb[:, 2], g)) / np.linalg.norm(lpv_parity_row(Hb, Fb[:, 0], g))
@@ -124,7 +124,7 @@ def _s1_trace(duration=70.0):
 
 
 def test_constant_speed_reproduces_lti_and_vaf_rises_with_gamma():
-    """Checklist 10: exact with the projection; VAF(LTI, LPV) rises with γ and exceeds 99.9 % at γ = 1e7.
+    """Sec. 4-3-4, Fig. 4-14: exact with the projection; VAF(LTI, LPV) rises with γ and exceeds 99.9 % at γ = 1e7.
 
     The thesis prints VAF = 99.98 % at γ = 1e7 and "γ > 8·10⁶ approaches the LTI result" (Fig. 4-14).
     """

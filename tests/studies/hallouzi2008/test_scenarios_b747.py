@@ -1,4 +1,4 @@
-"""B747 linear FDI benchmark (Hallouzi 2008, §2.4.1, Table 2.6; research note §3.1, checklist §4.2 item 18)."""
+"""B747 linear FDI benchmark (Hallouzi 2008, §2.4.1, Table 2.6)."""
 
 import numpy as np
 import pytest

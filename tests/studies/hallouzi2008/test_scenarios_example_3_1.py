@@ -1,4 +1,4 @@
-"""Example 3.1 / Table 3.1 (Hallouzi 2008, §3.3.1; checklist §4.2 item 19): parameter-basis conditioning and the
+"""Example 3.1 / Table 3.1 (Hallouzi 2008, §3.3.1): parameter-basis conditioning and the
 degree of observability of model pairs."""
 
 import numpy as np

@@ -1,4 +1,4 @@
-"""MSD OD model set + augmented EKF (Hallouzi 2008, §3.6.2, Table 3.3, Figs 3.8–3.9; checklist §4.2 item 20)."""
+"""MSD OD model set + augmented EKF (Hallouzi 2008, §3.6.2, Table 3.3, Figs 3.8–3.9)."""
 
 import numpy as np
 import pytest

@@ -1,4 +1,4 @@
-"""Maneuvering-target tracking benchmark, Hallouzi 2008, §2.4.2 (checklist item 17, reduced to 8 runs).
+"""Maneuvering-target tracking benchmark, Hallouzi 2008, §2.4.2, Figs. 2.4–2.5 (reduced to 8 runs).
 
 Fixed seed; the assertions are the thesis' qualitative statements (§2.4.2, Figs 2.4–2.5) with margins
 measured on this seed (values in the comments).

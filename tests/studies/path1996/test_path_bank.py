@@ -1,4 +1,4 @@
-"""The PATH four-filter bank (Douglas et al. 1996, §4.1–4.2, §5.1.1): checklist R-FDF-1, 3, 4, 6, 7 and the
+"""The PATH four-filter bank (Douglas et al. 1996, §4.1–4.2, §5.1.1): properties R-FDF-1, 3, 4, 6, 7 and the
 single-fault isolation of all 15 faults in linear simulation."""
 
 import numpy as np
@@ -33,7 +33,8 @@ def _design_model(name):
 
 
 def test_spectra_are_the_assigned_sets(bank):
-    """R-FDF-1: eig(A + LC) = Ξ_0 ∪ Ξ_1 ∪ … to 1e-8 relative (filter 4: throttle {−4, −9}, steering {−6} ...)."""
+    """R-FDF-1: eig(A − LC) (the report's A + LC) = Ξ_0 ∪ Ξ_1 ∪ … to 1e-8 relative (filter 4: throttle {−4, −9},
+    steering {−6} ...)."""
     for name, d in bank.designs.items():
         sets, comp = EIGENVALUES[name]
         want = np.sort(np.concatenate([np.concatenate(sets), comp]))

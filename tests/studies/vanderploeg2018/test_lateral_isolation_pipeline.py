@@ -1,6 +1,6 @@
 """Unified LPV parity filter + pre-filter + isolation under varying speed (van der Ploeg 2018, Sec. 4-3-5).
 
-Checklist item 11 of the van der Ploeg note: the speed-scheduled filter (Thm 3-3.4) feeds the
+van der Ploeg 2018, Sec. 4-3-5: the speed-scheduled filter (Thm 3-3.4) feeds the
 pre-filtered least-squares isolation (Sec. 3-2); f_a and f_m are both recovered while V_x sweeps
 70 → 120 km/h, and the accuracy improves with γ (exact with the γ → ∞ projection).
 """

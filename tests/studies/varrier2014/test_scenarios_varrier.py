@@ -1,4 +1,4 @@
-"""The a_y-sensor fault scenario of Varrier, Koenig & Martinez 2014, §5.4–5.5 (research note §5 items 14–15).
+"""The a_y-sensor fault scenario of Varrier, Koenig & Martinez 2014, §5.4–5.5.
 
 Item 14 is asserted: the fault is +0.5 m/s² on a_y over [150 s, 158 s) only, the residuals are
 normalised to mean one over the faulty time and ϖ is computed exactly as defined.  Item 15: the paper's
