@@ -27,10 +27,33 @@ def project_to_simplex(mu, ordering: str = "michelot") -> np.ndarray:
     unconstrained μ̂, as §2.3.2 words it; it can differ when ``1ᵀμ̂ < 1`` (``tests/multimodel/test_convex.py``
     shows a case).
 
-    Example
+    Parameters
+    ----------
+    mu : array_like
+        Unconstrained weights μ̂ (N), finite.
+    ordering : {"michelot", "thesis"}
+        When the negative weights are fixed at 0 (see above); default ``"michelot"``.
+
+    Returns
     -------
+    ndarray
+        Constrained weights ``μ^c`` (N), non-negative and summing to 1.
+
+    Raises
+    ------
+    ModelError
+        On an unknown ``ordering``.
+    DataError
+        If ``mu`` is empty or not finite.
+
+    Examples
+    --------
     >>> project_to_simplex([0.9, 0.5, -0.2]).round(3).tolist()
     [0.7, 0.3, 0.0]
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.2, (2.37)–(2.38) and the inequality step that follows them.
     """
     if ordering not in ("michelot", "thesis"):
         raise ModelError(f"ordering must be 'michelot' or 'thesis', got {ordering!r}")
@@ -59,11 +82,36 @@ def project_to_simplex_weighted(mu, W, ridge: float = 1e-9) -> np.ndarray:
     do not determine) is regularised by ``ridge · tr(W)/N · I``, so the projection moves along the
     undetermined directions first.  With ``W = I`` this is the Euclidean projection.
 
-    Example
+    Parameters
+    ----------
+    mu : array_like
+        Unconstrained weights μ̂ (N), finite.
+    W : array_like
+        Symmetric positive semidefinite metric (N x N), e.g. the RLS information ``TᵀT``.
+    ridge : float, optional
+        Relative regularisation of a singular ``W`` (default 1e-9).
+
+    Returns
     -------
+    ndarray
+        Constrained weights (N), non-negative and summing to 1.
+
+    Raises
+    ------
+    ModelError
+        If ``W`` is not a finite N x N matrix, or the active-set loop does not converge (``W`` not PSD).
+    DataError
+        If ``mu`` is empty or not finite.
+
+    Examples
+    --------
     >>> W = np.array([[1.0, 0.0], [0.0, 100.0]])   # the second weight is 100x better determined
     >>> project_to_simplex_weighted([0.6, 0.6], W).round(4).tolist()
     [0.402, 0.598]
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.2, (2.37)–(2.38) with a general W.
     """
     y = _weights(mu)
     N = y.size
@@ -97,10 +145,28 @@ def project_to_affine(mu, W=None, ridge: float = 1e-9) -> np.ndarray:
     For model sets that represent the large set *affinely*, such as the OD sets of (3.21), whose weights
     may be negative.  ``W`` defaults to ``I``: ``m = μ − 1 (1ᵀμ − 1)/N``.
 
-    Example
+    Parameters
+    ----------
+    mu : array_like
+        Unconstrained weights (N), finite.
+    W : array_like, optional
+        Symmetric PSD metric (N x N); the identity if omitted.
+    ridge : float, optional
+        Relative regularisation of a singular ``W`` (default 1e-9).
+
+    Returns
     -------
+    ndarray
+        Weights (N) summing to 1 (possibly negative).
+
+    Examples
+    --------
     >>> project_to_affine([0.9, 0.5, -0.2]).round(4).tolist()
     [0.8333, 0.4333, -0.2667]
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.2, (2.38); §3.3.2, (3.21) (the affine OD sets).
     """
     y = _weights(mu)
     N = y.size
@@ -146,10 +212,35 @@ def constrain_weights(mu, constrain, W=None, ordering: str = "michelot") -> np.n
     Euclidean one with the given ``ordering``), ``"affine"`` (1ᵀμ = 1 only, for OD sets), ``"box"``
     (each μ_j clipped to [0, 1], for limit-value sets, (3.39)) or ``False`` (unchanged).
 
-    Example
+    Parameters
+    ----------
+    mu : array_like
+        Unconstrained weights (N), finite.
+    constrain : bool or {"simplex", "affine", "box"}
+        The constraint, as above.
+    W : array_like, optional
+        Projection metric (N x N) for ``"simplex"``/``"affine"``; the identity if omitted.
+    ordering : {"michelot", "thesis"}
+        Ordering of the Euclidean simplex projection (:func:`project_to_simplex`).
+
+    Returns
     -------
+    ndarray
+        Constrained weights (N).
+
+    Raises
+    ------
+    ModelError
+        On an unknown ``constrain`` (or as the projections).
+
+    Examples
+    --------
     >>> constrain_weights([1.2, -0.1], "box").tolist(), constrain_weights([0.7, 0.5], "affine").tolist()
     ([1.0, 0.0], [0.6, 0.4])
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.2, (2.37)–(2.38); §3.5, (3.39)–(3.40) (weights in [0, 1]).
     """
     if constrain is False:
         return _weights(mu)
