@@ -100,8 +100,8 @@ CASES = [
     # ------------------------------------------------------------------ PATH monitor
     case("path-fault-model-13", lambda: path_fault_model(13), ParameterError, "n_states", "13"),
     case("path-bank-dt-negative", lambda: path_bank(dt=-0.01), ParameterError, "dt", "positive"),
-    case("path-bank-eig-unknown", lambda: path_bank(eigenvalues={"filter9": [-1.0]}), ParameterError,
-         "eigenvalues", "filter9"),
+    case("path-bank-eig-unknown", lambda: path_bank(poles={"filter9": [-1.0]}), ParameterError,
+         "poles", "filter9"),
     case("path-runs-not-bank", lambda: path_runs("bank"), ParameterError, "bank", "PathBank"),
     case("path-runs-duration", lambda: path_runs(_BANK(), duration=0.0), ParameterError, "duration", "positive"),
     case("path-runs-count", lambda: path_runs(_BANK(), runs_per_fault=-1), ParameterError, "runs_per_fault",

@@ -196,7 +196,7 @@ def _dc(model: FaultModel, gen: ResidualGenerator) -> np.ndarray:
     return R.C @ np.linalg.solve(M, R.Bf) + R.Df
 
 
-def path_bank(dt: float | None = None, eigenvalues: dict | None = None) -> PathBank:
+def path_bank(dt: float | None = None, poles: dict | None = None) -> PathBank:
     """Design the PATH four-filter bank (continuous, or on the ZOH models at ``dt`` with ``e^{λ dt}``).
 
     Parameters
@@ -204,9 +204,9 @@ def path_bank(dt: float | None = None, eigenvalues: dict | None = None) -> PathB
     dt : float, optional
         Sample time [s]; the filters are designed on the ZOH models with the eigenvalues mapped to
         ``e^{λ dt}``.  ``None`` (default) designs in continuous time.
-    eigenvalues : dict, optional
+    poles : dict, optional
         Filter name → ``(sets, complement)`` replacing entries of :data:`EIGENVALUES` (continuous-time
-        eigenvalues: one list per fault in :data:`FILTER_GROUPS` order, then Ξ_0).
+        eigenvalues of ``A − L C``: one list per fault in :data:`FILTER_GROUPS` order, then Ξ_0).
 
     Returns
     -------
@@ -219,7 +219,7 @@ def path_bank(dt: float | None = None, eigenvalues: dict | None = None) -> PathB
     DesignError
         When a filter cannot be designed (the message names the filter).
     ParameterError
-        For a bad ``dt`` or ``eigenvalues`` that name no filter of :data:`FILTER_GROUPS`.
+        For a bad ``dt`` or ``poles`` that name no filter of :data:`FILTER_GROUPS`.
 
     References
     ----------
@@ -235,15 +235,15 @@ def path_bank(dt: float | None = None, eigenvalues: dict | None = None) -> PathB
     """
     if dt is not None:
         dt = validate.positive("dt", dt)
-    if eigenvalues is not None:
-        if not isinstance(eigenvalues, Mapping):
-            raise ParameterError(f"eigenvalues must be a dict filter name -> (sets, complement), got "
-                                 f"{type(eigenvalues).__name__}")
-        unknown = sorted(set(eigenvalues) - set(FILTER_GROUPS))
+    if poles is not None:
+        if not isinstance(poles, Mapping):
+            raise ParameterError(f"poles must be a dict filter name -> (sets, complement), got "
+                                 f"{type(poles).__name__}")
+        unknown = sorted(set(poles) - set(FILTER_GROUPS))
         if unknown:
-            raise ParameterError(f"eigenvalues given for unknown filter(s) {unknown}; the filters are "
+            raise ParameterError(f"poles given for unknown filter(s) {unknown}; the filters are "
                                  f"{list(FILTER_GROUPS)}")
-    eig = dict(EIGENVALUES, **(eigenvalues or {}))
+    eig = dict(EIGENVALUES, **(poles or {}))
     nominal = nominal_fault_sizes()
     designs, gens, groups, scales = {}, [], [], {}
     for name, specs in FILTER_GROUPS.items():
