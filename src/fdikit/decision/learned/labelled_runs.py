@@ -23,7 +23,40 @@ __all__ = ["LabelledInputs", "as_runs", "one_hot_targets", "posterior_decisions"
 
 @dataclass(frozen=True)
 class LabelledInputs:
-    """How a residual row becomes the network/classifier input."""
+    """How a residual row becomes the network/classifier input.
+
+    Calling the object maps residual rows ``(..., n_columns)`` to inputs ``(..., len(keys))``: per group, the
+    Euclidean magnitude of its residuals (``magnitude``) or the residual itself (raw), divided by ``scale``.
+    Build it with ``LabelledInputs.build(names, isolates, mode, columns)``: ``mode`` ``"magnitude"`` groups the
+    residuals tied to the same fault (an untied one by its name), ``"raw"`` keeps one input per residual;
+    ``columns`` (names, or None for all) selects the residuals used.
+
+    Attributes
+    ----------
+    n_columns : int
+        Number of residuals a row must have.
+    groups : tuple of tuple of int
+        Residual indices behind each input.
+    keys : tuple of str
+        Each input's name: the fault of its group, or the residual's name.
+    magnitude : bool
+        Whether an input is its group's magnitude (else the raw residual).
+    scale : (len(keys),) ndarray
+        Divisor of each input (ones from ``build``).
+
+    References
+    ----------
+    Douglas et al. 1996, §5.1.1 (residual magnitudes per fault) and §6.4 (the residual process as the input of
+    the Bayesian neural networks).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.decision.learned.labelled_runs import LabelledInputs
+    >>> inputs = LabelledInputs.build(("a0", "a1", "b"), ("fa", "fa", "fb"), "magnitude", None)
+    >>> inputs.keys, inputs(np.array([3.0, 4.0, 1.0])).tolist()
+    (('fa', 'fb'), [5.0, 1.0])
+    """
 
     n_columns: int
     groups: tuple[tuple[int, ...], ...]
@@ -64,7 +97,43 @@ class LabelledInputs:
 
 
 def as_runs(data, labels) -> list[tuple[Residuals, np.ndarray]]:
-    """Training data as (residuals, per-sample labels) pairs."""
+    """Training data as (residuals, per-sample labels) pairs.
+
+    Parameters
+    ----------
+    data : mapping, Residuals or sequence of Residuals
+        ``{label: Residuals or sequence of Residuals}`` (the key labels every sample: ``"none"`` or a fault name,
+        ``"fa+fb"`` for several), or runs whose labels come from ``labels``.
+    labels : str, sequence or None
+        None with a mapping; otherwise one entry per run: a label for the whole run, or an (N,) array of
+        per-sample labels.
+
+    Returns
+    -------
+    list of (Residuals, (N,) object ndarray)
+        Each run with its per-sample labels as strings.
+
+    Raises
+    ------
+    ParameterError
+        When ``labels`` is given with a mapping, or missing with runs.
+    DataError
+        When an item is not a ``Residuals``, the numbers of runs and labels differ, a label array does not have
+        one entry per sample, there is no data, or the runs differ in their residual names.
+
+    References
+    ----------
+    Douglas et al. 1996, §6.4 (networks trained on simulated runs with and without each fault).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.residuals import Residuals
+    >>> from fdikit.decision.learned.labelled_runs import as_runs
+    >>> r = Residuals(np.arange(4) * 0.1, np.zeros((4, 1)), ("r",), ("f",))
+    >>> [(len(res), str(lab[0])) for res, lab in as_runs({"none": r, "f": [r, r]}, None)]
+    [(4, 'none'), (4, 'f'), (4, 'f')]
+    """
     runs: list[tuple[Residuals, np.ndarray]] = []
     if isinstance(data, Mapping):
         if labels is not None:
@@ -101,7 +170,32 @@ def as_runs(data, labels) -> list[tuple[Residuals, np.ndarray]]:
 
 
 def one_hot_targets(labels: np.ndarray, hypotheses: tuple[str, ...]) -> np.ndarray:
-    """One-hot targets (§6.2.2): zeros for 'none' and for faults outside the hypotheses."""
+    """One-hot targets (§6.2.2): zeros for 'none' and for faults outside the hypotheses.
+
+    Parameters
+    ----------
+    labels : (N,) array of str
+        Per-sample labels; ``"fa+fb"`` sets both columns.
+    hypotheses : tuple of str
+        The fault hypotheses, one output column each.
+
+    Returns
+    -------
+    (N, len(hypotheses)) ndarray
+        ``z_k``: 1 where the sample's label contains the hypothesis, else 0.
+
+    References
+    ----------
+    Douglas et al. 1996, §6.2.2 (the desired output ``z_k``, a unit vector for class ``i``, zero outside the
+    classes).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.decision.learned.labelled_runs import one_hot_targets
+    >>> one_hot_targets(np.array(["none", "fa", "fa+fb"], dtype=object), ("fa", "fb")).tolist()
+    [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]
+    """
     Z = np.zeros((labels.size, len(hypotheses)))
     for j, h in enumerate(hypotheses):
         Z[:, j] = [h in str(lab).split("+") for lab in labels]
@@ -109,6 +203,45 @@ def one_hot_targets(labels: np.ndarray, hypotheses: tuple[str, ...]) -> np.ndarr
 
 
 def posterior_decisions(t, P, valid, hypotheses, threshold, meta) -> Diagnosis:
+    """The diagnosis from posterior probabilities: a hypothesis fires at or above ``threshold``.
+
+    The alarm is on when any hypothesis fires; the isolated fault is then the most probable hypothesis (also
+    when it is not the fired one), ``"none"`` otherwise.
+
+    Parameters
+    ----------
+    t : (N,) ndarray
+        Sample times [s].
+    P : (N, m) ndarray
+        Posterior probability of each fault hypothesis per sample.
+    valid : (N,) bool ndarray
+        Validity per sample (passed to the diagnosis).
+    hypotheses : tuple of str
+        The ``m`` fault names of the columns of ``P``.
+    threshold : float or (m,) array_like
+        Announcement probability per hypothesis.
+    meta : dict
+        Metadata of the diagnosis.
+
+    Returns
+    -------
+    Diagnosis
+        With ``fired = P >= threshold`` per hypothesis and ``probabilities = P``.
+
+    References
+    ----------
+    Douglas et al. 1996, §6.2.2 (network outputs as posterior probabilities) and §6.4 (a fault announced with
+    its probability).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.decision.learned.labelled_runs import posterior_decisions
+    >>> P = np.array([[0.1, 0.2], [0.7, 0.1]])
+    >>> d = posterior_decisions(np.array([0.0, 0.1]), P, np.array([True, True]), ("fa", "fb"), 0.5, {})
+    >>> d.alarm.tolist(), d.isolated.tolist()
+    ([False, True], ['none', 'fa'])
+    """
     fired = P >= threshold
     alarm = fired.any(axis=1)
     isolated = np.where(alarm, np.asarray(hypotheses, dtype=object)[np.argmax(P, axis=1)], NO_FAULT).astype(str)
