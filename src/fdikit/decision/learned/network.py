@@ -23,6 +23,49 @@ class BnnNetwork:
     ``w`` stacks ``W², θ², …, W^q, θ^q`` (row-major) and, when ``learn_feedback``, ``F`` last.
     Sequences are ``(B, T, n_in)`` arrays (or ``(T, n_in)``); a sample is used when ``valid`` and
     finite, otherwise the feedback state is held and the output repeats.
+
+    Parameters
+    ----------
+    widths : sequence of int
+        Layer widths ``(n_in, n_2, …, n_out)``: at least an input and an output layer, all positive.
+    feedback : (n_in, n_out) array_like, optional
+        ``F`` of ``x¹_k = u_k + F y_{k−1}``; default the rectangular identity.
+    learn_feedback : bool, default False
+        Train ``F`` along with the weights (it is then the last part of ``w``).
+
+    Attributes
+    ----------
+    widths : tuple of int
+        The layer widths.
+    feedback : (n_in, n_out) ndarray
+        ``F`` (the fixed one; when learned, the trained ``F`` is in the weight vector).
+    learn_feedback : bool
+        Whether ``F`` is part of ``w``.
+    n_params : int
+        Length of the flat weight vector ``w``.
+
+    Raises
+    ------
+    ParameterError
+        When there are fewer than two layers, a width is not positive, or ``feedback`` has the wrong shape or
+        non-finite entries.
+
+    References
+    ----------
+    Douglas et al. 1996, §6.1, (6.1) (the connections with one-step delayed output feedback, Fig. 6.1) and
+    §6.3.1 (the mean-squared-error cost ``J``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.decision.learned.network import BnnNetwork
+    >>> net = BnnNetwork((2, 3, 2))
+    >>> w = net.init(np.random.default_rng(0))
+    >>> net.n_params, net.forward(w, np.zeros((5, 2))).shape
+    (17, (5, 2))
+    >>> J, grad = net.cost_grad(w, np.ones((4, 2)), np.zeros((4, 2)))
+    >>> grad.shape
+    (17,)
     """
 
     def __init__(self, widths: Sequence[int], feedback=None, learn_feedback: bool = False) -> None:
