@@ -53,6 +53,38 @@ ACTUATOR_NOISE_STD = {"throttle": 0.05, "brake": 5.0, "steering": 2e-4}
 
 @dataclass(frozen=True, eq=False)
 class DemoResult:
+    """What :func:`run_kalman_demo` returns.
+
+    Attributes
+    ----------
+    trace : Trace
+        The faulty run (yaw-rate bias at ``onset``).
+    residuals : Residuals
+        The 12 Kalman innovations on it, each tied to its own sensor fault.
+    diagnosis : Diagnosis
+        The threshold decisions.
+    score : Score
+        Detection delay, false alarms and isolation of the run.
+    design : ObserverDesign
+        The steady-state Kalman filter.
+    evaluator : ThresholdEvaluator
+        Thresholds calibrated on the fault-free run.
+    files : dict of str to pathlib.Path
+        ``"trace"`` (``trace.parquet``) and ``"report"`` (``report.png``).
+
+    References
+    ----------
+    Douglas et al. 1996, App. D (the 12-state model), §5.1.1 (the 0.02 rad/s nominal rate-sensor fault).
+
+    Examples
+    --------
+    The demo simulates a calibration run and writes files (seconds), so it is not run here:
+
+    >>> result = run_kalman_demo("out/demo", duration=3.0, onset=1.0, calibration_minutes=0.5)  # doctest: +SKIP
+    >>> sorted(result.files), result.residuals.r.shape  # doctest: +SKIP
+    (['report', 'trace'], (301, 12))
+    """
+
     trace: Trace
     residuals: Residuals
     diagnosis: Diagnosis
@@ -66,12 +98,45 @@ def check_demo_arguments(*, out="out/demo", seed=2026, method="bank", onset=10.0
                          calibration_minutes=10.0, dt=0.01, **positive) -> Path:
     """Check the demo's arguments before any work; return the output folder (created, writable).
 
+    Parameters
+    ----------
+    out : str or PathLike, default "out/demo"
+        Output folder; created if missing, must be writable.
+    seed : int, default 2026
+        Seed, >= 0.
+    method : {"bank", "kalman"}, default "bank"
+        Which demo.
+    onset, duration : float, default 10.0, 30.0
+        Fault onset and run length [s]; ``onset < duration``.
+    calibration_minutes : float, default 10.0
+        Length of the fault-free calibration run [min].
+    dt : float, default 0.01
+        Sample time [s], smaller than ``duration``.
+    **positive : float
+        Further values that must be finite and > 0 (``fault_size``, ``noise_fraction``, ``false_alarms_per_hour``).
+
+    Returns
+    -------
+    pathlib.Path
+        The output folder.
+
     Raises
     ------
     ParameterError
         Naming the argument: ``method`` 'bank' or 'kalman', ``seed`` an integer >= 0, ``onset`` < ``duration``,
         times and the other keyword values (``fault_size``, ``noise_fraction``, ``false_alarms_per_hour``)
         finite and > 0, ``out`` a writable folder.
+
+    References
+    ----------
+    Douglas et al. 1996, §5.1.1 (the demo scenarios).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> folder = pathlib.Path(tempfile.mkdtemp()) / "demo"
+    >>> check_demo_arguments(out=folder, method="kalman", fault_size=0.02) == folder
+    True
     """
     from fdikit.resume import check_output_folder, check_positive, check_seed
 
@@ -90,7 +155,29 @@ def check_demo_arguments(*, out="out/demo", seed=2026, method="bank", onset=10.0
 
 
 def demo_model(dt: float = 0.01) -> FaultModel:
-    """The 12-state PATH model, actuator jitter as its noise group, sampled at ``dt``."""
+    """The 12-state PATH model, actuator jitter as its noise group, sampled at ``dt``.
+
+    Parameters
+    ----------
+    dt : float, default 0.01
+        ZOH sample time [s].
+
+    Returns
+    -------
+    FaultModel
+        Discrete 12-state model with the noise group ``<control>_jitter`` (entering like the controls,
+        ``Bw = Bu``, ``Dw = Du``) and the 12 fault inputs ``<output>_sensor``.
+
+    References
+    ----------
+    Douglas et al. 1996, App. D, (d.2a–d).
+
+    Examples
+    --------
+    >>> m = demo_model()
+    >>> m.n, m.dt, m.noise
+    (12, 0.01, ('throttle_jitter', 'brake_jitter', 'steering_jitter'))
+    """
     m = path_vehicle_12()
     m = m.replace(Bw=m.Bu, Dw=m.Du, noise=[f"{c}_jitter" for c in m.controls])
     return m.with_sensor_faults(m.outputs).discretize(dt)
@@ -109,6 +196,47 @@ def run_kalman_demo(
     """Run the demo; writes ``report.png`` and ``trace.parquet`` to ``out_dir`` (each atomically).
 
     Every argument is checked first (:func:`check_demo_arguments`).
+
+    Parameters
+    ----------
+    out_dir : str or PathLike, default "out/demo"
+        Output folder.
+    seed : int, default 2026
+        Seed of the calibration and test runs.
+    fault_size : float, default 0.02
+        Yaw-rate sensor bias [rad/s].
+    onset : float, default 10.0
+        Fault onset [s].
+    duration : float, default 30.0
+        Length of the faulty run [s].
+    calibration_minutes : float, default 10.0
+        Length of the fault-free calibration run [min].
+    false_alarms_per_hour : float, default 1.0
+        Design false-alarm rate of the thresholds.
+    dt : float, default 0.01
+        Sample time [s].
+
+    Returns
+    -------
+    DemoResult
+        Trace, innovations, diagnosis, score, Kalman design, evaluator and the written files.
+
+    Raises
+    ------
+    ParameterError
+        For a bad argument (see :func:`check_demo_arguments`).
+
+    References
+    ----------
+    Douglas et al. 1996, App. D; §5.1.1 (nominal rate-sensor fault), §5.1.2 (vertical accelerometer noise).
+
+    Examples
+    --------
+    A short run still simulates a calibration run and writes a plot (about 2 s), so it is not run here:
+
+    >>> result = run_kalman_demo("out/demo", duration=3.0, onset=1.0, calibration_minutes=0.5)  # doctest: +SKIP
+    >>> result.score.detected  # doctest: +SKIP
+    True
     """
     out = check_demo_arguments(out=out_dir, seed=seed, method="kalman", onset=onset, duration=duration,
                                calibration_minutes=calibration_minutes, dt=dt, fault_size=fault_size,
@@ -148,6 +276,36 @@ def run_kalman_demo(
 
 @dataclass(frozen=True, eq=False)
 class BankDemoResult:
+    """What :func:`run_demo` returns; the dicts are keyed by scenario label (:data:`BANK_SCENARIOS`).
+
+    Attributes
+    ----------
+    traces : dict of str to Trace
+        The faulty run of each scenario.
+    diagnoses : dict of str to Diagnosis
+        The bank's threshold decisions on each run.
+    scores : dict of str to Score
+        Detection and isolation score of each run.
+    evaluator : ThresholdEvaluator
+        Thresholds (grouped by filter, persistence 5 of 10) calibrated on the fault-free run.
+    noise : numpy.ndarray
+        (12,) sensor noise standard deviations used.
+    files : dict of str to pathlib.Path
+        ``"report"``, ``"structure"`` and one ``"trace (<label>)"`` per scenario.
+
+    References
+    ----------
+    Douglas et al. 1996, §4.1–4.2 (the bank), §5.1.1 (nominal fault sizes), Figs. 5.13–5.14.
+
+    Examples
+    --------
+    The demo designs the bank, simulates and writes files (seconds), so it is not run here:
+
+    >>> result = run_demo("out/demo", duration=3.0, onset=1.0, calibration_minutes=0.5)  # doctest: +SKIP
+    >>> sorted(result.scores)  # doctest: +SKIP
+    ['throttle +2 deg', 'yaw-rate gyro bias']
+    """
+
     traces: dict[str, Trace]
     diagnoses: dict[str, Diagnosis]
     scores: dict[str, Score]
@@ -177,6 +335,45 @@ def run_demo(
     reconstructed filters amplify noise strongly; see ``docs/methods/beard_jones.md``).
     Thresholds: 1 false alarm per hour on a fault-free run, persistence 5 of 10.  Every argument is
     checked first (:func:`check_demo_arguments`); every file is written atomically.
+
+    Parameters
+    ----------
+    out_dir : str or PathLike, default "out/demo"
+        Output folder.
+    seed : int, default 2026
+        Seed of the calibration and scenario runs.
+    onset : float, default 10.0
+        Fault onset [s].
+    duration : float, default 30.0
+        Length of each faulty run [s].
+    noise_fraction : float, default 1e-4
+        Sensor noise as a fraction of each sensor's nominal fault size.
+    calibration_minutes : float, default 10.0
+        Length of the fault-free calibration run [min].
+    dt : float, default 0.01
+        Sample time [s].
+
+    Returns
+    -------
+    BankDemoResult
+        Per scenario the trace, diagnosis and score; the evaluator, the noise levels and the written files.
+
+    Raises
+    ------
+    ParameterError
+        For a bad argument (see :func:`check_demo_arguments`).
+
+    References
+    ----------
+    Douglas et al. 1996, §4.1–4.2 (the bank), §5.1.1 (nominal fault sizes), Figs. 5.13–5.14.
+
+    Examples
+    --------
+    The bank design, the runs and the plots take a few seconds, so the call is not run here:
+
+    >>> result = run_demo("out/demo", duration=3.0, onset=1.0, calibration_minutes=0.5)  # doctest: +SKIP
+    >>> sorted(result.files)  # doctest: +SKIP
+    ['report', 'structure', 'trace (throttle +2 deg)', 'trace (yaw-rate gyro bias)']
     """
     from fdikit.analysis.gains import fault_to_residual_gain
     from fdikit.studies.path1996 import path_bank, path_fault_model
