@@ -47,10 +47,31 @@ __all__ = [
 def vectorize(A, B, C, D=None) -> np.ndarray:
     """``vec([A B; C D])`` (column stacking), Hallouzi 2008, (3.14).
 
+    Parameters
+    ----------
+    A, B, C : array_like
+        State (n x n), input (n x m) and output (p x n) matrices.
+    D : array_like, optional
+        Feedthrough (p x m); zero if omitted.
+
+    Returns
+    -------
+    ndarray
+        The model vector ``𝔐`` ((n + p)(n + m),).
+
+    Raises
+    ------
+    ModelError
+        If the shapes are inconsistent.
+
     Examples
     --------
     >>> vectorize([[1.0]], [[2.0]], [[3.0]]).tolist()
     [1.0, 3.0, 2.0, 0.0]
+
+    References
+    ----------
+    Hallouzi 2008, §3.3.2, (3.14)–(3.15).
     """
     A, B, C = (np.atleast_2d(np.asarray(M, float)) for M in (A, B, C))
     D = np.zeros((C.shape[0], B.shape[1])) if D is None else np.atleast_2d(np.asarray(D, float))
@@ -62,7 +83,34 @@ def vectorize(A, B, C, D=None) -> np.ndarray:
 
 
 def unvectorize(vector, n: int, m: int, p: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Inverse of :func:`vectorize`: ``(A, B, C, D)`` from a model vector, Hallouzi 2008, (3.24)."""
+    """Inverse of :func:`vectorize`: ``(A, B, C, D)`` from a model vector, Hallouzi 2008, (3.24).
+
+    Parameters
+    ----------
+    vector : array_like
+        Model vector of ``(n + p)(n + m)`` entries.
+    n, m, p : int
+        Numbers of states, inputs and outputs.
+
+    Returns
+    -------
+    A, B, C, D : ndarray
+        (n x n), (n x m), (p x n), (p x m).
+
+    Raises
+    ------
+    ModelError
+        If the vector has another length than ``(n + p)(n + m)``.
+
+    Examples
+    --------
+    >>> [M.tolist() for M in unvectorize([1.0, 3.0, 2.0, 0.0], 1, 1, 1)]
+    [[[1.0]], [[2.0]], [[3.0]], [[0.0]]]
+
+    References
+    ----------
+    Hallouzi 2008, §3.3.2, (3.14), (3.24).
+    """
     vector = np.asarray(vector, float).ravel()
     if vector.size != (n + p) * (n + m):
         raise ModelError(f"a model vector for n={n}, m={m}, p={p} has {(n + p) * (n + m)} entries, got {vector.size}")
@@ -86,17 +134,38 @@ def first_order_discretize(A, B, dt: float) -> tuple[np.ndarray, np.ndarray]:
     Unlike ZOH it is linear in ``(A, B)``, so for weights summing to one the discretised convex
     combination of local models equals the combination of the discretised local models (B.9).
 
+    Parameters
+    ----------
+    A, B : array_like
+        Continuous-time state (n x n) and input (n x m) matrices.
+    dt : float
+        Sample time ``T`` [s], positive.
+
+    Returns
+    -------
+    Ad, Bd : ndarray
+        ``I + T A`` and ``T B``.
+
+    Raises
+    ------
+    ModelError
+        If ``dt`` is not positive and finite, or the shapes do not fit.
+
     Examples
     --------
     >>> Ad, Bd = first_order_discretize([[-2.0]], [[1.0]], 0.1)
     >>> Ad.tolist(), Bd.tolist()
     ([[0.8]], [[0.1]])
+
+    References
+    ----------
+    Hallouzi 2008, App. B, (B.8)–(B.9); §4.3.1.
     """
     A = np.atleast_2d(np.asarray(A, float))
     B = np.atleast_2d(np.asarray(B, float))
     dt = float(dt)
     if not np.isfinite(dt) or dt <= 0:
-        raise ModelError(f"the sample time must be positive, got {dt}")
+        raise ParameterError(f"the sample time must be positive, got {dt}")
     if A.shape[0] != A.shape[1] or B.shape[0] != A.shape[0]:
         raise ModelError(f"A must be square and B must have as many rows, got A {A.shape}, B {B.shape}")
     return np.eye(A.shape[0]) + dt * A, dt * B
@@ -109,6 +178,20 @@ def taylor_remainder_bound(A, dt: float, order: int = 1) -> float:
     ``|r_ij| ≤ (‖A‖T)^{M+1}/(M+1)! · 1/(1 − ‖A‖T/(M+2))`` with ``‖A‖ = Σ|a_ij|``.  ``A`` may be a
     matrix or the norm itself (a scalar).
 
+    Parameters
+    ----------
+    A : array_like or float
+        The matrix (n x n), or ``‖A‖`` itself.
+    dt : float
+        Sample time ``T`` [s].
+    order : int, optional
+        Taylor order ``M`` (default 1, the first-order discretisation).
+
+    Returns
+    -------
+    float
+        The bound on every entry of ``expm(A T) − Σ_{k≤M} (A T)^k / k!``.
+
     Raises
     ------
     DesignError
@@ -118,6 +201,10 @@ def taylor_remainder_bound(A, dt: float, order: int = 1) -> float:
     --------
     >>> round(taylor_remainder_bound(3.0, 0.01), 7)   # B747, §4.3.1: "in the order of 1e-4"
     0.0004545
+
+    References
+    ----------
+    Hallouzi 2008, App. B, (B.5)–(B.7); §4.3.1.
     """
     A = np.asarray(A, float)
     norm = float(A) if A.ndim == 0 else float(np.abs(A).sum())
@@ -139,10 +226,26 @@ def gap_rank(values, min_gap: float = 10.0) -> int:
     of nonzero values); the rank is the index of the largest ratio ``v_i / v_{i+1}`` if that ratio is
     at least ``min_gap``, else all values count.
 
+    Parameters
+    ----------
+    values : array_like
+        Non-increasing non-negative values (singular values or ``|diag R|``).
+    min_gap : float, optional
+        Smallest ratio counted as a significant gap (default 10).
+
+    Returns
+    -------
+    int
+        The numerical rank (0 for an empty or all-zero sequence).
+
     Examples
     --------
     >>> gap_rank([3.0, 1.0, 0.5, 1e-6, 1e-7])
     3
+
+    References
+    ----------
+    Hallouzi 2008, §3.3.2, step 2 of the OD method, (3.19)–(3.20).
     """
     v = np.abs(np.asarray(values, float).ravel())
     if v.size == 0 or v[0] == 0:
@@ -162,6 +265,32 @@ def affine_weights(reduced, models) -> np.ndarray:
     ``W = [M_r; 1]^† [M; 1]``; column ``j`` holds the weights of model ``j``.  As in the thesis the
     sum-to-one condition is one more least-squares row: it holds exactly for models in the affine hull
     of ``M_r`` (e.g. every large-set model once OD has found the rank) and approximately otherwise.
+
+    Parameters
+    ----------
+    reduced : array_like
+        ``M_r`` (n_q x N_r), one model vector per column.
+    models : array_like
+        Models to represent (n_q x N).
+
+    Returns
+    -------
+    ndarray
+        Weights (N_r x N), one column per model.
+
+    Raises
+    ------
+    ModelError
+        If the two sets have model vectors of different lengths (or contain NaN/inf).
+
+    Examples
+    --------
+    >>> affine_weights([[0.0, 2.0]], [[0.5, 1.0, 3.0]]).round(6).tolist()
+    [[0.75, 0.5, -0.5], [0.25, 0.5, 1.5]]
+
+    References
+    ----------
+    Hallouzi 2008, §3.3.2, (3.21).
     """
     Mr = as_model_matrix(reduced)
     M = as_model_matrix(models)
@@ -191,6 +320,17 @@ class ODModelSet:
         Affine weights (3.21) of every large-set model on the final set, ``(N_r+1) × N_ℓ``.
     residual : numpy.ndarray
         ``‖M̃_r w_j − 𝔐_j‖₂`` per large-set model (0 when the set represents it exactly).
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> od = od_model_set(rng.normal(size=(2, 1000)) + [[3.0], [1.0]])
+    >>> od.rank, od.models.shape, od.weights.shape
+    (2, (2, 3), (3, 1000))
+
+    References
+    ----------
+    Hallouzi 2008, §3.3.2, (3.19)–(3.23).
     """
 
     indices: tuple[int, ...]
@@ -227,7 +367,15 @@ def pivoted_qr(matrix, tie_tol: float = 1e-10, priority=None) -> tuple[np.ndarra
 
     Returns
     -------
-    pivots : (n,) int array, the column order ``Π``.  diag_r : (min(m, n),) ``|diag R|``.
+    pivots : ndarray of int
+        (n,) the column order ``Π``.
+    diag_r : ndarray
+        (min(m, n),) ``|diag R|``.
+
+    Raises
+    ------
+    ParameterError
+        If ``tie_tol`` is not in [0, 1) or ``priority`` is not n finite numbers.
 
     Examples
     --------
@@ -236,6 +384,10 @@ def pivoted_qr(matrix, tie_tol: float = 1e-10, priority=None) -> tuple[np.ndarra
     ([2, 0, 1], [1.414214, 0.707107])
     >>> pivoted_qr([[1.0, 0.0, 1.0], [0.0, 1.0, 1.0]], priority=[1, 0, 2])[0].tolist()
     [2, 1, 0]
+
+    References
+    ----------
+    Hallouzi 2008, §3.3.2, (3.19), (3.22) (the pivoted QR of the OD method).
     """
     M = as_model_matrix(matrix)
     m, n = M.shape
@@ -308,6 +460,11 @@ def od_model_set(models, rank: int | None = None, min_gap: float = 10.0, *, tie_
         ``(N_ℓ,)`` secondary key among tied columns (lower wins), e.g. one that prefers models at the
         limits of a parameter range; default the column order.
 
+    Returns
+    -------
+    ODModelSet
+        The selected models, their indices in ``M_ℓ``, the rank and the affine weights of every large-set model.
+
     Raises
     ------
     DesignError
@@ -321,6 +478,10 @@ def od_model_set(models, rank: int | None = None, min_gap: float = 10.0, *, tie_
     >>> od = od_model_set(rng.normal(size=(2, 1000)) + [[3.0], [1.0]])
     >>> len(od.indices), bool(od.residual.max() < 1e-10)
     (3, True)
+
+    References
+    ----------
+    Hallouzi 2008, §3.3.2, (3.19)–(3.23).
     """
     M = as_model_matrix(models)
     if not isinstance(min_gap, (int, float, np.floating, np.integer)) or not min_gap > 0 or not np.isfinite(min_gap):
@@ -362,6 +523,16 @@ class LimitValueModelSet:
         ``(A^Δ_j, B^Δ_j, C^Δ_j, D^Δ_j)``: change when parameter ``j`` moves to its other limit.
     dt : float or None
         First-order sample time if discretised (3.44)–(3.45), else ``None``.
+
+    Examples
+    --------
+    >>> lv = limit_value_model_set(lambda a: ([[a]], [[1.0]], [[1.0]]), {"a": -1.0}, {"a": -3.0})
+    >>> lv.names, lv.offset[0].tolist(), lv.deltas[0][0].tolist(), lv.model([0.5])[0].tolist()
+    (('a',), [[-1.0]], [[-2.0]], [[-2.0]])
+
+    References
+    ----------
+    Hallouzi 2008, §3.5, (3.34)–(3.40); §3.6.1, (3.44)–(3.45).
     """
 
     names: tuple[str, ...]
@@ -391,12 +562,36 @@ def limit_value_model_set(matrices: Callable[..., Sequence], upper: Mapping[str,
     parameter values.  With ``dt`` the blocks are first-order discretised (3.44): ``A⁺ → I + T A⁺``,
     ``A^Δ → T A^Δ``, ``B → T B``.
 
+    Parameters
+    ----------
+    matrices : callable
+        ``matrices(**params) -> (A, B, C)`` or ``(A, B, C, D)``, continuous-time if ``dt`` is given.
+    upper, lower : mapping of str to float
+        The "+" and "−" limit of every varying parameter (the same names in both).
+    dt : float, optional
+        Sample time [s] of a first-order discretisation; None keeps the matrices as returned.
+
+    Returns
+    -------
+    LimitValueModelSet
+        The offset model and one change per parameter.
+
     Raises
     ------
     DesignError
         If ``upper`` and ``lower`` name different parameters.
     ParameterError
         If ``matrices`` is not callable or does not return 3 or 4 numeric arrays.
+
+    Examples
+    --------
+    >>> lv = limit_value_model_set(lambda k: ([[-k]], [[1.0]], [[1.0]]), {"k": 1.0}, {"k": 3.0}, dt=0.1)
+    >>> lv.offset[0].round(6).tolist(), lv.deltas[0][0].round(6).tolist(), lv.dt
+    ([[0.9]], [[-0.2]], 0.1)
+
+    References
+    ----------
+    Hallouzi 2008, §3.5, (3.34)–(3.40); §3.6.1, (3.44).
     """
     if set(upper) != set(lower) or not upper:
         raise DesignError(f"upper and lower limits must name the same parameters, got {sorted(upper)} and "
@@ -437,11 +632,38 @@ def nearest_model(models, estimate):
     ``estimate`` is a model vector (n_q,), e.g. ``M̃_r μ̂`` (OD) or ``U¹ V μ̂`` (CP, (3.51)), or a sequence of
     them (K, n_q); returns an int, or an int array (K,).  The reported parameters are those of model
     ``n_s``, hence quantised to the grid of the large set.
+
+    Parameters
+    ----------
+    models : array_like
+        The large model set ``M_ℓ`` (n_q x N_ℓ).
+    estimate : array_like
+        One model vector (n_q,) or several (K, n_q).
+
+    Returns
+    -------
+    int or ndarray of int
+        Column index of the nearest model (one per estimate for a 2-D ``estimate``).
+
+    Raises
+    ------
+    ModelError
+        If the estimate's length differs from that of the model vectors.
+
+    Examples
+    --------
+    >>> M = [[0.0, 1.0, 2.0, 3.0], [1.0, 1.0, 1.0, 1.0]]
+    >>> nearest_model(M, [1.2, 1.0]), nearest_model(M, [[1.2, 1.0], [2.9, 1.0]]).tolist()
+    (1, [1, 3])
+
+    References
+    ----------
+    Hallouzi 2008, §3.6.2, (3.51)–(3.52).
     """
     M = as_model_matrix(models)
     E = np.atleast_2d(np.asarray(estimate, float))
     if E.shape[1] != M.shape[0]:
-        raise ModelError(f"the estimate has {E.shape[1]} entries, the model vectors {M.shape[0]}")
+        raise ParameterError(f"the estimate has {E.shape[1]} entries, the model vectors {M.shape[0]}")
     d2 = ((E[:, :, None] - M[None, :, :]) ** 2).sum(axis=1)
     idx = d2.argmin(axis=1)
     return idx if np.ndim(estimate) == 2 else int(idx[0])
@@ -454,11 +676,32 @@ def minimum_mismatch_points(distribution, n_models: int) -> np.ndarray:
     centre of its region, ``F⁻¹((i − ½)/N)``.  ``distribution`` is a frozen ``scipy.stats``
     distribution (anything with ``ppf``).
 
+    Parameters
+    ----------
+    distribution : scipy.stats frozen distribution
+        Distribution of the parameter (anything with ``ppf``).
+    n_models : int
+        Number of models, at least 1.
+
+    Returns
+    -------
+    ndarray
+        (n_models,) parameter values, increasing.
+
+    Raises
+    ------
+    DesignError
+        If ``n_models < 1`` or ``distribution`` has no ``ppf``.
+
     Examples
     --------
     >>> from scipy.stats import norm
     >>> minimum_mismatch_points(norm(1.0, 0.2), 2).round(4).tolist()   # §3.6.4: 0.865 and 1.135
     [0.8651, 1.1349]
+
+    References
+    ----------
+    Hallouzi 2008, §3.6.4, (3.58), Table 3.4 (after Li et al. 2005).
     """
     if int(n_models) < 1:
         raise DesignError(f"n_models must be >= 1, got {n_models}")
@@ -479,6 +722,42 @@ def observability_condition(step: Callable[[np.ndarray, np.ndarray], np.ndarray]
     central differences (exact for systems quadratic in ``x``, such as the MM system with the
     weights appended to the state, (3.10)).  Returns ``(cond, jacobian)``; ``cond`` is ``inf`` if
     the matrix is rank deficient.
+
+    Parameters
+    ----------
+    step : callable
+        ``step(x, u) -> x_next``, the state transition ``f``.
+    output : callable
+        ``output(x) -> y``, the measurement ``h``.
+    state : array_like
+        The point ``x`` (n) where the matrix is evaluated.
+    inputs : array_like
+        Inputs ``u_k, …`` (at least n − 1 rows).
+    rel_step : float, optional
+        Relative central-difference step (default 1e-6).
+
+    Returns
+    -------
+    cond : float
+        ``σ_max / σ_min`` of the observability matrix, (3.9); ``inf`` when it is rank deficient.
+    jacobian : ndarray
+        ``∂hⁿ/∂x`` (n·p x n).
+
+    Raises
+    ------
+    DesignError
+        If fewer than n − 1 input samples are given.
+
+    Examples
+    --------
+    >>> step = lambda z, u: np.array([z[1] * z[0], z[1]])     # x⁺ = μ x with the weight μ as a state
+    >>> cond, J = observability_condition(step, lambda z: z[:1], [1.0, 0.5], np.zeros((1, 1)))
+    >>> round(cond, 4), J.round(6).tolist()
+    (1.6404, [[1.0, 0.0], [0.5, 1.0]])
+
+    References
+    ----------
+    Hallouzi 2008, §3.3.1, Definition 3.1, (3.7)–(3.10).
     """
     x0 = np.asarray(state, float).ravel()
     n = x0.size
@@ -512,6 +791,34 @@ def pair_observability(first, second, C, states, weights, u) -> float:
     ``second`` are ``(A, B)``;
     ``states`` (K, n) and ``weights`` (K,) are the points ``(x_k, μ_k)`` where the matrix is evaluated; the
     input ``u`` (m,) is held constant over the ``n`` steps of (3.8).  Used for Example 3.1 and Table 3.4.
+
+    Parameters
+    ----------
+    first, second : tuple of array_like
+        ``(A, B)`` of the two models, (n x n) and (n x m).
+    C : array_like
+        Common output matrix (p x n).
+    states : array_like
+        (K, n) states ``x_k``.
+    weights : array_like
+        (K,) weights ``μ_k`` of the first model.
+    u : array_like
+        (m,) input held constant.
+
+    Returns
+    -------
+    float
+        Mean of the condition numbers over the K points.
+
+    Examples
+    --------
+    >>> c = pair_observability(([[0.5]], [[1.0]]), ([[0.9]], [[1.0]]), [[1.0]], [[1.0]], [0.5], [0.0])
+    >>> round(c, 3)
+    3.866
+
+    References
+    ----------
+    Hallouzi 2008, §3.3.1, Example 3.1, (3.8)–(3.9), Table 3.1; §3.6.4, Table 3.4.
     """
     (A1, B1), (A2, B2) = [(np.asarray(A, float), np.atleast_2d(np.asarray(B, float))) for A, B in (first, second)]
     C = np.atleast_2d(np.asarray(C, float))
