@@ -47,6 +47,17 @@ class CPModelSet:
         Convex (barycentric) weights of every large-set model, ``N_h × N_ℓ``.
     cost : float
         ``J_CP = Σ d²(v, conv(M̄_ℓ))`` (3.29) of the vertices.
+
+    Examples
+    --------
+    >>> M = np.array([[0.0, 1.0, 0.0, 0.3], [0.0, 0.0, 1.0, 0.3], [1.0, 1.0, 1.0, 1.0]])
+    >>> cp = cp_model_set(M)                  # a triangle of models and one point inside it
+    >>> cp.basis.shape, cp.models.shape, cp.weights.shape, round(cp.cost, 6)
+    ((3, 3), (3, 3), (3, 4), 0.0)
+
+    References
+    ----------
+    Hallouzi 2008, §3.4, (3.25)–(3.33).
     """
 
     basis: np.ndarray
@@ -62,6 +73,28 @@ def convex_weights(vertices, point) -> np.ndarray | None:
 
     Used to check polytope enclosure (Hallouzi 2008, (3.30)); solved with ``scipy.optimize.linprog``
     (HiGHS), minimising the ℓ1 equality violation with a tolerance of ``1e-9 · scale``.
+
+    Parameters
+    ----------
+    vertices : array_like
+        ``V`` (d x k), one vertex per column.
+    point : array_like
+        ``x`` (d).
+
+    Returns
+    -------
+    ndarray or None
+        The weights ``λ`` (k), or None when ``x`` is outside the polytope.
+
+    Examples
+    --------
+    >>> V = [[0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    >>> convex_weights(V, [0.25, 0.25]).round(6).tolist(), convex_weights(V, [1.0, 1.0])
+    ([0.5, 0.25, 0.25], None)
+
+    References
+    ----------
+    Hallouzi 2008, §3.4, (3.30).
     """
     V = np.atleast_2d(np.asarray(vertices, float))
     x = np.asarray(point, float).ravel()
@@ -123,12 +156,45 @@ def cp_model_set(models, rank: int | None = None, min_gap: float = 10.0, n_verti
     ``n_vertices`` vertices (default ``d + 1``) subject to the enclosure (3.30)
     (:func:`fit_enclosing_polytope`); the weights of the samples are then barycentric (a simplex) or
     non-negative least squares (more vertices).  If the optimiser loses the enclosure, the simplex is returned
-    (with more than ``d + 1`` vertices requested: :class:`DesignError`).
+    (with more than ``d + 1`` vertices requested: :class:`~fdikit.errors.DesignError`).
+
+    Parameters
+    ----------
+    models : array_like
+        The large model set ``M_ℓ`` (n_q x N_ℓ), one model vector per column
+        (:func:`~fdikit.multimodel.model_set.vectorize`).
+    rank : int, optional
+        ``n_g``; default from the singular-value gap.
+    min_gap : float, optional
+        Smallest ratio counted as a significant gap (default 10; :func:`~fdikit.multimodel.model_set.gap_rank`).
+    n_vertices : int, optional
+        Number of vertices ``N_h`` (at least ``d + 1``; default ``d + 1``, a simplex).
+    optimize : bool, optional
+        Locally minimise ``J_CP`` from the enclosing simplex (default True).
+
+    Returns
+    -------
+    CPModelSet
+        Basis, coordinates, vertices, local models ``U¹ v^(i)``, weights of every sample and ``J_CP``.
 
     Raises
     ------
     DesignError
-        If the samples are affinely degenerate (fewer than two distinct models).
+        If the samples are affinely degenerate (fewer than two distinct models), ``n_vertices < d + 1``, or a
+        fit with more than ``d + 1`` vertices loses the enclosure.
+    ParameterError
+        On a non-positive ``min_gap`` or a ``rank``/``n_vertices`` that is not a positive integer.
+
+    Examples
+    --------
+    >>> M = np.array([[0.0, 1.0, 0.0, 0.3], [0.0, 0.0, 1.0, 0.3], [1.0, 1.0, 1.0, 1.0]])
+    >>> cp = cp_model_set(M, optimize=False)
+    >>> cp.models.shape, all(convex_weights(cp.models, m) is not None for m in M.T)
+    ((3, 3), True)
+
+    References
+    ----------
+    Hallouzi 2008, §3.4, (3.29)–(3.33) (after Kanev 2006).
     """
     min_gap = validate.positive("min_gap", min_gap)
     if rank is not None:
@@ -196,6 +262,41 @@ def fit_enclosing_polytope(hull: np.ndarray, start: np.ndarray, n_vertices: int,
     ``start`` (d × k, k ≤ n_vertices) must enclose ``hull``; further vertices start as copies of the start
     vertices farthest from the hull, each taking the hull points on one side of the hull's principal direction.
     Returns ``(vertices, converged)``, the vertices d × n_vertices.
+
+    Parameters
+    ----------
+    hull : ndarray
+        Points to enclose (d x h), e.g. the convex-hull vertices of the samples.
+    start : ndarray
+        Enclosing start vertices (d x k), k ≤ ``n_vertices``.
+    n_vertices : int
+        Number of vertices of the result.
+    maxiter : int, optional
+        SLSQP iteration limit (default 500).
+    tol : float, optional
+        SLSQP ``ftol`` (default 1e-10).
+
+    Returns
+    -------
+    vertices : ndarray
+        (d x n_vertices).
+    converged : bool
+        Whether SLSQP converged with the enclosure constraints met to 1e-7.
+
+    Raises
+    ------
+    DesignError
+        If ``n_vertices`` is smaller than the number of start vertices.
+
+    Examples
+    --------
+    >>> V, ok = fit_enclosing_polytope(np.array([[0.0, 1.0, 2.0]]), np.array([[-1.0, 3.0]]), 2)
+    >>> (V.round(4) + 0.0).tolist(), ok     # the interval [0, 2] itself
+    ([[0.0, 2.0]], True)
+
+    References
+    ----------
+    Hallouzi 2008, §3.4, (3.27)–(3.30).
     """
     H = np.asarray(hull, dtype=float)
     d, h = H.shape
