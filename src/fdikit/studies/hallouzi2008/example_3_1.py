@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.stats
 
-from fdikit.errors import ModelError
+from fdikit.errors import ParameterError
 from fdikit.multimodel.model_set import pair_observability
 
 __all__ = ["PAIRS", "Example31Result", "example_3_1_models", "example_3_1"]
@@ -40,8 +40,21 @@ class Example31Result:
 
     Attributes
     ----------
-    observability : (S, 6) mean condition number of the observability matrix per model set and pair.
-    basis : (S, 6) parameter-basis condition number ``c^(i_p)`` per model set and pair.
+    observability : (S, 6) array
+        Mean condition number of the observability matrix per model set and pair (columns in :data:`PAIRS` order).
+    basis : (S, 6) array
+        Parameter-basis condition number ``c^(i_p)`` per model set and pair.
+
+    References
+    ----------
+    Hallouzi 2008, §3.3.1, Example 3.1, Table 3.1, (3.9).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> row = np.array([[1.0, 5.0, 2.0, 3.0, 4.0, 3.5]])
+    >>> Example31Result(row, row).frequency()["max_at_13"]
+    1.0
     """
 
     observability: np.ndarray
@@ -62,7 +75,31 @@ class Example31Result:
 
 
 def example_3_1_models(rng, b_scale: float = 0.1) -> list[tuple[np.ndarray, np.ndarray]]:
-    """One random model set of (3.10)–(3.13): four ``(A, B)`` pairs."""
+    """One random model set of (3.10)–(3.13): four ``(A, B)`` pairs.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        Source of the random ``A^(1)``, ``A^(2)`` (N(0, 1) entries, redrawn until stable) and ``B^(1)``, ``B^(2)``.
+    b_scale : float, default 0.1
+        Standard deviation of the ``B`` entries (an fdikit choice, see the module docstring).
+
+    Returns
+    -------
+    list of (numpy.ndarray, numpy.ndarray)
+        Four pairs ``(A, B)``, ``A`` (2, 2) and ``B`` (2,): models 1, 2 random, 3 by (3.12), 4 by (3.13).
+
+    References
+    ----------
+    Hallouzi 2008, §3.3.1, (3.10)–(3.13).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> models = example_3_1_models(np.random.default_rng(0))
+    >>> len(models), bool(np.allclose(models[3][0], 0.4 * models[0][0] + 0.6 * models[1][0]))
+    (4, True)
+    """
     As = []
     while len(As) < 2:
         A = rng.standard_normal((2, 2))
@@ -106,13 +143,41 @@ def example_3_1(model_sets: int = 15, seed: int | None = 10, *, b_scale: float =
                 samples: int = 100) -> Example31Result:
     """Table 3.1 for ``model_sets`` random model sets (Hallouzi 2008, Example 3.1).
 
+    Parameters
+    ----------
+    model_sets : int, default 15
+        Number of random model sets (rows of Table 3.1).
+    seed : int or None, default 10
+        Seed of the model draws.
+    b_scale : float, default 0.1
+        Standard deviation of the random ``B`` entries.
+    n_steps : int, default 300
+        Length of the simulated state realization.
+    samples : int, default 100
+        Number of final samples over which the observability condition number is averaged (``<= n_steps``).
+
+    Returns
+    -------
+    Example31Result
+        (``model_sets``, 6) observability and basis condition numbers.
+
     Raises
     ------
-    ModelError
+    ParameterError
         On non-positive sizes.
+
+    References
+    ----------
+    Hallouzi 2008, §3.3.1, Example 3.1, Table 3.1.
+
+    Examples
+    --------
+    >>> result = example_3_1(model_sets=1, n_steps=20, samples=5)
+    >>> result.observability.shape, result.basis.shape
+    ((1, 6), (1, 6))
     """
     if model_sets < 1 or samples < 1 or n_steps < samples or b_scale <= 0:
-        raise ModelError("need model_sets >= 1, 1 <= samples <= n_steps and b_scale > 0")
+        raise ParameterError("need model_sets >= 1, 1 <= samples <= n_steps and b_scale > 0")
     rng = np.random.default_rng(seed)
     rows = []
     while len(rows) < model_sets:
