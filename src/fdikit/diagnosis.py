@@ -119,7 +119,7 @@ def isolate(
 ) -> np.ndarray:
     """Per-sample isolated fault from per-residual decisions.
 
-    Single-fault logic of Douglas et al. 1996 §1 ("no announcement when more than one
+    Single-fault logic of Douglas et al. 1996, §1 ("no announcement when more than one
     residual crosses"): the fault is named when every fired residual is tied to the
     same fault; other patterns are ``'unknown'``; no fired residual is ``'none'``.
 

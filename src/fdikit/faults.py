@@ -7,7 +7,7 @@ function ``apply(t, v, rng) -> v_faulty`` of the clean signal sampled at times
 
 The kinds follow Douglas et al. 1996, Ch. 3 (additive sensor bias, eq. (3.3);
 actuator faults in the direction of the control, §3.2; a stuck actuator,
-App. A), Hallouzi 2008 Ch. 4 (lock-in-place, loss of effectiveness) and the
+App. A), Hallouzi 2008, Ch. 4 (lock-in-place, loss of effectiveness) and the
 usual taxonomy of Simulink Fault Analyzer (bias, drift, stuck, scale factor,
 noise, intermittent).
 
@@ -248,8 +248,8 @@ class Drift(Fault):
 class Stuck(Fault):
     """Stuck-at / lock-in-place: the signal holds ``value``, or its value at onset when ``value`` is None.
 
-    Lock-in-place of a control surface, Hallouzi 2008 §4.1; stuck actuator,
-    Douglas et al. 1996 App. A (``m_i = −u_i + u_ic``).
+    Lock-in-place of a control surface, Hallouzi 2008, §4.1; stuck actuator,
+    Douglas et al. 1996, App. A (``m_i = −u_i + u_ic``).
 
     Parameters
     ----------

@@ -187,7 +187,7 @@ def sensor_fault_map(model: FaultModel, output: str, direction: str = "both", rt
     F2 = model.A @ F1
     maps = {"both": np.hstack([F1, F2]), "magnitude": F2, "rate": F1}
     if direction not in maps:
-        raise ModelError(f"direction must be 'both', 'magnitude' or 'rate', got {direction!r}")
+        raise ParameterError(f"direction must be 'both', 'magnitude' or 'rate', got {direction!r}")
     return maps[direction]
 
 
@@ -268,7 +268,7 @@ def split_fault_name(model: FaultModel, name: str) -> tuple[str, str, str]:
 
     * a fault input of the model (group ``f``) by its own name → ``('fault', name, suffix)``;
     * ``'<output>_sensor'`` → ``('sensor', output, suffix)``, with the optional suffix ``':magnitude'``
-      (``A F¹`` only, the bias assumption, Douglas et al. 1996 §3.1) or ``':rate'`` (``F¹`` only);
+      (``A F¹`` only, the bias assumption, Douglas et al. 1996, §3.1) or ``':rate'`` (``F¹`` only);
     * ``'<control>_actuator'`` → ``('actuator', control, '')``.
 
     Raises
@@ -341,7 +341,7 @@ def resolve_fault(model: FaultModel, name: str) -> tuple[np.ndarray, str]:
     ``name`` is a fault name (:func:`split_fault_name`):
 
     * ``'<output>_sensor'`` → :func:`sensor_fault_map` ``[F¹, A F¹]`` (kind ``'sensor'``);
-      ``'<output>_sensor:magnitude'`` → ``A F¹`` only (the bias assumption, Douglas et al. 1996 §3.1),
+      ``'<output>_sensor:magnitude'`` → ``A F¹`` only (the bias assumption, Douglas et al. 1996, §3.1),
       ``'<output>_sensor:rate'`` → ``F¹`` only (kind ``'sensor:magnitude'`` / ``'sensor:rate'``);
     * ``'<control>_actuator'`` → :func:`actuator_fault_map`, the column of ``Bu`` (``'actuator'``);
     * a fault input of the model (group ``f``) by its own name → its ``Bf`` column when ``Df`` is
@@ -560,7 +560,7 @@ def resolve_faults(model: FaultModel, faults: Mapping[str, np.ndarray] | Sequenc
     A mapping gives explicit ``F`` matrices (n x k) under its keys.  A name or a sequence of
     names is resolved by :func:`fdikit.linalg.resolve_fault`: ``'<output>_sensor'`` is the sensor
     fault ``[F¹, A F¹]``, ``'<output>_sensor:magnitude'`` its bias direction ``A F¹`` only
-    (Douglas et al. 1996 §4.1, the air-mass fix), ``'<control>_actuator'`` the actuator fault
+    (Douglas et al. 1996, §4.1, the air-mass fix), ``'<control>_actuator'`` the actuator fault
     ``B[:, j]``, a fault input of the model (group ``f``) its own map.  The keys are the names
     without the suffix.  A bare signal name (``'theta'``) raises :class:`ParameterError` whose
     message gives the fault name (``'theta_sensor'``).

@@ -1,4 +1,4 @@
-"""Discrete LPV models and their stacked parity-relation matrices (Varrier, Koenig & Martinez 2014, §2–§3, §4.1).
+"""Discrete LPV models and their stacked parity-relation matrices (Varrier et al. 2014, §2–§3, §4.1).
 
 Models here are polynomial in one scheduling parameter, ``X(ρ) = Σ_j ρ^j X_j`` (the paper's
 affine form (3) with ``ρ₂ = ρ₁²`` substituted, §5.1): :class:`LPVModel`.
@@ -184,7 +184,7 @@ class LPVModel:
 # ---------------------------------------------------------------------------------------------- stacking
 @dataclass(frozen=True, eq=False)
 class StackedMatrices:
-    """Stacked observability and input matrices over a horizon ``s`` (Varrier 2014, (7)–(8)).
+    """Stacked observability and input matrices over a horizon ``s`` (Varrier et al. 2014, (7)–(8)).
 
     Every array may carry leading batch axes (one set of matrices per ρ).  ``H_os`` is
     ``(s+1)p × n``; ``H[g]`` is ``(s+1)p × (s+1)k_g`` for input group ``g`` with the
@@ -282,7 +282,7 @@ def stacked_matrices(model: FaultModel | Sequence[FaultModel], s: int | None = N
 
 def lpv_stacked_matrices(lpv: LPVModel, rho, s: int, *, mode: str = "frozen", groups: Sequence[str] = GROUPS
                          ) -> StackedMatrices:
-    """Stacked matrices of an :class:`LPVModel` (Varrier 2014, (7)–(8), corrected; (45)).
+    """Stacked matrices of an :class:`LPVModel` (Varrier et al. 2014, (7)–(8), corrected; (45)).
 
     Parameters
     ----------
@@ -326,7 +326,7 @@ def _poly_coefficients(name: str, value, shape: tuple[int, int]) -> np.ndarray:
 
 @dataclass(frozen=True, eq=False)
 class Uncertainty:
-    """One unknown scalar δ: ``Ā(ρ) = A₀(ρ) + δ Ã(ρ)``, ``C̄(ρ) = C₀(ρ) + δ C̃(ρ)`` (Varrier 2014, (2), (5)).
+    """One unknown scalar δ: ``Ā(ρ) = A₀(ρ) + δ Ã(ρ)``, ``C̄(ρ) = C₀(ρ) + δ C̃(ρ)`` (Varrier et al. 2014, (2), (5)).
 
     ``A`` and ``C`` are constant matrices or mappings power -> coefficient of ``ρ^power``;
     ``n`` and ``p`` are the model's sizes (checked against the LPV model when stacking).
@@ -357,7 +357,7 @@ class Uncertainty:
 
 @dataclass(frozen=True, eq=False)
 class UncertainStack:
-    """Stacked matrices of the uncertain model expanded in the monomials of δ (Varrier 2014, (14)).
+    """Stacked matrices of the uncertain model expanded in the monomials of δ (Varrier et al. 2014, (14)).
 
     ``nominal`` holds ``H_os, H_us, …`` at δ = 0; ``tilde[kind][e]`` is the coefficient of the
     monomial ``δ^e`` (``e`` an exponent tuple, total degree ≥ 1) in the stacked ``kind``
@@ -384,7 +384,7 @@ def _pmul(P1: dict, P2: dict) -> dict:
 
 def uncertain_stacked_matrices(lpv: LPVModel, uncertainties: Sequence[Uncertainty], rho, s: int, *,
                                mode: str = "frozen", groups: Sequence[str] = ("u", "d", "f")) -> UncertainStack:
-    """δ-expansion of the stacked matrices of an uncertain LPV model (Varrier 2014, (5), (14)).
+    """δ-expansion of the stacked matrices of an uncertain LPV model (Varrier et al. 2014, (5), (14)).
 
     ``Σ_e δ^e tilde[kind][e]`` plus the nominal map equals the stacked map of the model with
     ``Ā = A₀ + Σ δ_i Ã_i`` and ``C̄ = C₀ + Σ δ_i C̃_i`` exactly (a polynomial identity in δ).

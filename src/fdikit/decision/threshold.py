@@ -1,6 +1,6 @@
 """Fixed thresholds per residual, calibrated on fault-free data, with k-of-n persistence.
 
-The simplest residual processor of Douglas et al. 1996 §1 ("a simple threshold per
+The simplest residual processor of Douglas et al. 1996, §1 ("a simple threshold per
 residual, traded between false and missed alarms").  Residual ``i`` fires when
 ``|r_i − c_i| > τ_i`` in at least ``k`` of the last ``n`` valid samples; the alarm
 is on when any residual fires, and the fault is isolated when every fired residual

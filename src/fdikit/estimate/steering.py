@@ -1,6 +1,6 @@
 """Additive vs multiplicative steering-fault isolation by moving-window least squares.
 
-van der Ploeg (2018), Ch. 3.  A steering actuator with an offset ``f_a`` and a gain
+van der Ploeg 2018, Ch. 3.  A steering actuator with an offset ``f_a`` and a gain
 ``f_m`` applies ``δ = f_m δ_set + f_a`` (eq. (1.3)); a parity residual generator that rejects the
 disturbances and has unit DC gain sees
 
@@ -69,7 +69,7 @@ _CHUNK = 1 << 20  # window elements per vectorised block (bounds the memory of s
 def lateral_fault_map(pole: float = 0.9048, zero: float = -0.97294, dt: float = 0.01) -> scipy.signal.TransferFunction:
     """Fault-to-residual map of the thesis' parity filter, ``G(q) = K (q − z_0)/(q − p)^3``, ``G(1) = 1``.
 
-    van der Ploeg (2018), (4.10) with the triple pole of Sec. 4-3-1; ``K = (1 − p)^3/(1 − z_0)``
+    van der Ploeg 2018, (4.10) with the triple pole of Sec. 4-3-1; ``K = (1 − p)^3/(1 − z_0)``
     makes the DC gain 1 (Lemma 2-1.2, (2.8b)).  The zero ``z_0 = −0.97294`` is that of ``N(q)F`` for
     the Table 4-1 vehicle at 70 km/h (computed from the Sec. 4-3-1 filter, not printed in the thesis;
     ``tests/studies/vanderploeg2018`` recompute it).
@@ -255,7 +255,7 @@ def isolate_steering_faults(
 ) -> SteeringFaultEstimate:
     """Isolate an additive from a multiplicative steering fault over a moving window (batch).
 
-    van der Ploeg (2018), FI filter (3.4)/(4.11), or with ``prefilter`` the pre-filter FI filter
+    van der Ploeg 2018, FI filter (3.4)/(4.11), or with ``prefilter`` the pre-filter FI filter
     (3.7)–(3.8)/(4.13).  Vectorised over all windows with ``sliding_window_view``; the online twin
     :class:`SteeringFaultIsolator` gives the same numbers sample by sample.
 
@@ -344,7 +344,7 @@ def _check_unit_dc(num: np.ndarray, den: np.ndarray, tol: float = 1e-6) -> None:
 class SteeringFaultIsolator:
     """Online FI filter: one ``step(residual, setpoint)`` per sample, same numbers as :func:`isolate_steering_faults`.
 
-    van der Ploeg (2018), (3.4) or with ``prefilter`` (3.8).  A ring buffer holds the last ``n``
+    van der Ploeg 2018, (3.4) or with ``prefilter`` (3.8).  A ring buffer holds the last ``n``
     samples; the pre-filter ``G(q)`` runs in transposed direct form II (as :func:`scipy.signal.lfilter`)
     from a zero state.  A non-finite set-point holds the pre-filter state; any window holding a
     non-finite value is invalid (NaN estimates, ``valid=False``).

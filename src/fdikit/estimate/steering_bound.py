@@ -217,7 +217,7 @@ def isolation_error_bound(
 ) -> IsolationErrorBound:
     """Error ``θ_e`` and bound ``Θ_e`` of a steering-fault estimate, given the true faults.
 
-    van der Ploeg (2018), Thm 3-1.3 ((3.5)–(3.6), (4.12a)) for the plain FI filter and Thm 3-2.1
+    van der Ploeg 2018, Thm 3-1.3 ((3.5)–(3.6), (4.12a)) for the plain FI filter and Thm 3-2.1
     ((3.9)–(3.10), (4.14)) for the pre-filter FI filter, with the corrections listed in the module
     docstring.
 

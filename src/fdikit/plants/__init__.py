@@ -26,7 +26,7 @@ Examples
 
 * :mod:`fdikit.plants.registry` — The registry of benchmark plants: :data:`PLANTS` maps a short name to its
   constructor, :func:`get_plant` builds one.
-* :mod:`fdikit.plants.path_vehicle` — PATH linear vehicle models of Douglas et al. (1996), Appendix D.
+* :mod:`fdikit.plants.path_vehicle` — PATH linear vehicle models of Douglas et al. 1996, Appendix D.
 * :mod:`fdikit.plants.path_longitudinal` — PATH 7-state longitudinal car model: the game-filter example of Douglas
   et al. (1996), §9.6.
 * :mod:`fdikit.plants.single_track` — Linear single-track (bicycle) lateral model with lane-error states (van der

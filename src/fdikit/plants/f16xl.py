@@ -98,7 +98,7 @@ def f16xl_gust(
 
     * ``A(1,5) = 0.0430`` (printed "0.04 130"): the gust column equals the ``w`` column in rows
       1–3, as ``w_g`` enters like ``w`` (and as Murray's gust input is column 2 of ``A``).
-    * ``B_δ(1) = −0.1672``: the sign is lost in the print; Murray 2012 §6.1 prints −0.1672.
+    * ``B_δ(1) = −0.1672``: the sign is lost in the print; Murray 2012, §6.1 prints −0.1672.
     * ``C(2,4) = 0`` (row 2 prints a stray "1.0000"): the printed ``F_Az`` needs ``C e_4 ∝ e_3``
       (``F¹ = e_4 / C(3,4)``, ``A F¹`` normalised = [0.9986, 0.0534, 0, 0, 0] as printed).
     * ``C(3,2)`` = ``az_w_coefficient``: printed "1.0517" without a legible sign.  −1.0517 is the

@@ -1,4 +1,4 @@
-"""PATH 7-state longitudinal car model: the game-filter example of Douglas et al. (1996), §9.6.
+"""PATH 7-state longitudinal car model: the game-filter example of Douglas et al. 1996, §9.6.
 
 The nonlinear PATH vehicle linearised on a straight road at 25 m/s and reduced (spectral
 separation + balanced realisation) to 7 states, 7 outputs and 2 inputs (throttle deg, brake
@@ -59,7 +59,7 @@ __all__ = [
     "PATH7_OUTPUTS",
 ]
 
-#: State matrix exactly as printed in Douglas et al. (1996), §9.6 (A(2,3) = −19.0734: a sign error).
+#: State matrix exactly as printed in Douglas et al. 1996, §9.6 (A(2,3) = −19.0734: a sign error).
 PATH7_A_PRINTED = np.array(
     [
         [-0.0521, -0.2213, 0.2681, -0.0121, 0.0136, 0.0084, -0.0078],
@@ -137,7 +137,7 @@ PATH7_OUTPUTS: tuple[str, ...] = (
 
 
 def path_longitudinal_7() -> FaultModel:
-    """The 7-state longitudinal model of Douglas et al. (1996), §9.6, (9.86)–(9.87), corrected.
+    """The 7-state longitudinal model of Douglas et al. 1996, §9.6, (9.86)–(9.87), corrected.
 
     ``A`` with A(2,3) = +19.0734 and ``C`` in the labelled row order (module docstring); no
     controls (``B``, ``D`` are not printed), no fault inputs.  The air-mass sensor fault of the

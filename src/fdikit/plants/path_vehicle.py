@@ -1,4 +1,4 @@
-"""PATH linear vehicle models of Douglas et al. (1996), Appendix D.
+"""PATH linear vehicle models of Douglas et al. 1996, Appendix D.
 
 Two continuous-time linearisations of the Berkeley PATH passenger-car model in a
 constant-radius turn (tire steer 0.005 rad, 24.87 m/s, about 0.1 g; §2.2), reduced by

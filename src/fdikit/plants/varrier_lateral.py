@@ -1,4 +1,4 @@
-"""Renault Scénic lateral dynamics, LPV in ρ = 1/v (Varrier, Koenig & Martinez 2014, §5.1, (47)–(48)).
+"""Renault Scénic lateral dynamics, LPV in ρ = 1/v (Varrier et al. 2014, §5.1, (47)–(48)).
 
 Bicycle model with states side-slip ``β`` and yaw rate ``r``, steering input ``u_L`` and
 outputs lateral acceleration ``a_y`` and ``r``, (47)::
@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fdikit import validate
-from fdikit.errors import ModelError, ParameterError
+from fdikit.errors import ParameterError
 from fdikit.lpv import LPVModel, Uncertainty
 from fdikit.model import FaultModel
 
@@ -62,7 +62,7 @@ T_D: float = 0.02
 
 @dataclass(frozen=True)
 class VarrierParameters:
-    """Vehicle parameters of the Renault Scénic (Varrier 2014, §5.1 table).
+    """Vehicle parameters of the Renault Scénic (Varrier et al. 2014, §5.1 table).
 
     Attributes
     ----------
@@ -79,7 +79,7 @@ class VarrierParameters:
 
     Raises
     ------
-    ModelError
+    ParameterError
         On construction, if a field is not a positive finite number.
 
     References
@@ -104,7 +104,7 @@ class VarrierParameters:
         for name in ("m", "l_V", "l_H", "I_z", "c_V", "c_H", "g"):
             value = getattr(self, name)
             if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
-                raise ModelError(f"VarrierParameters.{name} must be a positive finite number, got {value!r}")
+                raise ParameterError(f"VarrierParameters.{name} must be a positive finite number, got {value!r}")
 
 
 #: The table of §5.1.

@@ -6,7 +6,7 @@ commands (the plants are library data in :mod:`fdikit.plants`).
 * :mod:`fdikit.studies.hallouzi2008` — Hallouzi 2008: the target-tracking, B747 and mass–spring–damper benchmarks of
   the multiple-model methods, Table 3.1 and the model-set comparison (Table 3.3), and the report command.
 * :mod:`fdikit.studies.vanderploeg2018` — van der Ploeg 2018: the single-track steering-fault cases S1–S8 (Ch. 4).
-* :mod:`fdikit.studies.varrier2014` — Varrier, Koenig & Martinez 2014: the lateral-acceleration sensor fault and the
+* :mod:`fdikit.studies.varrier2014` — Varrier et al. 2014: the lateral-acceleration sensor fault and the
   ϖ score (§5).
 """
 

@@ -424,7 +424,7 @@ def _barrier(s: np.ndarray, width: np.ndarray) -> float:
 
 def _initial_gain(prob, tg, given, g, Vw, Q, M, eps) -> np.ndarray:
     """Average of the single-fault GTFDF gains; if that violates the margins, the feasible single-fault
-    gain of lowest cost (the average can be unstable, e.g. Murray 2012 §6.2.4)."""
+    gain of lowest cost (the average can be unstable, e.g. Murray 2012, §6.2.4)."""
     Qs, Ms = per_target("Q", Q, prob, given), per_target("M", M, prob, given)
     gains = [
         single_fault_game_filter(prob.model, {t.name: t.F}, {"complementary": t.Fhat}, gamma=g, V=Vw,

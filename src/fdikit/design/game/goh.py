@@ -1,6 +1,6 @@
 """The γ → 0 limit of the game filter: Goh transformation (Algorithm 4.1) and the Goh Riccati equation.
 
-As γ → 0 with the sensor-noise weight scaled along (``V = V̄/γ`` fixed, Murray 2012 §4.1; PATH's
+As γ → 0 with the sensor-noise weight scaled along (``V = V̄/γ`` fixed, Murray 2012, §4.1; PATH's
 ``V̄ = lim ν/γ``), the game filter's cost becomes *singular* in the nuisance fault (Douglas et al.
 1996, (9.35): ``Π F̂ = 0``).  Goh transformations ``ρ = ∫ μ̂``, ``α = x − B ρ`` move the nuisance to
 an input that reaches the output, and the limiting Riccati equation — the **Goh Riccati
@@ -403,7 +403,7 @@ def goh_riccati_transient(A, C, F_hat, t: Sequence[float], *, V=1.0, Q=1e-4, S0=
 
     t = np.asarray(t, dtype=float)
     if t.ndim != 1 or np.any(t < 0) or np.any(np.diff(t) < 0):
-        raise ModelError("t must be a nondecreasing 1-D sequence of times ≥ 0 (the equation starts at t0 = 0)")
+        raise ParameterError("t must be a nondecreasing 1-D sequence of times ≥ 0 (the equation starts at t0 = 0)")
     Sb0 = np.zeros((n1, n1)) if S0 is None else G1 @ _as2d("S0", S0, n) @ G1.T
     sol = solve_ivp(rhs, (0.0, float(t[-1]) if t.size else 0.0), Sb0.ravel(), method="Radau", t_eval=t,
                     rtol=tol, atol=tol * max(np.abs(q).max(), _EPS))

@@ -1,6 +1,6 @@
 """Indefinite (H∞-type) algebraic Riccati equations of the game-theoretic detection filters.
 
-Two equations appear in Murray (2012), Ch. 3:
+Two equations appear in Murray 2012, Ch. 3:
 
 * the per-target Riccati equation for a *given* gain ``L`` (3.26)/(3.28), (3.35)::
 

@@ -1,4 +1,4 @@
-"""Polytopic machinery of the robust LPV parity design (Varrier, Koenig & Martinez 2014, §4.5–4.6, (32)–(46)).
+"""Polytopic machinery of the robust LPV parity design (Varrier et al. 2014, §4.5–4.6, (32)–(46)).
 
 The pointwise optimum of 𝒫₂ involves ``Γ_κ(ρ)⁻¹ = adj Γ_κ(ρ) / det Γ_κ(ρ)``
 (:mod:`fdikit.design.parity.robust`); this module holds the steps that turn it into a
@@ -37,7 +37,7 @@ from itertools import product
 
 import numpy as np
 
-from fdikit.errors import DesignError, ModelError
+from fdikit.errors import DesignError, ParameterError
 
 __all__ = [
     "adjugate", "polynomial_coefficients", "box_vertices", "is_admissible", "property1_vertices",
@@ -86,7 +86,7 @@ def polynomial_coefficients(fun: Callable[[np.ndarray], np.ndarray], rho_min: fl
         If the coefficients do not die out (``fun`` is not a polynomial of degree < points/2).
     """
     if not (np.isfinite(rho_min) and np.isfinite(rho_max) and rho_max > rho_min):
-        raise ModelError(f"need finite rho_min < rho_max, got [{rho_min}, {rho_max}]")
+        raise ParameterError(f"need finite rho_min < rho_max, got [{rho_min}, {rho_max}]")
     t = np.exp(2j * np.pi * np.arange(points) / points)
     vals = np.asarray(fun(rho_min + (rho_max - rho_min) * t))
     coef = np.fft.fft(vals, axis=0) / points
@@ -135,7 +135,7 @@ def scheduling_weights(rho, N: int, rho_min: float, rho_max: float) -> np.ndarra
 
 
 def repair_vertex(M: np.ndarray, mode: str = "inverse", factor: float = 10.0) -> tuple[np.ndarray, int]:
-    """Replace the non-positive eigenvalues of a symmetric vertex matrix (Varrier 2014, (41)–(42)).
+    """Replace the non-positive eigenvalues of a symmetric vertex matrix (Varrier et al. 2014, (41)–(42)).
 
     ``mode="paper"``: by ``factor × max positive eigenvalue``; ``"inverse"``: by
     ``min positive eigenvalue / factor`` (large in the inverse, Remark 7).  Eigenvectors and
@@ -152,7 +152,7 @@ def repair_vertex(M: np.ndarray, mode: str = "inverse", factor: float = 10.0) ->
     elif mode == "inverse":
         new = ref.min() / factor
     else:
-        raise ModelError(f"unknown repair mode {mode!r}; use 'inverse' or 'paper'")
+        raise ParameterError(f"unknown repair mode {mode!r}; use 'inverse' or 'paper'")
     d = np.where(bad, new, d)
     return (V * d) @ V.T, int(bad.sum())
 
@@ -170,7 +170,7 @@ class PolytopicLmi:
 
 def polytopic_lmi(vertices: np.ndarray, c: np.ndarray, *, objective: str = "common", solver: str = "CLARABEL"
                   ) -> PolytopicLmi:
-    """``min γ'`` s.t. ``[[Γ̃_i, W_i], [W_iᵀ, γ'_i]] ⪰ 0``, ``cᵀW_i = 1`` for every vertex (Varrier 2014, (39)–(40)).
+    """``min γ'`` s.t. ``[[Γ̃_i, W_i], [W_iᵀ, γ'_i]] ⪰ 0``, ``cᵀW_i = 1`` per vertex (Varrier et al. 2014, (39)–(40)).
 
     ``objective="common"``: one γ' (as printed in (38)–(40)); ``"sum"``: γ'_i per vertex
     ("the same structure for γ'", (37)), minimising their sum.  Vertices are scaled by a
@@ -182,7 +182,7 @@ def polytopic_lmi(vertices: np.ndarray, c: np.ndarray, *, objective: str = "comm
     import cvxpy as cp
 
     if objective not in ("common", "sum"):
-        raise ModelError(f"unknown objective {objective!r}; use 'common' or 'sum'")
+        raise ParameterError(f"unknown objective {objective!r}; use 'common' or 'sum'")
     V = np.asarray(vertices, dtype=float)
     r, q = V.shape[0], V.shape[1]
     sc = max(np.linalg.norm(Vi, 2) for Vi in V)

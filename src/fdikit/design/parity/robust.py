@@ -1,4 +1,4 @@
-"""Robust parity design for uncertain LPV systems (Varrier, Koenig & Martinez 2014, §4).
+"""Robust parity design for uncertain LPV systems (Varrier et al. 2014, §4).
 
 The residual ``r = W₂ᵀ P(ρ) (Y_s − H_us U_s)`` (16) is decoupled from the state by
 ``P H_os = 0`` for every ``W₂``; ``W₂`` is chosen to trade the uncertainty and unknown-input
@@ -47,7 +47,7 @@ from fdikit.design.parity.polytope import (
     solver_options,
 )
 from fdikit.design.parity.state_space import lpv_parity_residuals, parity_matrix, regular_rows
-from fdikit.errors import DesignError, ModelError, ParameterError
+from fdikit.errors import DesignError, ParameterError
 from fdikit.lpv import LPVModel, Uncertainty, lpv_stacked_matrices, uncertain_stacked_matrices
 from fdikit.protocols import no_internal_form
 from fdikit.residuals import Residuals
@@ -64,7 +64,7 @@ _T = np.swapaxes  # plain (not conjugate) transpose keeps Γ analytic in a compl
 # ---------------------------------------------------------------------------------------------- criteria
 @dataclass(frozen=True, eq=False)
 class RobustCriteria:
-    """``Γ₁ = P G Gᵀ Pᵀ``, ``Γ₂ = P H_F H_Fᵀ Pᵀ`` (Varrier 2014, (18)–(20)); batch axes allowed.
+    """``Γ₁ = P G Gᵀ Pᵀ``, ``Γ₂ = P H_F H_Fᵀ Pᵀ`` (Varrier et al. 2014, (18)–(20)); batch axes allowed.
 
     ``fault_direction`` is ``P H_fs 𝟙``, the image of a constant fault (per target fault).
     """
@@ -80,8 +80,8 @@ class RobustCriteria:
 
 def robust_criteria(lpv: LPVModel, uncertainties: Sequence[Uncertainty], rho, s: int, *, mode: str = "frozen",
                     fault_model: str = "sequence", weights: Mapping[str, float] | None = None,
-                    nuisance_faults: Sequence[str] = (), rows: Sequence[int] | None = None) -> RobustCriteria:
-    """Γ₁ and Γ₂ of the uncertain LPV model at ρ (Varrier 2014, (14), (18)–(20)).
+                    nuisance: Sequence[str] | str = (), rows: Sequence[int] | None = None) -> RobustCriteria:
+    """Γ₁ and Γ₂ of the uncertain LPV model at ρ (Varrier et al. 2014, (14), (18)–(20)).
 
     Parameters
     ----------
@@ -89,17 +89,22 @@ def robust_criteria(lpv: LPVModel, uncertainties: Sequence[Uncertainty], rho, s:
         the window) or ``"constant"`` (``H_F = H_fs (𝟙 ⊗ I)``, a fault constant over the window,
         an fdikit option; Γ₂ then has rank ≤ #faults).
     weights : per-block weights of G, keys ``"os", "us", "ds", "ds_tilde"`` (default 1, as printed).
-    nuisance_faults : faults moved into the unknown inputs (§2.4, (4)); the others are targets.
-        (The paper's sentence after (4) swaps f₁ and f₂; the construction is followed.)
+    nuisance : fault names moved into the unknown inputs (§2.4, (4)); ``()`` (default) none.  The
+        faults of the model not listed are the targets.  (The paper's sentence after (4) swaps f₁
+        and f₂; the construction is followed.)
     rows : rows of ``H_os1``; default :func:`regular_rows` at the mean of ``Re ρ``.
     """
     w = {"os": 1.0, "us": 1.0, "ds": 1.0, "ds_tilde": 1.0} | dict(weights or {})
     if set(w) != {"os", "us", "ds", "ds_tilde"}:
-        raise ModelError(f"weights keys must be 'os', 'us', 'ds', 'ds_tilde'; got {sorted(weights or {})}")
-    unknown = [f for f in nuisance_faults if f not in lpv.faults]
+        raise ParameterError(f"weights keys must be 'os', 'us', 'ds', 'ds_tilde'; got {sorted(weights or {})}")
+    if isinstance(nuisance, str) and nuisance == "others":
+        raise ParameterError("robust_criteria's targets are the faults not in nuisance, so nuisance='others' leaves "
+                             "none; list the nuisance faults by name")
+    nuisance = (nuisance,) if isinstance(nuisance, str) else tuple(nuisance)
+    unknown = [f for f in nuisance if f not in lpv.faults]
     if unknown:
-        raise ModelError(f"no fault named {unknown}; the model's faults are {list(lpv.faults)}")
-    target = [i for i, f in enumerate(lpv.faults) if f not in nuisance_faults]
+        raise ParameterError(f"no fault named {unknown}; the model's faults are {list(lpv.faults)}")
+    target = [i for i, f in enumerate(lpv.faults) if f not in nuisance]
     if not target:
         raise DesignError("no target fault left: every fault is a nuisance; keep at least one fault to detect")
     st = uncertain_stacked_matrices(lpv, uncertainties, rho, s, mode=mode, groups=("u", "d", "f"))
@@ -126,7 +131,7 @@ def robust_criteria(lpv: LPVModel, uncertainties: Sequence[Uncertainty], rho, s:
     elif fault_model == "constant":
         HF = Hc
     else:
-        raise ModelError(f"unknown fault_model {fault_model!r}; use 'sequence' (paper) or 'constant'")
+        raise ParameterError(f"unknown fault_model {fault_model!r}; use 'sequence' (paper) or 'constant'")
     PG, PF = P @ G, P @ HF
     return RobustCriteria(PG @ _T(PG, -1, -2), PF @ _T(PF, -1, -2), P, G, H_fs, (P @ Hc).sum(axis=-1), rows)
 
@@ -142,7 +147,7 @@ class EigenDesign:
 
 
 def theorem1(gamma1: np.ndarray, gamma2: np.ndarray, *, sign_ref: np.ndarray | None = None) -> EigenDesign:
-    """Minimise ``W₂ᵀΓ₁W₂ / W₂ᵀΓ₂W₂`` by the generalised eigenproblem (Varrier 2014, Theorem 1, (21)–(23)).
+    """Minimise ``W₂ᵀΓ₁W₂ / W₂ᵀΓ₂W₂`` by the generalised eigenproblem (Varrier et al. 2014, Theorem 1, (21)–(23)).
 
     ``scipy.linalg.eigh(Γ₂, Γ₁)`` gives ``μ``; ``λ = 1/μ`` and ``λ_min = 1/μ_max``.  If Γ₁ is
     singular the residual can decouple the uncertainty exactly: ``λ_min = 0`` and ``W₂``
@@ -227,7 +232,7 @@ def kappa_max(gamma1: np.ndarray, gamma2: np.ndarray) -> float:
 
 
 def gamma_kappa(gamma1: np.ndarray, gamma2: np.ndarray, kappa: float) -> np.ndarray:
-    """``Γ_κ = Γ₁ − κ²Γ₂`` (Varrier 2014, (25)); DesignError unless it is positive definite.
+    """``Γ_κ = Γ₁ − κ²Γ₂`` (Varrier et al. 2014, (25)); DesignError unless it is positive definite.
 
     Raises
     ------
@@ -267,7 +272,7 @@ class LmiDesign:
 
 def lti_lmi(gamma1: np.ndarray, gamma2: np.ndarray, kappa: float, *, normalization: str = "linear",
             c: np.ndarray | None = None, eps: float = 1.0, solver: str = "CLARABEL") -> LmiDesign:
-    """LTI 𝒫₂ as the LMI ``min γ s.t. [[Γ_κ⁻¹, W₂], [W₂ᵀ, γ]] ⪰ 0`` (Varrier 2014, (27), (31)) with cvxpy.
+    """LTI 𝒫₂ as the LMI ``min γ s.t. [[Γ_κ⁻¹, W₂], [W₂ᵀ, γ]] ⪰ 0`` (Varrier et al. 2014, (27), (31)) with cvxpy.
 
     ``normalization="linear"``: ``cᵀW₂ = 1`` (default ``c = 𝟙``).  ``"l1"``: ``‖W₂‖₁ ≥ ε`` (30),
     exactly, by enumerating ``σ ∈ {±1}^q`` with ``σ₁ = +1`` (``±W₂`` are equivalent) and
@@ -288,12 +293,12 @@ def lti_lmi(gamma1: np.ndarray, gamma2: np.ndarray, kappa: float, *, normalizati
         rhs = 1.0
     elif normalization == "l1":
         if q > 12:
-            raise ModelError(f"normalization='l1' enumerates 2^(q-1) sign vectors; q = {q} is too large, "
+            raise ParameterError(f"normalization='l1' enumerates 2^(q-1) sign vectors; q = {q} is too large, "
                              "use normalization='linear'")
         cs = [np.array((1.0,) + sg) for sg in product((1.0, -1.0), repeat=q - 1)]
         rhs = float(eps)
     else:
-        raise ModelError(f"unknown normalization {normalization!r}; use 'linear' (cᵀW₂ = 1) or 'l1' (‖W₂‖₁ ≥ ε)")
+        raise ParameterError(f"unknown normalization {normalization!r}; use 'linear' (cᵀW₂ = 1) or 'l1' (‖W₂‖₁ ≥ ε)")
     best = None
     for ci in cs:
         w, g = cp.Variable(q), cp.Variable()
@@ -325,7 +330,7 @@ def lti_lmi(gamma1: np.ndarray, gamma2: np.ndarray, kappa: float, *, normalizati
 # ---------------------------------------------------------------------------------------------- LPV design
 @dataclass(frozen=True, eq=False)
 class RobustParityDesign:
-    """A scheduled robust parity vector ``W₂(ρ) = Σ_j α̃_j(ρ) W_j`` (Varrier 2014, (37), (49)) and its report.
+    """A scheduled robust parity vector ``W₂(ρ) = Σ_j α̃_j(ρ) W_j`` (Varrier et al. 2014, (37), (49)) and its report.
 
     Attributes
     ----------
@@ -420,7 +425,7 @@ def robust_lpv_parity(
     solver: str = "CLARABEL",
     **criteria_kw,
 ) -> RobustParityDesign:
-    """Polytopic robust parity design for an uncertain LPV model (Varrier 2014, §4.5–4.6, (32)–(46)).
+    """Polytopic robust parity design for an uncertain LPV model (Varrier et al. 2014, §4.5–4.6, (32)–(46)).
 
     Steps: Γ₁, Γ₂ on a ρ grid and the κ check (refusal with ``κ_max``); ``adj Γ_κ(ρ)`` as a
     polynomial in ``t``; truncation to degree ``order`` (N+1 = ``order+1`` vertices, Property 1);
@@ -435,11 +440,11 @@ def robust_lpv_parity(
         LMI is infeasible.
     """
     if not (0 <= rho_min < rho_max) or not np.isfinite(rho_max):
-        raise ModelError(f"need 0 <= rho_min < rho_max < inf, got [{rho_min}, {rho_max}]")
+        raise ParameterError(f"need 0 <= rho_min < rho_max < inf, got [{rho_min}, {rho_max}]")
     if method not in ("lmi", "adjugate"):
-        raise ModelError(f"unknown method {method!r}; use 'lmi' (paper, (40)) or 'adjugate'")
+        raise ParameterError(f"unknown method {method!r}; use 'lmi' (paper, (40)) or 'adjugate'")
     if not (isinstance(order, int) and order >= 0):
-        raise ModelError(f"order must be an integer >= 0, got {order!r}")
+        raise ParameterError(f"order must be an integer >= 0, got {order!r}")
     unc = tuple(uncertainties)
     rho_nominal = (rho_min + rho_max) / 2 if rho_nominal is None else float(rho_nominal)
     if rows is None:

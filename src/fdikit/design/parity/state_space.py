@@ -1,4 +1,4 @@
-"""State-space parity space for discrete LTI and LPV models (Varrier, Koenig & Martinez 2014, §3).
+"""State-space parity space for discrete LTI and LPV models (Varrier et al. 2014, §3).
 
 The stacked matrices of the parity relation (7)–(8) (``Y_s = H_os x + H_us U_s + …``) are built
 in :mod:`fdikit.lpv`.  The parity matrix (10)–(12) splits ``H_os`` into ``n`` regular rows
@@ -42,13 +42,13 @@ __all__ = [
 
 
 def minimal_horizon(n: int, p: int, residuals: int = 1) -> int:
-    """Smallest ``s`` with ``q = (s+1)p − n >= residuals`` (cf. Varrier 2014, (13): ``s = ⌈n/m⌉``).
+    """Smallest ``s`` with ``q = (s+1)p − n >= residuals`` (cf. Varrier et al. 2014, (13): ``s = ⌈n/m⌉``).
 
     >>> minimal_horizon(2, 2)
     1
     """
     if n < 0 or p < 1 or residuals < 1:
-        raise ModelError(f"need n >= 0, p >= 1 and residuals >= 1, got n={n}, p={p}, residuals={residuals}")
+        raise ParameterError(f"need n >= 0, p >= 1 and residuals >= 1, got n={n}, p={p}, residuals={residuals}")
     return max(0, -(-(n + residuals) // p) - 1)
 
 
@@ -63,7 +63,7 @@ def regular_rows(H_os: np.ndarray, rtol: float = 1e-9) -> tuple[int, ...]:
     """
     H = np.asarray(H_os)
     if H.ndim != 2:
-        raise ModelError(f"regular_rows needs one 2-D H_os, got shape {H.shape}")
+        raise ParameterError(f"regular_rows needs one 2-D H_os, got shape {H.shape}")
     n = H.shape[1]
     scale = max(np.linalg.norm(H, 2), np.finfo(float).tiny)
     rows: list[int] = []
@@ -80,7 +80,7 @@ def regular_rows(H_os: np.ndarray, rtol: float = 1e-9) -> tuple[int, ...]:
 
 
 def parity_matrix(H_os: np.ndarray, rows: Sequence[int] | None = None, cond_max: float = 1e12) -> np.ndarray:
-    """Parity basis ``P = [−H_os2 H_os1⁻¹, I_q]`` with ``P H_os = 0`` (Varrier 2014, (10)–(12)).
+    """Parity basis ``P = [−H_os2 H_os1⁻¹, I_q]`` with ``P H_os = 0`` (Varrier et al. 2014, (10)–(12)).
 
     Parameters
     ----------
@@ -107,7 +107,7 @@ def parity_matrix(H_os: np.ndarray, rows: Sequence[int] | None = None, cond_max:
         rows = regular_rows(H.reshape((-1, N, n))[0].real)
     rows = [int(i) for i in rows]
     if len(rows) != n or len(set(rows)) != n or not all(0 <= i < N for i in rows):
-        raise ModelError(f"rows must be {n} distinct row indices of H_os (0..{N - 1}), got {rows}")
+        raise ParameterError(f"rows must be {n} distinct row indices of H_os (0..{N - 1}), got {rows}")
     rest = [i for i in range(N) if i not in rows]
     H1, H2 = H[..., rows, :], H[..., rest, :]
     cond = np.linalg.cond(H1)
@@ -177,7 +177,7 @@ def _as_w2(W2, q: int) -> np.ndarray:
 
 def parity_design(model: FaultModel, s: int | None = None, *, W2=None, rows: Sequence[int] | None = None,
                   names: Sequence[str] | None = None, isolates: Sequence[str | None] | None = None) -> ParityDesign:
-    """Parity-space residual generator of a discrete LTI model (Varrier 2014, (7)–(12); Chow & Willsky 1984).
+    """Parity-space residual generator of a discrete LTI model (Varrier et al. 2014, (7)–(12); Chow & Willsky 1984).
 
     The residual is ``r(k) = W₂ᵀ P (Y_s(k) − H_us U_s(k))`` over the window ``[k−s, k]``,
     built as an FIR :class:`ResidualGenerator` whose state holds the last ``s`` samples of
@@ -204,7 +204,7 @@ def parity_design(model: FaultModel, s: int | None = None, *, W2=None, rows: Seq
     (1, True)
     """
     if not isinstance(model, FaultModel):
-        raise ModelError(f"parity_design needs a FaultModel, got {type(model).__name__}")
+        raise ParameterError(f"parity_design needs a FaultModel, got {type(model).__name__}")
     if not model.is_discrete:
         raise ModelError("parity_design needs a discrete model; use model.discretize(dt) first")
     s = minimal_horizon(model.n, model.p) if s is None else check_horizon(s)
@@ -246,7 +246,7 @@ def lpv_parity_residuals(
 ) -> Residuals:
     """LPV parity residual ``r(k) = W₂(ρ_k)ᵀ P(ρ) (Y_s(k) − H_us(ρ) U_s(k))``, P recomputed every sample.
 
-    Varrier 2014, (9), (12) and (16), on the causal window ``[k−s, k]``.
+    Varrier et al. 2014, (9), (12) and (16), on the causal window ``[k−s, k]``.
 
     Parameters
     ----------
@@ -298,7 +298,7 @@ def lpv_parity_residuals(
         if w.ndim == 2:
             w = w[..., None]
         if w.shape[:2] != (N - s, q):
-            raise ModelError(f"the W2 function returned shape {w.shape}; need ({N - s}, {q}) or ({N - s}, {q}, k)")
+            raise ParameterError(f"the W2 function returned shape {w.shape}; need ({N - s}, {q}) or ({N - s}, {q}, k)")
         r = np.einsum("kqi,kq->ki", w, z)
     else:
         r = z @ _as_w2(W2, q)

@@ -1,6 +1,6 @@
 """van der Ploeg 2018: the single-track steering-fault cases S1–S8 (Ch. 4).
 
-* :mod:`fdikit.studies.vanderploeg2018.scenarios` — Simulation cases of van der Ploeg (2018), Ch. 4: lateral vehicle
+* :mod:`fdikit.studies.vanderploeg2018.scenarios` — Simulation cases of van der Ploeg 2018, Ch. 4: lateral vehicle
   with additive and multiplicative steering faults.
 """
 

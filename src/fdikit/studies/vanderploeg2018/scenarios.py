@@ -1,4 +1,4 @@
-"""Simulation cases of van der Ploeg (2018), Ch. 4: lateral vehicle with additive and multiplicative steering faults.
+"""Simulation cases of van der Ploeg 2018, Ch. 4: lateral vehicle with additive and multiplicative steering faults.
 
 The plant is the single-track model with lane errors (:func:`fdikit.plants.single_track`, (B.12))
 sampled with a zero-order hold at ``h = 0.01`` s ((4.5)); it is simulated **open loop** with the
@@ -43,7 +43,7 @@ from dataclasses import asdict, replace
 import numpy as np
 from numpy.typing import ArrayLike
 
-from fdikit.errors import DataError, ModelError
+from fdikit.errors import DataError, ParameterError
 from fdikit.faults import NO_FAULT
 from fdikit.plants.single_track import PRIUS_2010, SingleTrackParameters, single_track, single_track_lpv
 from fdikit.simulate import simulate_scheduled
@@ -186,7 +186,7 @@ def design_bank_angle(radius: float, speed_kmh: int = 70) -> float:
 
     Raises
     ------
-    ModelError
+    ParameterError
         If ``speed_kmh`` is not a column of Table 4-2 or ``radius`` is not positive and finite.
 
     References
@@ -199,9 +199,9 @@ def design_bank_angle(radius: float, speed_kmh: int = 70) -> float:
     (1.43, 4.0, 4.0)
     """
     if speed_kmh not in (70, 90, 120):
-        raise ModelError(f"Table 4-2 lists 70, 90 and 120 km/h only, got {speed_kmh!r}")
+        raise ParameterError(f"Table 4-2 lists 70, 90 and 120 km/h only, got {speed_kmh!r}")
     if not (np.isfinite(radius) and radius > 0):
-        raise ModelError(f"curve radius must be positive (m), got {radius!r}")
+        raise ParameterError(f"curve radius must be positive (m), got {radius!r}")
     pairs = [(1.0 / R, b) for R, b in zip(TABLE_4_2[speed_kmh], TABLE_4_2["bank_deg"]) if R is not None]
     kappa, bank = np.array(pairs).T
     return float(np.interp(1.0 / radius, kappa, bank))
@@ -315,7 +315,7 @@ def lateral_run(
     DataError
         On a non-positive ``dt``, a ``duration`` shorter than one sample, a malformed fault schedule,
         speed, ``x0`` or noise standard deviation.
-    ModelError
+    ParameterError
         If ``params`` is not a :class:`~fdikit.plants.single_track.SingleTrackParameters`.
 
     References
@@ -333,7 +333,7 @@ def lateral_run(
     if not (np.isfinite(duration) and duration >= dt):
         raise DataError(f"duration must be at least one sample time ({dt} s), got {duration!r}")
     if not isinstance(params, SingleTrackParameters):
-        raise ModelError(f"params must be a SingleTrackParameters, got {type(params).__name__}")
+        raise ParameterError(f"params must be a SingleTrackParameters, got {type(params).__name__}")
     t = np.arange(int(round(duration / dt)) + 1) * dt
     N = t.size
     speed, speed_desc = _speed_array(speed_kmh, t, duration)
@@ -402,7 +402,7 @@ def vanderploeg_case(name: str, **overrides) -> Trace:
 
     Raises
     ------
-    ModelError
+    ParameterError
         If ``name`` is not one of the cases.
 
     References
@@ -416,7 +416,7 @@ def vanderploeg_case(name: str, **overrides) -> Trace:
     ('van der Ploeg 2018, Sec. 4-3-3 Case 1, Figs. 4-10, 4-11', [[0.0, 0.5], [40.0, 0.6]])
     """
     if name not in CASES:
-        raise ModelError(f"unknown case {name!r}; the cases are {sorted(CASES)} (S8: use cornering_run)")
+        raise ParameterError(f"unknown case {name!r}; the cases are {sorted(CASES)} (S8: use cornering_run)")
     kw = {**CASES[name], **overrides}
     kw.setdefault("label", name)
     return lateral_run(**kw)
@@ -571,7 +571,7 @@ def perturbed_parameters(params: SingleTrackParameters = PRIUS_2010, **scales: f
 
     Raises
     ------
-    ModelError
+    ParameterError
         If a name in ``scales`` is not a field of ``params``.
     ParameterError
         If a scaled value is invalid (e.g. a stiffness scaled to a positive value).
@@ -587,5 +587,5 @@ def perturbed_parameters(params: SingleTrackParameters = PRIUS_2010, **scales: f
     """
     unknown = set(scales) - set(asdict(params))
     if unknown:
-        raise ModelError(f"unknown vehicle parameters {sorted(unknown)}; choose from {sorted(asdict(params))}")
+        raise ParameterError(f"unknown vehicle parameters {sorted(unknown)}; choose from {sorted(asdict(params))}")
     return replace(params, **{k: getattr(params, k) * float(s) for k, s in scales.items()})

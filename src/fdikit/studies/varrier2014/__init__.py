@@ -1,4 +1,4 @@
-"""Varrier, Koenig & Martinez 2014: the lateral-acceleration sensor fault and the ϖ score (§5).
+"""Varrier et al. 2014: the lateral-acceleration sensor fault and the ϖ score (§5).
 
 * :mod:`fdikit.studies.varrier2014.scenarios` — The lateral-acceleration sensor fault of Varrier, Koenig & Martinez
   2014, §5.4–5.5, simulated.

@@ -1,4 +1,4 @@
-"""The lateral-acceleration sensor fault of Varrier, Koenig & Martinez 2014, §5.4–5.5, simulated.
+"""The lateral-acceleration sensor fault of Varrier et al. 2014, §5.4–5.5, simulated.
 
 The paper adds a +0.5 m/s² bias to the measured ``a_y`` from 150 s to 158 s of a Renault
 Scénic record (MIPS data, not available).  :func:`varrier_trace` replaces the record by a
@@ -31,7 +31,7 @@ import numpy as np
 
 from fdikit.design.parity.robust import kappa_max, pointwise_theorem1, robust_criteria, robust_lpv_parity
 from fdikit.design.parity.state_space import lpv_parity_residuals
-from fdikit.errors import DataError, ModelError
+from fdikit.errors import DataError, ParameterError
 from fdikit.faults import NO_FAULT
 from fdikit.plants.varrier_lateral import (
     RHO_STAR,
@@ -163,7 +163,7 @@ def varrier_trace(
 
     Raises
     ------
-    ModelError
+    ParameterError
         If ``duration`` or ``dt`` is not positive, or the fault window is empty.
 
     References
@@ -177,10 +177,10 @@ def varrier_trace(
     ((200, 3), 50)
     """
     if not (duration > 0 and dt > 0):
-        raise ModelError(f"duration and dt must be positive, got {duration}, {dt}")
+        raise ParameterError(f"duration and dt must be positive, got {duration}, {dt}")
     start, end = fault_window
     if not end > start:
-        raise ModelError(f"fault_window must be (start, end) with end > start, got {fault_window}")
+        raise ParameterError(f"fault_window must be (start, end) with end > start, got {fault_window}")
     rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
     lpv = varrier_lateral_lpv(dt, params)
     A1 = varrier_uncertainty(dt, params, mode=uncertainty_mode).A[0]
