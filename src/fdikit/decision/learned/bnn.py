@@ -109,7 +109,54 @@ class TrainingReport:
     """Training record: ``J`` on the whole training set at the start, after the quasi-Newton phase
     and at the end; quasi-Newton iterations, cost evaluations and stop reason; Robbins–Monro steps,
     first and last gain, and the largest Hessian eigenvalue used for the default ``ρ_0`` (NaN when
-    ``rho0`` was given)."""
+    ``rho0`` was given).
+
+    Attributes
+    ----------
+    cost_initial : float
+        ``J`` at the initial weights.
+    cost_deterministic : float
+        ``J`` after the quasi-Newton phase.
+    cost_final : float
+        ``J`` after the Robbins–Monro phase (the trained network).
+    iterations : int
+        Quasi-Newton iterations.
+    evaluations : int
+        Cost-and-gradient evaluations of the quasi-Newton phase.
+    message : str
+        Why the quasi-Newton phase stopped.
+    rm_steps : int
+        Robbins–Monro steps (0: phase skipped).
+    rho : (float, float)
+        First and last Robbins–Monro gain (``(0.0, 0.0)`` when skipped).
+    curvature : float
+        Largest Hessian eigenvalue estimate behind the default ``ρ_0 = 0.5/λ_max`` (NaN when ``rho0`` was
+        given or the phase was skipped).
+    samples : int
+        Valid training samples.
+    sequences : int
+        Training sequences (runs).
+
+    References
+    ----------
+    Douglas et al. 1996, §6.1, (6.1) (the network with output feedback), §6.2.2 (outputs as posterior
+    probabilities, one-hot targets), §6.3.1–6.3.2 (DFP and Robbins–Monro training), §6.4 (one network per
+    filter on the residual magnitudes) and §6.5 (step and ramp faults).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.residuals import Residuals
+    >>> from fdikit.decision.learned.bnn import BnnEvaluator
+    >>> rng = np.random.default_rng(0)
+    >>> def run(mean):
+    ...     r = np.abs(mean + 0.3 * rng.standard_normal((20, 2)))
+    ...     return Residuals(np.arange(20) * 0.01, r, ("za", "zb"), ("a", "b"))
+    >>> data = {"none": [run([0, 0])], "a": [run([1, 0])], "b": [run([0, 1])]}
+    >>> rep = BnnEvaluator(hidden=(2,), max_iter=10, rm_steps=5, rng=1).fit(data).report
+    >>> rep.samples, rep.sequences, rep.rm_steps, rep.cost_deterministic < rep.cost_initial
+    (60, 3, 5, True)
+    """
 
     cost_initial: float
     cost_deterministic: float
@@ -148,14 +195,18 @@ class BnnEvaluator:
     threshold : float
         Alarm when the largest posterior is ``≥ threshold`` (default 0.5); the isolated fault is
         the hypothesis with the largest posterior.
-    update : quasi-Newton update of the deterministic phase, 'bfgs' (default) or 'dfp' (the report's;
+    update : {'bfgs', 'dfp'}
+        Quasi-Newton update of the deterministic phase, 'bfgs' (default) or 'dfp' (the report's;
         see the module notes for why BFGS is the default).
-    max_iter : quasi-Newton iteration limit (0 skips the deterministic phase).
-    rm_steps, rm_window, rm_batch, rho0, rm_exponent : Robbins–Monro phase (``rm_steps=0`` skips it):
+    max_iter : int
+        Quasi-Newton iteration limit (0 skips the deterministic phase).
+    rm_steps, rm_window, rm_batch, rho0, rm_exponent : int, int, int, float or None, float
+        Robbins–Monro phase (``rm_steps=0`` skips it):
         number of steps, window length and windows per step, ``ρ_k = rho0/(k+1)^rm_exponent``;
         ``rho0=None`` takes half the stable gradient step, ``0.5/λ_max`` of the Hessian of the
         training cost at the deterministic solution (power iteration).
-    rng : Generator or seed for the initial weights and the random windows.
+    rng : numpy.random.Generator or int
+        Generator or seed for the initial weights and the random windows.
 
     Examples
     --------
@@ -170,6 +221,12 @@ class BnnEvaluator:
     >>> ev = BnnEvaluator(max_iter=60, rm_steps=20, rng=1).fit(data)
     >>> str(ev.run(run([1, 0])).isolated[-1])
     'a'
+
+    References
+    ----------
+    Douglas et al. 1996, §6.1, (6.1) (the network with output feedback), §6.2.2 (outputs as posterior
+    probabilities, one-hot targets), §6.3.1–6.3.2 (DFP and Robbins–Monro training), §6.4 (one network per
+    filter on the residual magnitudes) and §6.5 (step and ramp faults).
     """
 
     def __init__(
