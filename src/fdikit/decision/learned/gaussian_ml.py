@@ -38,8 +38,50 @@ class GaussianMlEvaluator:
 
     Parameters
     ----------
-    priors : None (equal: the report's ML rule), 'empirical' (class frequencies) or a mapping.
-    inputs, columns : as for :class:`BnnEvaluator` (no scaling: the rule is affine invariant).
+    priors : None, 'empirical' or mapping
+        None (equal: the report's ML rule), 'empirical' (class frequencies of the training samples, with
+        :meth:`fit` only) or a mapping class → positive weight (normalised to sum 1).
+    inputs : {'magnitude', 'raw'}, default 'magnitude'
+        One input per fault group (the Euclidean magnitude of its residuals) or one per residual, as for
+        :class:`~fdikit.decision.learned.bnn.BnnEvaluator` (no scaling: the rule is affine invariant).
+    columns : sequence of str, optional
+        Residual names to use (one classifier per filter of a stacked bank).
+
+    Attributes
+    ----------
+    classes : tuple of str
+        The classes, in order of first appearance in the training labels.
+    hypotheses : tuple of str
+        The fault classes (``classes`` without ``'none'``): the columns of ``Diagnosis.probabilities``.
+    means : (C, n) ndarray
+        Class means ``m_i`` of the inputs.
+    covariance : (n, n) ndarray
+        Shared (pooled within-class) covariance ``Λ``.
+    prior : (C,) ndarray
+        Class priors ``π_i``.
+    weights, bias : (C, n) and (C,) ndarray
+        ``2 m_iᵀΛ⁻¹`` and ``−m_iᵀΛ⁻¹m_i + 2 ln π_i``.
+
+    Raises
+    ------
+    ParameterError
+        When ``inputs`` is not 'magnitude' or 'raw'.
+
+    References
+    ----------
+    Douglas et al. 1996, §6.2.1 (a maximum-likelihood Gaussian classifier as a multilayer perceptron: ``L_ij``,
+    ``W`` and ``θ``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.residuals import Residuals
+    >>> from fdikit.decision.learned.gaussian_ml import GaussianMlEvaluator
+    >>> ev = GaussianMlEvaluator.from_moments({"none": [0.0, 0.0], "fa": [2.0, 0.0], "fb": [0.0, 2.0]}, np.eye(2))
+    >>> res = Residuals(np.arange(3) * 0.1, np.array([[0.0, 0.0], [2.0, 0.0], [0.1, 2.2]]), ("x0", "x1"), (None, None))
+    >>> d = ev.run(res)
+    >>> d.hypotheses, d.isolated.tolist(), np.round(d.probabilities[1], 3).tolist()
+    (('fa', 'fb'), ['none', 'fa', 'fb'], [0.867, 0.016])
     """
 
     def __init__(self, priors=None, *, inputs: str = "magnitude", columns: Sequence[str] | None = None) -> None:
