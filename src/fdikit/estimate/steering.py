@@ -75,11 +75,34 @@ def lateral_fault_map(pole: float = 0.9048, zero: float = -0.97294, dt: float = 
     ``tests/studies/vanderploeg2018`` recompute it).
     Poles used in the thesis: 0.9048, 0.6065, 0.3679 (``e^{-10h}, e^{-50h}, e^{-100h}``).
 
+    Parameters
+    ----------
+    pole : float, optional
+        The triple pole ``p`` (default 0.9048 = ``e^{-10h}``), ``|p| < 1``.
+    zero : float, optional
+        The zero ``z_0`` (default −0.97294), not 1.
+    dt : float, optional
+        Sample time ``h`` [s] (default 0.01).
+
+    Returns
+    -------
+    scipy.signal.TransferFunction
+        ``G(q)``, discrete with sample time ``dt``.
+
+    Raises
+    ------
+    ParameterError
+        If ``|pole| ≥ 1``, ``zero`` is 1 or not finite, or ``dt`` is not positive.
+
     Examples
     --------
     >>> G = lateral_fault_map()
     >>> round(float(np.polyval(G.num, 1.0) / np.polyval(G.den, 1.0)), 12)
     1.0
+
+    References
+    ----------
+    van der Ploeg 2018, §4-3-1, (4.9)–(4.10); Lemma 2-1.2, (2.8b).
     """
     p = validate.number("pole", pole, finite=False)
     z0 = validate.number("zero", zero, finite=False)
@@ -96,12 +119,32 @@ def lateral_fault_map(pole: float = 0.9048, zero: float = -0.97294, dt: float = 
 def fault_map_coefficients(fault_map: FaultMap) -> tuple[np.ndarray, np.ndarray]:
     """``(num, den)`` of a SISO discrete map, descending powers of ``q``, ``den`` monic, ``len(num) == len(den)``.
 
+    Parameters
+    ----------
+    fault_map : scipy.signal.dlti or tuple
+        The map ``G(q)``: a discrete LTI system or a ``(num, den)`` pair in descending powers of ``q``.
+
+    Returns
+    -------
+    num, den : ndarray
+        Coefficients of equal length, ``den[0] = 1`` (the form :func:`scipy.signal.lfilter` reads).
+
     Raises
     ------
     ModelError
         If the map is not SISO, not proper, or has a zero leading denominator coefficient.
     DesignError
         If it is unstable (a pole on or outside the unit circle): a pre-filter must be the stable ``G(q)``.
+
+    Examples
+    --------
+    >>> num, den = fault_map_coefficients(([1.0], [2.0, -1.0]))     # G(q) = 1 / (2q − 1)
+    >>> num.tolist(), den.tolist()
+    ([0.0, 0.5], [1.0, -0.5])
+
+    References
+    ----------
+    van der Ploeg 2018, §3-2, (3.7)–(3.8) (the pre-filter ``G(q)``); (4.10).
     """
     if isinstance(fault_map, scipy.signal.dlti):
         tf = fault_map.to_tf()
@@ -142,19 +185,41 @@ class SteeringFaultEstimate:
 
     Attributes
     ----------
-    t : (N,) sample times (or indices).
-    f_a_hat : (N,) additive fault estimate, in the residual's units (rad for a steering angle); NaN where invalid.
-    f_m_hat : (N,) multiplicative fault estimate (gain, ``nominal_gain`` when healthy); NaN where invalid.
-    valid : (N,) bool, True where the window is full, finite and exciting (``V_n`` above the guard).
-    regressor : (N,) the regressor signal used: ``E`` or the pre-filtered ``Ẽ = G(q)[E]``.
-    mean, variance : (N,) ``μ_n`` and ``V_n`` of the regressor over each window (NaN before the first full window).
-    excitation_factor : (N,) ``sqrt((max(1, σ_n²) + |μ_n|)/(n V_n))``, the bound of Lemma A-1.1 on
+    t : ndarray
+        (N,) sample times (or indices).
+    f_a_hat : ndarray
+        (N,) additive fault estimate, in the residual's units (rad for a steering angle); NaN where invalid.
+    f_m_hat : ndarray
+        (N,) multiplicative fault estimate (gain, ``nominal_gain`` when healthy); NaN where invalid.
+    valid : ndarray of bool
+        (N,) True where the window is full, finite and exciting (``V_n`` above the guard).
+    regressor : ndarray
+        (N,) the regressor signal used: ``E`` or the pre-filtered ``Ẽ = G(q)[E]``.
+    mean, variance : ndarray
+        (N,) ``μ_n`` and ``V_n`` of the regressor over each window (NaN before the first full window).
+    excitation_factor : ndarray
+        (N,) ``sqrt((max(1, σ_n²) + |μ_n|)/(n V_n))``, the bound of Lemma A-1.1 on
         ``‖Φ_n‖_2`` with the ``max(1, σ²)`` correction (erratum: see :mod:`fdikit.estimate.steering_bound`);
-        measurable online, it is
-        the excitation monitor (6.1).  inf where ``V_n = 0``.
-    n : window length.
-    nominal_gain : the healthy gain (1 in the thesis convention).
-    prefilter : ``(num, den)`` of the pre-filter ``G(q)``, or None.
+        measurable online, it is the excitation monitor (6.1).  inf where ``V_n = 0``.
+    n : int
+        Window length.
+    nominal_gain : float
+        The healthy gain (1 in the thesis convention).
+    prefilter : tuple of ndarray or None
+        ``(num, den)`` of the pre-filter ``G(q)``, or None.
+
+    Examples
+    --------
+    >>> E = np.array([1.0, 2.0, 4.0, 3.0, 1.0, 2.0])
+    >>> est = isolate_steering_faults(0.1 + (1.5 - 1.0) * E, E, n=3)   # f_a = 0.1, f_m = 1.5, G = 1
+    >>> len(est), est.valid.tolist(), est.prefiltered
+    (6, [False, False, True, True, True, True], False)
+    >>> round(float(est.f_a_hat[-1]), 6), round(float(est.f_m_hat[-1]), 6)
+    (0.1, 1.5)
+
+    References
+    ----------
+    van der Ploeg 2018, Def. 3-1.1, (3.1)–(3.4); §3-2, (3.8).
     """
 
     t: np.ndarray
@@ -179,7 +244,30 @@ class SteeringFaultEstimate:
 
 
 class IsolatorStep(NamedTuple):
-    """One online estimate: ``f_a_hat``, ``f_m_hat`` (NaN when invalid), ``valid``."""
+    """One online estimate: ``f_a_hat``, ``f_m_hat`` (NaN when invalid), ``valid``.
+
+    Attributes
+    ----------
+    f_a_hat : float
+        Additive fault estimate; NaN when invalid.
+    f_m_hat : float
+        Multiplicative fault (gain) estimate; NaN when invalid.
+    valid : bool
+        Whether the window is full, finite and exciting.
+
+    Examples
+    --------
+    >>> iso = SteeringFaultIsolator(n=2)
+    >>> iso.step(0.6, 1.0)
+    IsolatorStep(f_a_hat=nan, f_m_hat=nan, valid=False)
+    >>> step = iso.step(1.1, 2.0)
+    >>> round(step.f_a_hat, 12), round(step.f_m_hat, 12), step.valid
+    (0.1, 1.5, True)
+
+    References
+    ----------
+    van der Ploeg 2018, Def. 3-1.1, (3.4).
+    """
 
     f_a_hat: float
     f_m_hat: float
@@ -283,6 +371,18 @@ def isolate_steering_faults(
     Returns
     -------
     SteeringFaultEstimate
+        Estimates, validity and the regressor statistics per sample.
+
+    Raises
+    ------
+    DataError
+        If ``residual`` and ``setpoint`` are not 1-D arrays of equal length, or ``t`` does not match them.
+    ParameterError
+        If ``n`` is not an integer ≥ 2, or ``min_variance``/``rtol``/``nominal_gain`` is out of range.
+    ModelError
+        If ``prefilter`` is not a proper SISO map.
+    DesignError
+        If ``prefilter`` is unstable or its DC gain is not 1.
 
     Examples
     --------
@@ -297,6 +397,10 @@ def isolate_steering_faults(
     >>> est = isolate_steering_faults(r, E, n=100, t=t, prefilter=G)
     >>> print(f"{est.f_a_hat[-1]:.6f} {est.f_m_hat[-1]:.6f}")
     0.002000 0.500000
+
+    References
+    ----------
+    van der Ploeg 2018, Def. 3-1.1, (3.4), (4.11); §3-2, (3.7)–(3.8), Cor. 3-2.2, (4.13).
     """
     n = _check_window(n)
     min_var, rt = _check_guard(min_variance, rtol)
@@ -349,6 +453,24 @@ class SteeringFaultIsolator:
     from a zero state.  A non-finite set-point holds the pre-filter state; any window holding a
     non-finite value is invalid (NaN estimates, ``valid=False``).
 
+    Parameters
+    ----------
+    n : int
+        Window length, ≥ 2.
+    prefilter : FaultMap, optional
+        ``G(q)`` for the pre-filter estimator (stable, ``G(1) = 1``); None regresses on ``E`` itself.
+    nominal_gain : float, optional
+        Healthy gain added to the slope (default 1).
+    min_variance, rtol : float, optional
+        The excitation guard, as in :func:`isolate_steering_faults` (defaults 0 and 1e-10).
+
+    Raises
+    ------
+    ParameterError
+        If ``n`` is not an integer ≥ 2, or the guard or ``nominal_gain`` is out of range.
+    ModelError, DesignError
+        If ``prefilter`` is not a proper, stable SISO map with unit DC gain.
+
     Examples
     --------
     >>> iso = SteeringFaultIsolator(n=3)
@@ -357,6 +479,10 @@ class SteeringFaultIsolator:
     >>> s = iso.step(0.5 * 3.0 + 0.1, 3.0)
     >>> round(s.f_a_hat, 12), round(s.f_m_hat, 12)
     (0.1, 1.5)
+
+    References
+    ----------
+    van der Ploeg 2018, Def. 3-1.1, (3.4); §3-2, (3.8).
     """
 
     def __init__(
