@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fdikit.errors import ModelError
+from fdikit.errors import ParameterError
 from fdikit.metrics import vaf
 from fdikit.multimodel.convex import convex_model_set, dual_convex_filter, fault_size_from_weights
 from fdikit.multimodel.convex_ekf import augmented_ekf
@@ -63,6 +63,27 @@ MSD_STATES = ("x1", "x2", "x3", "v1", "v2", "v3")
 def msd_profile(t, f1_size: float = 0.5, f2_size: float = 0.5) -> np.ndarray:
     """Parameters ``(k1, m3, f1, f2)`` per time (K, 4) of the scenario (§3.6.2; trajectory and sizes assumed).
 
+    Parameters
+    ----------
+    t : array_like
+        Times [s].
+    f1_size, f2_size : float, default 0.5
+        Actuator-1 effectiveness on ``[30, 50)`` s and sensor-2 gain on ``[70, 80)`` s, in ``[0, 1]`` (1 = healthy).
+
+    Returns
+    -------
+    numpy.ndarray
+        (K, 4) array, columns ``k1, m3, f1, f2``.
+
+    Raises
+    ------
+    ParameterError
+        If a fault size is outside ``[0, 1]``.
+
+    References
+    ----------
+    Hallouzi 2008, §3.6.2, Fig. 3.6 (trajectory and sizes are fdikit's assumptions).
+
     Examples
     --------
     >>> msd_profile([0.0, 40.0, 75.0]).round(3).tolist()
@@ -71,7 +92,7 @@ def msd_profile(t, f1_size: float = 0.5, f2_size: float = 0.5) -> np.ndarray:
     t = np.atleast_1d(np.asarray(t, float))
     for name, size in (("f1_size", f1_size), ("f2_size", f2_size)):
         if not 0.0 <= size <= 1.0:
-            raise ModelError(f"{name} must be a fault parameter in [0, 1] (1 = healthy), got {size}")
+            raise ParameterError(f"{name} must be a fault parameter in [0, 1] (1 = healthy), got {size}")
     k1 = 1.0 + 0.7 * np.sin(2 * np.pi * t / 100.0)
     m3 = 1.0 + 0.7 * np.sin(2 * np.pi * t / 60.0 + np.pi / 4)
     f1 = np.where((t >= 30.0) & (t < 50.0), f1_size, 1.0)
@@ -87,7 +108,33 @@ def _inputs(t: np.ndarray) -> np.ndarray:
 @dataclass(frozen=True)
 class MSDSimulation:
     """One §3.6.2 run: ``t`` (K,), ``u`` (K, 2), noisy ``y`` (K, 3), true ``x`` (K, 6) and ``params`` (K, 4)
-    (columns k1, m3, f1, f2), and the measurement-noise standard deviations ``noise_std`` (3,)."""
+    (columns k1, m3, f1, f2), and the measurement-noise standard deviations ``noise_std`` (3,).
+
+    Attributes
+    ----------
+    t : (K,) array
+        Sample times [s].
+    u : (K, 2) array
+        Inputs ``u1``, ``u2`` (forces on m1 and m3).
+    y : (K, 3) array
+        Noisy position measurements.
+    x : (K, 6) array
+        True states ``x1, x2, x3, v1, v2, v3``.
+    params : (K, 4) array
+        True ``(k1, m3, f1, f2)`` per sample (:func:`msd_profile`).
+    noise_std : (3,) array
+        Measurement-noise standard deviations.
+
+    References
+    ----------
+    Hallouzi 2008, §3.6.2.
+
+    Examples
+    --------
+    >>> sim = simulate_msd(duration=1.0, dt=0.01)
+    >>> sim.y.shape, sim.x.shape, sim.params.shape
+    ((100, 3), (100, 6), (100, 4))
+    """
 
     t: np.ndarray
     u: np.ndarray
@@ -106,13 +153,41 @@ def simulate_msd(seed=0, duration: float = 100.0, dt: float = MSD_SAMPLE_TIME, s
     with white Gaussian ``v`` scaled so that every output has the given SNR (2.62) with respect to its
     noise-free signal.  Default ``dt`` is the thesis design sample time; the tests use 0.01 s.
 
+    Parameters
+    ----------
+    seed : int or numpy.random.Generator, default 0
+        Seed of the measurement noise.
+    duration : float, default 100.0
+        Run length [s].
+    dt : float, default MSD_SAMPLE_TIME (2.5e-3)
+        Sample time [s]; at most about 0.02 s (the series ZOH).
+    snr_db : float, default 60.0
+        Signal-to-noise ratio of every output [dB].
+    f1_size, f2_size : float, default 0.5
+        Fault sizes (see :func:`msd_profile`).
+
+    Returns
+    -------
+    MSDSimulation
+        ``round(duration / dt)`` samples of inputs, noisy outputs, true states and parameters.
+
     Raises
     ------
-    ModelError
+    ParameterError
         If ``duration`` or ``dt`` is not positive or a fault size is outside ``[0, 1]``.
+
+    References
+    ----------
+    Hallouzi 2008, §3.6.2, (2.62); App. B, (B.3)–(B.5).
+
+    Examples
+    --------
+    >>> sim = simulate_msd(duration=1.0, dt=0.01)
+    >>> sim.t.shape, sim.noise_std.shape
+    ((100,), (3,))
     """
     if not (np.isfinite(duration) and np.isfinite(dt)) or duration <= 0 or dt <= 0 or dt > duration:
-        raise ModelError(f"need 0 < dt <= duration, got dt={dt}, duration={duration}")
+        raise ParameterError(f"need 0 < dt <= duration, got dt={dt}, duration={duration}")
     rng = np.random.default_rng(seed)
     K = int(round(duration / dt))
     t = dt * np.arange(K)
@@ -124,7 +199,7 @@ def simulate_msd(seed=0, duration: float = 100.0, dt: float = MSD_SAMPLE_TIME, s
     C = np.stack([m[2] for m in mats])
     # ZOH transition by the Taylor series (B.3)-(B.4) to 6th order: ‖A‖T <= 0.5 here, remainder < 2e-7 (B.5).
     if np.abs(A).sum(axis=(1, 2)).max() > 0.5:
-        raise ModelError(f"dt={dt} is too coarse for the series ZOH of the MSD; use dt <= 0.02")
+        raise ParameterError(f"dt={dt} is too coarse for the series ZOH of the MSD; use dt <= 0.02")
     Ad, Bd = np.broadcast_to(np.eye(6), A.shape).copy(), B.copy()
     term_a, term_b = np.broadcast_to(np.eye(6), A.shape).copy(), B.copy()
     for j in range(1, 7):
@@ -147,10 +222,28 @@ class MSDModelSet:
 
     Attributes
     ----------
-    parameters : (6, 4) ``(k1, m3, f1, f2)`` of the selected models, in pivot order.
-    indices : their columns in the large set.  rank : numerical rank ``N_r`` (thesis: 5).
-    A, B, C : (6, ·, ·) first-order discretised local matrices.  dt : their sample time.
-    actuator_fault, sensor_fault : 0-based indices of the models with ``f1 = 0`` / ``f2 = 0``.
+    parameters : (6, 4) array
+        ``(k1, m3, f1, f2)`` of the selected models, in pivot order.
+    indices : tuple of int
+        Their columns in the large set.
+    rank : int
+        Numerical rank ``N_r`` (thesis: 5).
+    A, B, C : arrays (6, 6, 6), (6, 6, 2), (6, 3, 6)
+        First-order discretised local matrices.
+    dt : float
+        Their sample time [s].
+    actuator_fault, sensor_fault : tuple of int
+        0-based indices of the models with ``f1 = 0`` / ``f2 = 0``.
+
+    References
+    ----------
+    Hallouzi 2008, §3.6.1, Table 3.2.
+
+    Examples
+    --------
+    >>> ms = msd_od_model_set(dt=0.01, grid_levels=2)
+    >>> ms.parameters.shape, ms.rank, ms.actuator_fault, ms.sensor_fault
+    ((6, 4), 5, (4, 5), (1, 2))
     """
 
     parameters: np.ndarray
@@ -180,13 +273,37 @@ def msd_od_model_set(dt: float = MSD_SAMPLE_TIME, grid_levels: int = 5, fault_va
     Table 3.2.  (LAPACK's rounding-decided pivots gave, depending on the kernel, a 0.5-fault member, with
     which f2 read 0.64 in its 0.5 fault, or a single nominal model.)
 
+    Parameters
+    ----------
+    dt : float, default MSD_SAMPLE_TIME (2.5e-3)
+        Sample time [s] of the first-order discretised large model set.
+    grid_levels : int, default 5
+        Levels of ``k1`` and ``m3`` each, from range limit to range limit.
+    fault_values : sequence of float, default (0.0, 0.5, 1.0)
+        Fault levels of ``f1`` and ``f2`` (:func:`~fdikit.plants.msd.msd_parameter_grid`).
+
+    Returns
+    -------
+    MSDModelSet
+        The 6 selected models, their indices, the rank and the local matrices.
+
     Raises
     ------
-    ModelError
+    ParameterError
         If ``grid_levels < 2`` (the grid must hold the range limits).
+
+    References
+    ----------
+    Hallouzi 2008, §3.3.2, (3.19)–(3.23); §3.6.1, Table 3.2.
+
+    Examples
+    --------
+    >>> ms = msd_od_model_set(dt=0.01, grid_levels=2)
+    >>> ms.A.shape, ms.dt
+    ((6, 6, 6), 0.01)
     """
     if grid_levels < 2:
-        raise ModelError(f"grid_levels must be >= 2 so the grid holds both range limits, got {grid_levels}")
+        raise ParameterError(f"grid_levels must be >= 2 so the grid holds both range limits, got {grid_levels}")
     grid = msd_parameter_grid(np.linspace(0.25, 1.75, grid_levels), np.linspace(0.2, 1.8, grid_levels),
                               np.asarray(fault_values, float))
     at_limits = np.isin(grid[:, 2], (0.0, 1.0)) & np.isin(grid[:, 3], (0.0, 1.0))
@@ -205,11 +322,30 @@ class MSDFilterResult:
 
     Attributes
     ----------
-    mu : (K, 6) estimated weights.  x : (K, 6) estimated states.
-    f1, f2 : (K,) reconstructed faults ``1 − Σ μ̂ / Σ_all μ̂`` over the ``f = 0`` models (Fig. 3.9).
-    params : (K, 4) parameters of the blended model ``Σ μ̂^(i) (k1, 1/m3, f1, f2)^(i)`` (exact, since the MSD
+    mu : (K, 6) array
+        Estimated weights.
+    x : (K, 6) array
+        Estimated states.
+    f1, f2 : (K,) arrays
+        Reconstructed faults ``1 − Σ μ̂ / Σ_all μ̂`` over the ``f = 0`` models (Fig. 3.9).
+    params : (K, 4) array
+        Parameters of the blended model ``Σ μ̂^(i) (k1, 1/m3, f1, f2)^(i)`` (exact, since the MSD
         matrices are affine in ``k1, 1/m3, f1, f2``), mapped back to ``(k1, m3, f1, f2)``.
-    vaf : state name → VAF (3.53) in percent.  model_set : the OD set used.
+    vaf : dict of str to float
+        State name → VAF (3.53) in percent.
+    model_set : MSDModelSet
+        The OD set used.
+
+    References
+    ----------
+    Hallouzi 2008, §3.6.2, Table 3.3, Fig. 3.9, (3.53).
+
+    Examples
+    --------
+    >>> sim = simulate_msd(duration=1.0, dt=0.01)
+    >>> result = run_msd_filter(sim, msd_od_model_set(dt=0.01, grid_levels=2))
+    >>> result.mu.shape, sorted(result.vaf)
+    ((100, 6), ['v1', 'v2', 'v3', 'x1', 'x2', 'x3'])
     """
 
     mu: np.ndarray
@@ -228,16 +364,29 @@ def run_msd_filter(sim: MSDSimulation, model_set: MSDModelSet | None = None, fil
 
     Parameters
     ----------
-    sim : the simulated data (its sample time must equal the model set's).
-    model_set : default :func:`msd_od_model_set` at ``sim``'s sample time.
-    filter : ``"ekf"`` (Table 2.3, the thesis choice for §3.6.2) or ``"dual_cmf"`` (Table 2.2).
-    q_x : process-noise variance per state of the filter model.  q_mu : EKF weight random-walk variance.
-    lam : dual-CMF forgetting factor.
-    constrain : project the weights on the simplex (thesis, §2.3.2–2.3.3).  Default ``False``: the OD set
+    sim : MSDSimulation
+        The simulated data (its sample time must equal the model set's).
+    model_set : MSDModelSet, optional
+        Default :func:`msd_od_model_set` at ``sim``'s sample time.
+    filter : {"ekf", "dual_cmf"}, default "ekf"
+        ``"ekf"`` (Table 2.3, the thesis choice for §3.6.2) or ``"dual_cmf"`` (Table 2.2).
+    q_x : float, default 3e-6
+        Process-noise variance per state of the filter model.
+    q_mu : float, default 1e-6
+        EKF weight random-walk variance.
+    lam : float, default 0.999
+        Dual-CMF forgetting factor.
+    constrain : bool, default False
+        Project the weights on the simplex (thesis, §2.3.2–2.3.3).  Default ``False``: the OD set
         represents the large set only *affinely* ((3.21)); its two nominal models span a line in ``(k1, 1/m3)``,
         so most healthy ``(k1, m3)`` need a negative weight, and the simplex projection then borrows weight
         from the fault models (measured: f1 ≈ 0.47 while healthy, v2 VAF 80 %).  Unconstrained, the weights
         stay within 0.3 % of sum one after the first 5 s; the reconstruction divides by ``Σ μ̂``.
+
+    Returns
+    -------
+    MSDFilterResult
+        Weights, states, reconstructed faults, blended parameters and the VAF per state.
 
     Notes
     -----
@@ -247,13 +396,24 @@ def run_msd_filter(sim: MSDSimulation, model_set: MSDModelSet | None = None, fil
 
     Raises
     ------
-    ModelError
+    ParameterError
         On an unknown filter or a sample-time mismatch.
+
+    References
+    ----------
+    Hallouzi 2008, §3.6.2, Table 3.3, Fig. 3.9; Tables 2.2–2.3 (the filters); (3.53) (VAF).
+
+    Examples
+    --------
+    >>> sim = simulate_msd(duration=1.0, dt=0.01)
+    >>> result = run_msd_filter(sim, msd_od_model_set(dt=0.01, grid_levels=2))
+    >>> result.x.shape, result.f1.shape
+    ((100, 6), (100,))
     """
     dt = float(sim.t[1] - sim.t[0])
     ms = msd_od_model_set(dt) if model_set is None else model_set
     if not np.isclose(ms.dt, dt, rtol=1e-9):
-        raise ModelError(f"the model set is discretised at {ms.dt} s but the data at {dt} s; design it at {dt}")
+        raise ParameterError(f"the model set is discretised at {ms.dt} s but the data at {dt} s; design it at {dt}")
     cms = convex_model_set(ms.A, ms.B, ms.C, Q=q_x * np.eye(6), R=np.diag(sim.noise_std ** 2))
     x0, P0 = np.zeros(6), 1e-2 * np.eye(6)
     if filter == "ekf":
@@ -261,7 +421,7 @@ def run_msd_filter(sim: MSDSimulation, model_set: MSDModelSet | None = None, fil
     elif filter == "dual_cmf":
         res = dual_convex_filter(cms, sim.y, sim.u, x0, P0, lam=lam, constrain=constrain or "affine")
     else:
-        raise ModelError(f"filter must be 'ekf' or 'dual_cmf', got {filter!r}")
+        raise ParameterError(f"filter must be 'ekf' or 'dual_cmf', got {filter!r}")
     par = ms.parameters
     mu = res.mu / res.mu.sum(axis=1, keepdims=True)  # affine weights: renormalise the (small) sum drift
     blended = mu @ np.column_stack([par[:, 0], 1.0 / par[:, 1], par[:, 2], par[:, 3]])
@@ -279,10 +439,25 @@ class ObservabilityComparison:
 
     Attributes
     ----------
-    od_models, mismatch_models : the two ``m3`` values of each set (OD: 0.2, 1.8; minimum mismatch: 0.8651, 1.1349).
-    od, mismatch : (R,) mean condition number (3.9) per realization of the ``m3`` sequence.
-    ratio : (R,) ``mismatch / od``.  predicted_ratio : ``(1/m_a − 1/m_b)_OD / (1/m_a − 1/m_b)_mm`` — the
-        ratio of the model separations, to which the weight column of the observability matrix is proportional.
+    od_models, mismatch_models : (2,) arrays
+        The two ``m3`` values of each set (OD: 0.2, 1.8; minimum mismatch: 0.8651, 1.1349).
+    od, mismatch : (R,) arrays
+        Mean condition number (3.9) per realization of the ``m3`` sequence.
+    ratio : (R,) array
+        ``mismatch / od``.
+    predicted_ratio : float
+        ``(1/m_a − 1/m_b)_OD / (1/m_a − 1/m_b)_mm`` — the ratio of the model separations, to which the
+        weight column of the observability matrix is proportional.
+
+    References
+    ----------
+    Hallouzi 2008, §3.6.4, Table 3.4, (3.9).
+
+    Examples
+    --------
+    >>> c = msd_observability_comparison(realizations=1, n_steps=50, samples=10)
+    >>> c.od_models.tolist(), c.mismatch_models.round(4).tolist(), round(float(c.predicted_ratio), 2)
+    ([0.2, 1.8], [0.8651, 1.1349], 16.17)
     """
 
     od_models: np.ndarray
@@ -323,9 +498,44 @@ def msd_observability_comparison(realizations: int = 5, seed: int | None = 0, *,
     say how the weights enter).  The absolute numbers depend on these choices; the ratio does not (measured 16.17
     in every realization,
     the thesis's 16.1–16.15).
+
+    Parameters
+    ----------
+    realizations : int, default 5
+        Number of random ``m3`` sequences.
+    seed : int or None, default 0
+        Seed of the sequences.
+    n_steps : int, default 2000
+        Samples per sequence.
+    samples : int, default 100
+        Final samples over which the condition number is averaged (``<= n_steps``).
+    dt : float, default MSD_SAMPLE_TIME (2.5e-3)
+        Sample time [s] of the first-order discretisation.
+    sigma0 : float, default 0.2
+        Standard deviation of the ``m3`` prior (3.58).
+
+    Returns
+    -------
+    ObservabilityComparison
+        The two model pairs, the condition numbers per realization, their ratio and the predicted ratio.
+
+    Raises
+    ------
+    ParameterError
+        Unless ``realizations >= 1`` and ``1 <= samples <= n_steps``.
+
+    References
+    ----------
+    Hallouzi 2008, §3.6.4, Table 3.4, (3.58); §3.3.1, Def. 3.1, (3.9).
+
+    Examples
+    --------
+    >>> c = msd_observability_comparison(realizations=1, n_steps=50, samples=10)
+    >>> c.ratio.shape, round(float(c.predicted_ratio), 2)
+    ((1,), 16.17)
     """
     if realizations < 1 or samples < 1 or n_steps < samples:
-        raise ModelError("need realizations >= 1 and 1 <= samples <= n_steps")
+        raise ParameterError("need realizations >= 1 and 1 <= samples <= n_steps")
     from scipy.stats import norm
 
     grid = np.linspace(0.2, 1.8, 17)
