@@ -74,6 +74,27 @@ def restricted_matrices(fault_map: FaultMap, n: int) -> tuple[np.ndarray, np.nda
         [y(k); …; y(k−n+1)] = O_n x(k−n+1) + T_n [u(k); …; u(k−n+1)]
         O_n = [C A^{n−1}; …; C A; C],   T_n[i, j] = D (j = i),  C A^{j−i−1} B (j > i),  0 (j < i).
 
+    Parameters
+    ----------
+    fault_map : FaultMap
+        The SISO map ``G(q)`` (a :class:`scipy.signal.dlti` or a ``(num, den)`` pair), proper and stable.
+    n : int
+        Horizon (window length), ≥ 1.
+
+    Returns
+    -------
+    O : ndarray
+        ``O_n`` (n x d), d the order of the realisation.
+    T : ndarray
+        ``T_n`` (n x n), upper triangular Toeplitz.
+
+    Raises
+    ------
+    DataError
+        If ``n`` is not a positive integer.
+    ModelError, DesignError
+        If ``fault_map`` is not a proper, stable SISO map (:func:`~fdikit.estimate.steering.fault_map_coefficients`).
+
     Examples
     --------
     >>> O, T = restricted_matrices(([0.0, 0.5], [1.0, -0.5]), 3)   # G(q) = 0.5/(q − 0.5)
@@ -83,6 +104,10 @@ def restricted_matrices(fault_map: FaultMap, n: int) -> tuple[np.ndarray, np.nda
            [0.  , 0.  , 0.  ]])
     >>> O.ravel().tolist()
     [0.125, 0.25, 0.5]
+
+    References
+    ----------
+    van der Ploeg 2018, Def. 3-1.2; §1-4 (window notation).
     """
     if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
         raise DataError(f"horizon n must be a positive integer, got {n!r}")
@@ -110,19 +135,42 @@ class IsolationErrorBound:
 
     Attributes
     ----------
-    t : (N,) times.
-    theta : (N,) ``θ_e = ‖[f̂_a − μ_n[f_a]; f̂_m − μ_n[f_m]]‖_2``.
-    bound : (N,) ``Θ_e`` with the corrections of the module docstring (a guaranteed bound).
-    bound_thesis : (N,) ``Θ_e`` as printed ((3.5) / (3.9)): factor ``sqrt((1+|μ|)/(nV))`` and, for the
+    t : ndarray
+        (N,) times.
+    theta : ndarray
+        (N,) ``θ_e = ‖[f̂_a − μ_n[f_a]; f̂_m − μ_n[f_m]]‖_2``.
+    bound : ndarray
+        (N,) ``Θ_e`` with the corrections of the module docstring (a guaranteed bound).
+    bound_thesis : ndarray
+        (N,) ``Θ_e`` as printed ((3.5) / (3.9)): factor ``sqrt((1+|μ|)/(nV))`` and, for the
         pre-filter, the commutator times ``‖E‖_{L_n∞}``.
-    factor, factor_thesis, regressor_norm : (N,) corrected ``κ_n``, printed ``κ_n``, exact ``‖Φ_n‖_2``.
-    e1, e2, e3 : (N,) the error terms (3.6a)–(3.6c), or ``ẽ_1`` (corrected), ``ẽ_2``, ``e_3`` (3.10).
-    e1_thesis : (N,) ``ẽ_1`` as printed (equal to ``e1`` without the pre-filter).
-    mismatch : (N,) ``‖r − G[f_a + Δ E]‖_{L_n2}``, the residual content the pre-filter bound's model
+    factor, factor_thesis, regressor_norm : ndarray
+        (N,) corrected ``κ_n``, printed ``κ_n``, exact ``‖Φ_n‖_2``.
+    e1, e2, e3 : ndarray
+        (N,) the error terms (3.6a)–(3.6c), or ``ẽ_1`` (corrected), ``ẽ_2``, ``e_3`` (3.10).
+    e1_thesis : ndarray
+        (N,) ``ẽ_1`` as printed (equal to ``e1`` without the pre-filter).
+    mismatch : ndarray or None
+        (N,) ``‖r − G[f_a + Δ E]‖_{L_n2}``, the residual content the pre-filter bound's model
         does not explain (≈ 0 for an exact residual generator; added to ``e1`` and ``e1_thesis``),
         or None without the pre-filter (``e1`` already contains it).
-    valid : (N,) the estimate's validity mask; every array is NaN where it is False.
-    prefiltered : whether this is the pre-filter bound (3.9).
+    valid : ndarray of bool
+        (N,) the estimate's validity mask; every array is NaN where it is False.
+    prefiltered : bool
+        Whether this is the pre-filter bound (3.9).
+
+    Examples
+    --------
+    >>> from fdikit.estimate.steering import isolate_steering_faults
+    >>> E = np.array([1.0, 2.0, 4.0, 3.0, 1.0, 2.0])
+    >>> r = 0.1 + (1.5 - 1.0) * E                      # exact faults f_a = 0.1, f_m = 1.5 with G = 1
+    >>> b = isolation_error_bound(isolate_steering_faults(r, E, n=3), r, E, 0.1, 1.5)
+    >>> b.prefiltered, b.mismatch is None, bool(np.nanmax(b.theta) < 1e-12), bool(np.nanmax(b.bound) < 1e-12)
+    (False, True, True, True)
+
+    References
+    ----------
+    van der Ploeg 2018, Thm 3-1.3, (3.5)–(3.6); Thm 3-2.1, (3.9)–(3.10); App. A, Lemma A-1.1.
     """
 
     t: np.ndarray
@@ -233,6 +281,14 @@ def isolation_error_bound(
     Returns
     -------
     IsolationErrorBound
+        ``θ_e``, the corrected and the printed bounds and their terms per sample.
+
+    Raises
+    ------
+    DataError
+        If ``residual``/``setpoint`` do not have the estimate's length, or any input is non-finite.
+    ParameterError
+        If ``estimate`` is not a :class:`~fdikit.estimate.steering.SteeringFaultEstimate`.
 
     Examples
     --------
@@ -246,6 +302,10 @@ def isolation_error_bound(
     >>> b = isolation_error_bound(est, r, E, 1.7e-3, 0.5)
     >>> bool(np.all(b.theta[est.valid] <= b.bound[est.valid]))
     True
+
+    References
+    ----------
+    van der Ploeg 2018, Thm 3-1.3, (3.5)–(3.6), (4.12a); Thm 3-2.1, (3.9)–(3.10), (4.14); App. A.
     """
     validate.instance("estimate", estimate, SteeringFaultEstimate, "pass the result of isolate_steering_faults(...)")
     r = validate.as_array("residual", residual, error=DataError, finite=False)
