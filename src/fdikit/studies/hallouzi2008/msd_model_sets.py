@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fdikit.errors import ModelError
+from fdikit.errors import ParameterError
 from fdikit.metrics import vaf
 from fdikit.multimodel.convex import (
     convex_model_set,
@@ -48,7 +48,7 @@ _P0 = 1e-2
 
 def _grid(grid_levels: int, fault_values) -> np.ndarray:
     if grid_levels < 2:
-        raise ModelError(f"grid_levels must be >= 2 so the grid holds both range limits, got {grid_levels}")
+        raise ParameterError(f"grid_levels must be >= 2 so the grid holds both range limits, got {grid_levels}")
     (k_lo, k_hi), (m_lo, m_hi) = MSD_RANGES["k1"], MSD_RANGES["m3"]
     return msd_parameter_grid(np.linspace(k_lo, k_hi, grid_levels), np.linspace(m_lo, m_hi, grid_levels),
                               np.asarray(fault_values, float))
@@ -64,6 +64,43 @@ def msd_cp_model_set(dt: float, grid_levels: int = 5, fault_values=(0.0, 0.5, 1.
     this run — with the latter f2 reads 0.85 in its 0.5 fault and the v2 VAF falls to 76–92 % (seeds 0–2);
     six vertices (the thesis's N_h, J_CP = 0.076) leave one weight direction unidentifiable and give v2 VAF
     51–85 %.
+
+    Parameters
+    ----------
+    dt : float
+        Sample time [s] of the first-order discretised large set.
+    grid_levels : int, default 5
+        Levels of ``k1`` and ``m3`` each (>= 2).
+    fault_values : sequence of float, default (0.0, 0.5, 1.0)
+        Fault levels of ``f1`` and ``f2``.
+    n_vertices : int, optional
+        Number of simplex vertices; default the affine dimension of the set plus one.
+    optimize : bool, default False
+        Minimise J_CP (3.29) instead of the facet-parallel simplex.
+
+    Returns
+    -------
+    cp : CPModelSet
+        The vertices (``cp.models``, (n_q, N_h)) and each large-set model's convex weights.
+    grid : (N_ℓ, 4) array
+        The large set's parameters.
+    vectors : (n_q, N_ℓ) array
+        Its model vectors.
+
+    Raises
+    ------
+    ParameterError
+        If ``grid_levels < 2``.
+
+    References
+    ----------
+    Hallouzi 2008, §3.4, (3.29), (3.31)–(3.33); §3.6.1.
+
+    Examples
+    --------
+    >>> cp, grid, vectors = msd_cp_model_set(0.01, grid_levels=2)
+    >>> cp.models.shape, grid.shape, vectors.shape
+    ((72, 5), (20, 4), (72, 20))
     """
     grid = _grid(grid_levels, fault_values)
     vectors = msd_model_vectors(grid, dt=dt)
@@ -71,7 +108,27 @@ def msd_cp_model_set(dt: float, grid_levels: int = 5, fault_values=(0.0, 0.5, 1.
 
 
 def msd_lv_model_set(dt: float) -> LimitValueModelSet:
-    """LV model set of the MSD (§3.6.1, (3.44)–(3.49)): weights ``μ_k1, μ_m3, μ_f1, μ_f2``; "+" = k1max, m3max, 1, 1."""
+    """LV model set of the MSD (§3.6.1, (3.44)–(3.49)): weights ``μ_k1, μ_m3, μ_f1, μ_f2``; "+" = k1max, m3max, 1, 1.
+
+    Parameters
+    ----------
+    dt : float
+        Sample time [s] of the first-order discretisation.
+
+    Returns
+    -------
+    LimitValueModelSet
+        The "+" model and one limit-value difference per parameter ``k1, m3, f1, f2``.
+
+    References
+    ----------
+    Hallouzi 2008, §3.5; §3.6.1, (3.44)–(3.49).
+
+    Examples
+    --------
+    >>> msd_lv_model_set(0.01).dt
+    0.01
+    """
     upper = {"k1": MSD_RANGES["k1"][1], "m3": MSD_RANGES["m3"][1], "f1": 1.0, "f2": 1.0}
     lower = {"k1": MSD_RANGES["k1"][0], "m3": MSD_RANGES["m3"][0], "f1": 0.0, "f2": 0.0}
     return limit_value_model_set(msd_matrices, upper, lower, dt=dt)
@@ -83,8 +140,27 @@ class ModelSetRun:
 
     Attributes
     ----------
-    structure : ``"od"``, ``"cp"`` or ``"lv"``.  mu : (K, N) weights.  x : (K, 6) states.
-    params : (K, 4) reconstructed ``(k1, m3, f1, f2)``.  vaf : state name → VAF (3.53) in percent.
+    structure : {"od", "cp", "lv"}
+        The model set.
+    mu : (K, N) array
+        Estimated weights (N = 6 for OD, the number of vertices for CP, 4 for LV).
+    x : (K, 6) array
+        Estimated states.
+    params : (K, 4) array
+        Reconstructed ``(k1, m3, f1, f2)``.
+    vaf : dict of str to float
+        State name → VAF (3.53) in percent.
+
+    References
+    ----------
+    Hallouzi 2008, §3.6.2, Table 3.3.
+
+    Examples
+    --------
+    >>> from fdikit.studies.hallouzi2008.msd import simulate_msd
+    >>> run = run_msd_model_set(simulate_msd(duration=0.5, dt=0.01), "lv")
+    >>> run.structure, run.mu.shape, run.params.shape
+    ('lv', (50, 4), (50, 4))
     """
 
     structure: str
@@ -98,10 +174,39 @@ def run_msd_model_set(sim: MSDSimulation, structure: str = "lv", *, q_x: float =
                       grid_levels: int = 5) -> ModelSetRun:
     """Filter ``sim`` with the augmented EKF on the OD, CP or LV model set (Hallouzi 2008, §3.6.2, Table 3.3).
 
+    Parameters
+    ----------
+    sim : MSDSimulation
+        The run (:func:`~fdikit.studies.hallouzi2008.msd.simulate_msd`).
+    structure : {"od", "cp", "lv"}, default "lv"
+        Which model set.
+    q_x : float, default 3e-6
+        Process-noise variance per state of the filter model.
+    q_mu : float, default 1e-6
+        Weight random-walk variance.
+    grid_levels : int, default 5
+        Grid levels of the CP design (unused for OD and LV).
+
+    Returns
+    -------
+    ModelSetRun
+        Weights, states, reconstructed parameters and VAF per state.
+
     Raises
     ------
-    ModelError
+    ParameterError
         On an unknown structure.
+
+    References
+    ----------
+    Hallouzi 2008, §3.6.2, Table 3.3; Table 2.3 (augmented EKF); (3.51)–(3.57) (parameter reconstruction).
+
+    Examples
+    --------
+    >>> from fdikit.studies.hallouzi2008.msd import simulate_msd
+    >>> run = run_msd_model_set(simulate_msd(duration=0.5, dt=0.01), "cp", grid_levels=2)
+    >>> run.mu.shape
+    (50, 5)
     """
     dt = float(sim.t[1] - sim.t[0])
     R = np.diag(sim.noise_std ** 2)
@@ -128,10 +233,33 @@ def run_msd_model_set(sim: MSDSimulation, structure: str = "lv", *, q_x: float =
         params = np.column_stack([lv_parameter(m[:, 0], k_hi, k_lo), lv_reciprocal_parameter(m[:, 1], m_hi, m_lo),
                                   1.0 - m[:, 2], 1.0 - m[:, 3]])  # (3.54)–(3.57)
     else:
-        raise ModelError(f"structure must be 'od', 'cp' or 'lv', got {structure!r}")
+        raise ParameterError(f"structure must be 'od', 'cp' or 'lv', got {structure!r}")
     return ModelSetRun(structure, res.mu, res.x, params, dict(zip(MSD_STATES, vaf(sim.x, res.x).tolist())))
 
 
 def msd_table_3_3(sim: MSDSimulation, **kwargs) -> dict[str, ModelSetRun]:
-    """Table 3.3: the three model sets on the same run (keyword arguments go to :func:`run_msd_model_set`)."""
+    """Table 3.3: the three model sets on the same run (keyword arguments go to :func:`run_msd_model_set`).
+
+    Parameters
+    ----------
+    sim : MSDSimulation
+        The run.
+    **kwargs
+        Keyword arguments of :func:`run_msd_model_set` (``q_x``, ``q_mu``, ``grid_levels``).
+
+    Returns
+    -------
+    dict of str to ModelSetRun
+        ``"od"``, ``"cp"`` and ``"lv"`` runs.
+
+    References
+    ----------
+    Hallouzi 2008, §3.6.2, Table 3.3.
+
+    Examples
+    --------
+    >>> from fdikit.studies.hallouzi2008.msd import simulate_msd
+    >>> list(msd_table_3_3(simulate_msd(duration=0.1, dt=0.01), grid_levels=2))
+    ['od', 'cp', 'lv']
+    """
     return {s: run_msd_model_set(sim, s, **kwargs) for s in ("od", "cp", "lv")}
