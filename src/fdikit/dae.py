@@ -26,10 +26,30 @@ class DAEModel:
     ----------
     H, L, F : tuple of arrays
         Coefficients of ``q⁰, q¹, …`` (each ``n_r x n_x``, ``n_r x n_z``, ``n_r x n_f``).
-    unknowns : names of ``x`` (states, then disturbances).
-    outputs, controls : names of ``z = [outputs; controls]``.
-    faults : names of the columns of ``F``.
-    dt : sample time.
+    unknowns : tuple of str
+        Names of ``x`` (states, then disturbances).
+    outputs, controls : tuple of str
+        Names of ``z = [outputs; controls]``.
+    faults : tuple of str
+        Names of the columns of ``F``.
+    dt : float or None
+        Sample time [s].
+
+    Raises
+    ------
+    ModelError
+        If a polynomial has no coefficient, a coefficient has the wrong shape, or an entry is not finite.
+
+    Examples
+    --------
+    ``x(k+1) = 0.9 x(k) + u(k) + f(k)``, ``y(k) = x(k)`` as ``H(q)[x] + L(q)[z] + F(q)[f] = 0``:
+
+    >>> dae = DAEModel(H=([[0.9], [1.0]], [[-1.0], [0.0]]), L=([[0.0, 1.0], [-1.0, 0.0]],), F=([[1.0], [0.0]],),
+    ...                unknowns=("x",), outputs=("y",), controls=("u",), faults=("f",), dt=0.1)
+    >>> dae.rows, dae.knowns, dae.fault_index(None)
+    (2, ('y', 'u'), 0)
+    >>> [M.round(6).tolist() for M in dae.evaluate(1.0)]     # H(1), L(1), F(1)
+    [[[-0.1], [1.0]], [[0.0, 1.0], [-1.0, 0.0]], [[1.0], [0.0]]]
     """
 
     H: tuple[np.ndarray, ...]
@@ -74,7 +94,7 @@ class DAEModel:
         """Column of ``F`` for ``fault``; ``None`` is allowed when there is exactly one."""
         if fault is None:
             if len(self.faults) != 1:
-                raise DesignError(f"the DAE has faults {list(self.faults)}; name the one to detect with fault=")
+                raise DesignError(f"the DAE has faults {list(self.faults)}; name the one to detect with targets=")
             return 0
         if fault not in self.faults:
             raise DesignError(f"no fault named {fault!r}; the DAE has {list(self.faults)}")
@@ -99,6 +119,19 @@ def dae_form(model: FaultModel, faults: Sequence[str] | None = None, multiplicat
         ``<control>_multiplicative`` with ``F = [Bu_j; Du_j]`` carrying ``(f_m − 1) u_j``
         (the ``E(z) f_m`` term of (2.1), (4.6)).
 
+    Returns
+    -------
+    DAEModel
+        ``H(q) = [[A, Bd], [C, Dd]] − q [[I, 0], [0, 0]]``, ``L = [[0, Bu], [−I, Du]]``, ``F = [Bf; Df]`` (plus
+        the multiplicative columns), with the names of the model.
+
+    Raises
+    ------
+    ModelError
+        If ``model`` is not a discrete ``FaultModel``.
+
+    Notes
+    -----
     The noise group ``w`` is not part of the DAE (declare noise to be rejected as a disturbance).
 
     Examples

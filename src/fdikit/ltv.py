@@ -66,17 +66,25 @@ class LTVModel:
         Finite-difference step in the model's time unit (default ``1e-3``); choose it well
         below the time scale on which the matrices change.  Nested differences lose about
         ``eps/step^j`` of accuracy at order ``j``: supply derivatives when ``β ≥ 2``.
-    controls, outputs : names of the columns of ``u`` and ``y`` (for
+    controls, outputs : tuple of str
+        Names of the columns of ``u`` and ``y`` (for
         :meth:`fdikit.design.game.time_varying.LTVDetectionFilter.run_trace`).
-    constant : the matrices do not depend on time (set by :meth:`from_lti`; the geometry is then
+    constant : bool
+        The matrices do not depend on time (set by :meth:`from_lti`; the geometry is then
         computed once).
+
+    Raises
+    ------
+    ModelError
+        If a matrix is not callable, there is no fault, derivatives are given for an unknown key, or
+        ``step`` is not positive.
 
     Examples
     --------
     >>> from fdikit.plants.white_speyer import white_speyer
     >>> m = LTVModel.from_lti(white_speyer(), ["f1", "f2"])
-    >>> m.matrix("f2", 3.0).ravel().tolist(), m.matrix("A", 3.0, order=1).any()
-    ([3.0, 1.0, 0.0], np.False_)
+    >>> m.matrix("f2", 3.0).ravel().tolist(), bool(m.matrix("A", 3.0, order=1).any())
+    ([3.0, 1.0, 0.0], False)
     """
 
     A: MatrixFunction
@@ -111,7 +119,12 @@ class LTVModel:
 
     @classmethod
     def from_lti(cls, model: FaultModel, faults: Mapping[str, np.ndarray] | Sequence[str]) -> LTVModel:
-        """Constant matrices of a continuous :class:`FaultModel` (faults resolved by ``resolve_faults``)."""
+        """Constant matrices of a continuous :class:`FaultModel`.
+
+        ``faults``: fault names resolved by :func:`fdikit.linalg.resolve_faults` (``'<output>_sensor'``,
+        ``'<control>_actuator'``, fault inputs of the model; a bare signal name raises
+        :class:`~fdikit.errors.ParameterError`) or a mapping name → ``F``.
+        """
         if model.is_discrete:
             raise ModelError("from_lti needs a continuous model; this one is discrete")
         maps = resolve_faults(model, faults)
@@ -128,10 +141,11 @@ class LTVModel:
                     step: float = 1e-3) -> LTVModel:
         """The matrices of ``model_at(t)`` (e.g. ``lambda t: single_track(speed(t))``; must accept t = 0).
 
-        Fault names: an output -> its sensor fault ``[F¹, A F¹ − Ḟ¹]`` (Murray (2.3), named
-        ``<output>_sensor``; ``':magnitude'``/``':rate'`` keep one column), a control -> its
-        ``Bu`` column (``<control>_actuator``), a disturbance -> its ``Bd`` column, a fault
-        input -> its ``Bf`` column.  A mapping gives the directions as functions.
+        Fault names: ``'<output>_sensor'`` -> the sensor fault ``[F¹, A F¹ − Ḟ¹]`` (Murray (2.3);
+        ``':magnitude'``/``':rate'`` keep one column), ``'<control>_actuator'`` -> the control's ``Bu``
+        column, a disturbance -> its ``Bd`` column, a fault input -> its ``Bf`` column.  A bare
+        signal name raises :class:`~fdikit.errors.ParameterError` naming the fault.  A mapping gives
+        the directions as functions.
         """
         at = functools.lru_cache(maxsize=256)(lambda t: model_at(float(t)))
         ref = at(0.0)
@@ -168,23 +182,21 @@ def _const(M: np.ndarray, t: float) -> np.ndarray:
 
 def _family_fault(at, ref: FaultModel, spec: str, step: float) -> tuple[str, MatrixFunction]:
     base, _, suffix = spec.partition(":")
-    if base in ref.outputs:
-        idx = ref.outputs.index(base)
-        cols = {"": [0, 1], "rate": [0], "magnitude": [1]}.get(suffix)
-        if cols is None:
-            raise ModelError(f"unknown suffix {suffix!r} in {spec!r}; use ':magnitude' or ':rate'")
-        return sensor_fault_name(base), lambda t: linalg.sensor_fault_map_tv(
-            lambda s: at(s).A, lambda s: at(s).C, idx, t, step=step)[:, cols]
-    if suffix:
-        raise ModelError(f"{spec!r}: the suffix applies to sensor faults (outputs) only")
-    if base in ref.controls:
-        return actuator_fault_name(base), lambda t: at(t).Bu[:, [ref.controls.index(base)]]
-    if base in ref.disturbances:
+    if base in ref.disturbances and base not in ref.faults:
+        if suffix:
+            raise ModelError(f"{spec!r}: the suffix applies to sensor faults only")
         return base, lambda t: at(t).Bd[:, [ref.disturbances.index(base)]]
-    if base in ref.faults:
-        return base, lambda t: at(t).Bf[:, [ref.faults.index(base)]]
-    raise ModelError(f"{base!r} is not an output, control, disturbance or fault of the model; outputs "
-                     f"{list(ref.outputs)}, controls {list(ref.controls)}, disturbances {list(ref.disturbances)}")
+    kind, signal, suffix = linalg.split_fault_name(ref, spec)
+    if kind == "sensor":
+        idx = ref.outputs.index(signal)
+        cols = {"": [0, 1], "rate": [0], "magnitude": [1]}[suffix]
+        return sensor_fault_name(signal), lambda t: linalg.sensor_fault_map_tv(
+            lambda s: at(s).A, lambda s: at(s).C, idx, t, step=step)[:, cols]
+    if kind == "actuator":
+        return actuator_fault_name(signal), lambda t: at(t).Bu[:, [ref.controls.index(signal)]]
+    if suffix:
+        raise ModelError(f"{spec!r}: the suffix applies to sensor faults only, {signal!r} is a fault input")
+    return signal, lambda t: at(t).Bf[:, [ref.faults.index(signal)]]
 
 
 # ---------------------------------------------------------------------- geometry
@@ -196,12 +208,40 @@ def invariant_generators(model: LTVModel, fault: str, t: float, rtol: float = 1e
     ``B^j`` follow from those of ``A`` and ``F`` by Leibniz' rule.  Returns ``(W, ends)``: all
     generators (n x r) and the visible last generator of each column (n x k).
 
+    Parameters
+    ----------
+    model : LTVModel
+        The plant.
+    fault : str
+        Name of a fault direction of ``model``.
+    t : float
+        Time at which the subspace is evaluated.
+    rtol : float, optional
+        Relative tolerance of the tests ``C B^j ≠ 0`` and ``B^j ≠ 0`` (default 1e-6).
+
+    Returns
+    -------
+    W : ndarray
+        All generators ``B^j`` of all columns (n x r), spanning ``W*(t)``.
+    ends : ndarray
+        The visible last generator ``B^β`` of each column (n x k).
+
     Raises
     ------
+    ModelError
+        If the fault direction does not have n rows.
     DesignError
         If a column never reaches the outputs within n steps, or the visible ends are
         dependent under ``C`` (a combination of columns lies in Ker C: the per-column
         recursion does not apply; Murray's Algorithm 4.1 would be needed).
+
+    Examples
+    --------
+    >>> from fdikit.plants.white_speyer import white_speyer
+    >>> m = LTVModel.from_lti(white_speyer(), ["f1", "f2"])
+    >>> W, ends = invariant_generators(m, "f1", 0.0)       # C f1 ≠ 0: β = 0
+    >>> W.ravel().tolist(), ends.shape
+    ([1.0, -0.5, 0.5], (3, 1))
     """
     n = model.matrix("A", t).shape[0]
     C = model.matrix("C", t)
@@ -249,7 +289,31 @@ def invariant_generators(model: LTVModel, fault: str, t: float, rtol: float = 1e
 
 
 def ltv_projector(model: LTVModel, complementary: Sequence[str], t: float, rtol: float = 1e-6) -> np.ndarray:
-    """``Ĥ(t) = I − U Uᵀ``, ``U`` orthonormal basis of ``C(t) Ŵ*(t)`` (Murray 2012, (3.10), (3.5))."""
+    """``Ĥ(t) = I − U Uᵀ``, ``U`` orthonormal basis of ``C(t) Ŵ*(t)`` (Murray 2012, (3.10), (3.5)).
+
+    Parameters
+    ----------
+    model : LTVModel
+        The plant; for a constant model (:meth:`LTVModel.from_lti`) the projector is computed once and cached.
+    complementary : sequence of str
+        The faults to block (their ``Ŵ*`` is the sum of their subspaces, Lemma 3.3).
+    t : float
+        Time at which the projector is evaluated.
+    rtol : float, optional
+        Relative tolerance of :func:`invariant_generators` (default 1e-6).
+
+    Returns
+    -------
+    ndarray
+        ``Ĥ(t)`` (p x p), the orthogonal projector that annihilates ``C(t) Ŵ*(t)``.
+
+    Examples
+    --------
+    >>> from fdikit.plants.white_speyer import white_speyer
+    >>> m = LTVModel.from_lti(white_speyer(), ["f1", "f2"])
+    >>> (ltv_projector(m, ["f2"], 0.0).round(6) + 0.0).tolist()   # C f2 = [1, 0]ᵀ is blocked
+    [[0.0, 0.0], [0.0, 1.0]]
+    """
     if model.constant:
         key = ("projector", tuple(complementary), rtol)
         if key not in model._cache:
