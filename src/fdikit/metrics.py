@@ -36,7 +36,45 @@ MISSED = "missed"
 
 @dataclass(frozen=True)
 class Score:
-    """Scores of one trace (see the module docstring for the definitions)."""
+    """Scores of one trace (see the module docstring for the definitions).
+
+    Attributes
+    ----------
+    label : str
+        The trace's fault label (``'none'`` for a healthy trace).
+    onset : float or None
+        Time of the first faulty sample [s] (None when healthy).
+    detected : bool
+        Whether the alarm was on at a sample at or after the onset where the fault is active.
+    detection_delay : float or None
+        Detection time minus onset [s] (None when not detected).
+    false_alarms : int
+        Alarms switching on at fault-free samples.
+    fault_free_hours : float
+        Fault-free time of the trace [h] (fault-free samples times the median sample time).
+    missed : bool
+        A faulty trace never detected while the fault is active.
+    isolated : str
+        The isolated fault: the most frequent named label while detected, ``'unknown'``, or ``'none'`` (missed);
+        for a healthy trace the isolation of its first false alarm (``'none'`` without one).
+    isolation_correct : bool or None
+        ``isolated == label`` for a faulty trace (False when missed); None for a healthy one.
+    false_alarm_rate : float
+        False alarms per hour of fault-free time (NaN without fault-free time).
+    outcome : str
+        Column of the confusion matrix: the isolated fault, ``'missed'``, or ``'none'``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.diagnosis import Diagnosis, isolate
+    >>> from fdikit.metrics import score, summarize
+    >>> fired = np.array([[0, 0], [1, 0], [0, 0], [0, 0], [0, 0], [1, 0], [1, 0], [1, 0]], dtype=bool)
+    >>> d = Diagnosis(np.arange(8) * 0.5, fired.any(axis=1), fired, ("ra", "rb"), isolate(fired, ("fa", "fb")))
+    >>> s = score(np.array(["none"] * 4 + ["fa"] * 4), d)
+    >>> s.detected, s.detection_delay, s.false_alarms, s.isolated, s.outcome
+    (True, 0.5, 1, 'fa', 'fa')
+    """
 
     label: str
     onset: float | None
@@ -62,7 +100,39 @@ class Score:
 
 
 def score(truth: Trace | np.ndarray, diagnosis: Diagnosis) -> Score:
-    """Score one diagnosis against a trace (or its per-sample truth labels)."""
+    """Score one diagnosis against a trace (or its per-sample truth labels).
+
+    Parameters
+    ----------
+    truth : Trace or (N,) array of str
+        The trace the diagnosis was run on (its ``fault`` labels), or the per-sample true fault labels
+        (``'none'`` where healthy).
+    diagnosis : Diagnosis
+        An evaluator's decisions on that trace, sample for sample.
+
+    Returns
+    -------
+    Score
+        Detection, delay, false alarms, missed detection and isolation of the trace.
+
+    Raises
+    ------
+    ParameterError
+        When ``diagnosis`` is not a :class:`~fdikit.diagnosis.Diagnosis`.
+    DataError
+        When the labels are not strings, not one-dimensional, or not as many as the diagnosis's samples.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.diagnosis import Diagnosis, isolate
+    >>> from fdikit.metrics import score, summarize
+    >>> fired = np.array([[0, 0], [1, 0], [0, 0], [0, 0], [0, 0], [1, 0], [1, 0], [1, 0]], dtype=bool)
+    >>> d = Diagnosis(np.arange(8) * 0.5, fired.any(axis=1), fired, ("ra", "rb"), isolate(fired, ("fa", "fb")))
+    >>> s = score(np.array(["none"] * 4 + ["fa"] * 4), d)
+    >>> s.label, s.onset, s.detection_delay, round(s.false_alarm_rate, 6)
+    ('fa', 2.0, 0.5, 1800.0)
+    """
     validate.instance("diagnosis", diagnosis, Diagnosis, "pass the Diagnosis an evaluator's run() returned")
     if isinstance(truth, Trace):
         labels = truth.fault
@@ -107,7 +177,40 @@ def score(truth: Trace | np.ndarray, diagnosis: Diagnosis) -> Score:
 
 @dataclass(frozen=True)
 class Summary:
-    """Aggregate over many traces."""
+    """Aggregate over many traces.
+
+    Attributes
+    ----------
+    runs : int
+        Number of traces.
+    faulty_runs : int
+        Traces with a fault.
+    detection_rate : float
+        Detected faulty traces / faulty traces (NaN without faulty traces).
+    missed_rate : float
+        Missed faulty traces / faulty traces.
+    mean_delay, median_delay : float
+        Of the detection delays of the detected traces [s] (NaN when none).
+    false_alarms : int
+        False alarms over all traces.
+    false_alarm_rate : float
+        False alarms per hour of fault-free time pooled over all traces [1/h].
+    isolation_accuracy : float
+        Correctly isolated / detected faulty traces.
+    confusion : pandas.DataFrame
+        :func:`confusion_matrix` of the scores.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.diagnosis import Diagnosis, isolate
+    >>> from fdikit.metrics import score, summarize
+    >>> fired = np.array([[0, 0], [1, 0], [0, 0], [0, 0], [0, 0], [1, 0], [1, 0], [1, 0]], dtype=bool)
+    >>> d = Diagnosis(np.arange(8) * 0.5, fired.any(axis=1), fired, ("ra", "rb"), isolate(fired, ("fa", "fb")))
+    >>> s = score(np.array(["none"] * 4 + ["fa"] * 4), d)
+    >>> summarize([s]).as_dict()["detection_rate"], summarize([s]).runs
+    (1.0, 1)
+    """
 
     runs: int
     faulty_runs: int
@@ -140,7 +243,37 @@ def _scores(scores) -> list[Score]:
 
 
 def confusion_matrix(scores: Iterable[Score]):
-    """Counts of true label (rows) vs outcome (columns: isolated fault, ``'unknown'``, ``'missed'``, ``'none'``)."""
+    """Counts of true label (rows) vs outcome (columns: isolated fault, ``'unknown'``, ``'missed'``, ``'none'``).
+
+    Parameters
+    ----------
+    scores : iterable of Score
+        One score per trace (:func:`score`).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Integer counts; index ``true`` (the labels, sorted), columns ``diagnosed`` (the outcomes and the labels,
+        sorted).
+
+    Raises
+    ------
+    DataError
+        When there are no scores.
+    ParameterError
+        When ``scores`` is not an iterable of :class:`Score`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.diagnosis import Diagnosis, isolate
+    >>> from fdikit.metrics import score, summarize
+    >>> fired = np.array([[0, 0], [1, 0], [0, 0], [0, 0], [0, 0], [1, 0], [1, 0], [1, 0]], dtype=bool)
+    >>> d = Diagnosis(np.arange(8) * 0.5, fired.any(axis=1), fired, ("ra", "rb"), isolate(fired, ("fa", "fb")))
+    >>> s = score(np.array(["none"] * 4 + ["fa"] * 4), d)
+    >>> confusion_matrix([s, score(np.array(["none"] * 8), d)]).to_dict()
+    {'fa': {'fa': 1, 'none': 1}, 'none': {'fa': 0, 'none': 0}}
+    """
     import pandas as pd
 
     scores = _scores(scores)
@@ -153,7 +286,38 @@ def confusion_matrix(scores: Iterable[Score]):
 
 
 def summarize(scores: Iterable[Score]) -> Summary:
-    """Rates and means over traces; the false-alarm rate pools fault-free time over all runs."""
+    """Rates and means over traces; the false-alarm rate pools fault-free time over all runs.
+
+    Parameters
+    ----------
+    scores : iterable of Score
+        One score per trace (:func:`score`).
+
+    Returns
+    -------
+    Summary
+        Detection and missed rates, mean and median delay, false alarms and their rate, isolation accuracy and
+        the confusion matrix.
+
+    Raises
+    ------
+    DataError
+        When there are no scores.
+    ParameterError
+        When ``scores`` is not an iterable of :class:`Score`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.diagnosis import Diagnosis, isolate
+    >>> from fdikit.metrics import score, summarize
+    >>> fired = np.array([[0, 0], [1, 0], [0, 0], [0, 0], [0, 0], [1, 0], [1, 0], [1, 0]], dtype=bool)
+    >>> d = Diagnosis(np.arange(8) * 0.5, fired.any(axis=1), fired, ("ra", "rb"), isolate(fired, ("fa", "fb")))
+    >>> s = score(np.array(["none"] * 4 + ["fa"] * 4), d)
+    >>> sm = summarize([s, score(np.array(["none"] * 8), d)])
+    >>> sm.runs, sm.faulty_runs, sm.detection_rate, sm.false_alarms, round(sm.false_alarm_rate, 6)
+    (2, 1, 1.0, 3, 1800.0)
+    """
     scores = _scores(scores)
     faulty = [s for s in scores if s.label != NO_FAULT]
     delays = np.array([s.detection_delay for s in faulty if s.detected], dtype=float)
@@ -180,6 +344,18 @@ def vaf(reference, estimate):
     measure of van der Ploeg 2018, Sec. 4-3-4, after Verhaegen & Verdult).
 
     ``reference`` and ``estimate`` have the same shape: (N,) gives a float, (N, k) one value per column.
+
+    Parameters
+    ----------
+    reference : (N,) or (N, k) array_like
+        The measured signal ``y``.
+    estimate : (N,) or (N, k) array_like
+        Its estimate ``ŷ``, same shape.
+
+    Returns
+    -------
+    float or (k,) ndarray
+        The VAF in percent, in [0, 100].
 
     Raises
     ------
