@@ -61,3 +61,147 @@ def test_a_new_figure_without_ax(residuals):
     assert len(plt.get_fignums()) == n_figs + 1 and len(fig.axes) == 2
     plt.close(fig)
     assert len(plt.get_fignums()) == n_figs
+
+
+# ---------------------------------------------------------------- the result types' .plot() and their functions
+def _trace():
+    from fdikit.trace import Trace
+
+    t = np.arange(50) * 0.1
+    return Trace(t=t, u=np.zeros((50, 1)), y=np.column_stack([np.sin(t), np.cos(t)]), controls=["steer"],
+                 outputs=["a", "b"], fault=["none"] * 20 + ["a_sensor"] * 20 + ["none"] * 10)
+
+
+def _diagnosis():
+    from fdikit.diagnosis import Diagnosis
+
+    fired = np.zeros((50, 2), bool)
+    fired[25:40, 0] = True
+    valid = np.ones(50, bool)
+    valid[5:8] = False
+    isolated = np.where(fired[:, 0], "a_sensor", "none")
+    return Diagnosis(np.arange(50) * 0.1, fired.any(axis=1), fired, ("ra", "rb"), isolated, valid=valid)
+
+
+def _kalman():
+    from fdikit.gaussian import LinearGaussianModel
+    from fdikit.multimodel.kalman import kalman_filter
+
+    mdl = LinearGaussianModel(A=np.diag([0.9, 0.8]), C=np.eye(2), Q=0.1 * np.eye(2), R=np.eye(2))
+    y = np.random.default_rng(0).normal(size=(30, 2))
+    return kalman_filter(mdl, None, y, x0=[0.0, 0.0], P0=np.eye(2))
+
+
+def _imm():
+    from fdikit.gaussian import LinearGaussianModel
+    from fdikit.multimodel.imm import IMMFilter
+
+    m0 = LinearGaussianModel(A=[[1.0]], C=[[1.0]], Q=[[0.01]], R=[[0.1]], name="nominal")
+    m1 = LinearGaussianModel(A=[[1.0]], C=[[2.0]], Q=[[0.01]], R=[[0.1]], name="gain fault")
+    imm = IMMFilter([m0, m1], [[0.99, 0.01], [0.01, 0.99]], x0=[1.0], P0=[[0.01]])
+    return imm.run(np.zeros((20, 0)), 2.0 * np.ones((20, 1)))
+
+
+def _convex():
+    from fdikit.multimodel.convex import convex_model_set, dual_convex_filter
+
+    ms = convex_model_set([[0.9]], [[[0.0]], [[1.0]]], [[1.0]], Q=[[1e-4]], R=[[1e-2]], names=["stuck", "nominal"])
+    u = np.sin(0.3 * np.arange(30)).reshape(-1, 1)
+    x, y = 0.0, []
+    for uk in u[:, 0]:
+        y.append([x])
+        x = 0.9 * x + uk
+    return dual_convex_filter(ms, np.array(y), u, x0=[0.0], P0=[[1.0]])
+
+
+#: (result factory, the plot function's name, lines drawn into the axes)
+RESULTS = {
+    "trace": (_trace, "plot_trace", 2),
+    "diagnosis": (_diagnosis, "plot_diagnosis", 3),  # one step line per residual and the alarm
+    "kalman": (_kalman, "plot_innovations", 6),  # per innovation: the series and its two band lines
+    "imm": (_imm, "plot_mode_probabilities", 2),
+    "convex": (_convex, "plot_weights", 2),
+}
+
+
+@pytest.mark.parametrize("kind", RESULTS)
+@pytest.mark.parametrize("via", ["method", "function"])
+def test_result_plots_draw_into_the_given_axes(kind, via):
+    import fdikit.plots as plots
+
+    make, func, n_lines = RESULTS[kind]
+    result = make()
+    draw = result.plot if via == "method" else lambda **kw: getattr(plots, func)(result, **kw)
+    backend = matplotlib.get_backend()
+    fig, ax = plt.subplots()
+    n_figs = plt.get_fignums()
+    out = draw(ax=ax)
+    assert out is ax
+    assert plt.get_fignums() == n_figs  # no new figure
+    assert len(ax.lines) == n_lines
+    assert ax.get_xlabel()
+    assert matplotlib.get_backend() == backend
+    plt.close(fig)
+
+
+@pytest.mark.parametrize("kind", RESULTS)
+def test_result_plots_make_a_figure_without_ax(kind, tmp_path):
+    make, _, n_lines = RESULTS[kind]
+    result = make()
+    backend = matplotlib.get_backend()
+    n_figs = len(plt.get_fignums())
+    fig = result.plot()
+    assert isinstance(fig, matplotlib.figure.Figure) and len(fig.axes) == 1
+    assert len(fig.axes[0].lines) == n_lines
+    assert len(plt.get_fignums()) == n_figs + 1
+    plt.close(fig)
+    fig = result.plot(path=tmp_path / "p.png")  # written to path: closed
+    assert (tmp_path / "p.png").read_bytes()[:4] == b"\x89PNG"
+    assert not plt.fignum_exists(fig.number) and len(plt.get_fignums()) == n_figs
+    assert matplotlib.get_backend() == backend
+
+
+def test_plots_mark_what_the_results_hold():
+    ax = plt.figure().add_subplot()
+    _trace().plot(ax=ax)
+    assert len(ax.patches) == 1  # the faulty stretch is shaded
+    assert [ln.get_label() for ln in ax.lines] == ["a", "b"]
+    ax = plt.figure().add_subplot()
+    _trace().plot(ax=ax, kind="u")
+    assert [ln.get_label() for ln in ax.lines] == ["steer"]
+    ax = plt.figure().add_subplot()
+    _diagnosis().plot(ax=ax)
+    assert [tl.get_text() for tl in ax.get_yticklabels()] == ["ra", "rb", "alarm"]
+    assert [tx.get_text() for tx in ax.texts] == ["a_sensor"]  # the alarm, labelled with its isolation
+    assert len(ax.patches) == 1  # the invalid samples
+    ax = plt.figure().add_subplot()
+    res = _kalman()
+    res.plot(ax=ax, sigmas=3.0)
+    np.testing.assert_allclose(ax.lines[1].get_ydata(), 3.0 * np.sqrt(res.S[:, 0, 0]))
+    ax = plt.figure().add_subplot()
+    res = _imm()
+    res.plot(ax=ax)
+    np.testing.assert_array_equal(ax.lines[1].get_ydata(), res.mu[:, 1])
+    ax = plt.figure().add_subplot()
+    res = _convex()
+    res.plot(ax=ax, raw=True)
+    np.testing.assert_array_equal(ax.lines[0].get_ydata(), res.mu_raw[:, 0])
+
+
+def test_a_wrong_number_of_axes_is_refused():
+    from fdikit.plots import plot_trace
+
+    _, axes = plt.subplots(2, 1)
+    with pytest.raises(ParameterError, match="1 panel"):
+        plot_trace(_trace(), ax=axes)
+
+
+def test_importing_fdikit_and_the_result_modules_does_not_import_matplotlib():
+    import subprocess
+    import sys
+
+    code = ("import sys, fdikit, fdikit.residuals, fdikit.diagnosis, fdikit.trace, fdikit.plots, "
+            "fdikit.multimodel.kalman, fdikit.multimodel.imm, fdikit.multimodel.convex, fdikit.analysis.gains; "
+            "print('matplotlib' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip()
+    assert out == "False"

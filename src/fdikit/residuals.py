@@ -29,7 +29,7 @@ from fdikit.errors import DataError, ModelError, ParameterError
 from fdikit.gaps import GapRule, Recovery, gap_options
 from fdikit.lti import dlsim_blocked
 from fdikit.model import GROUPS, FaultModel
-from fdikit.trace import Trace
+from fdikit.trace import Trace, check_signals  # check_signals: kept importable from here
 
 __all__ = ["ResidualGenerator", "ResidualStepper", "Residuals", "stack_generators", "check_signals"]
 
@@ -109,6 +109,34 @@ class Residuals:
         df["valid"] = self.valid
         df["recovering"] = self.recovering
         return df
+
+    def plot(self, ax=None, **kwargs):
+        """Draw the residuals, one panel each (:func:`fdikit.plots.plot_residuals`).
+
+        Parameters
+        ----------
+        ax : matplotlib Axes or sequence of Axes, optional
+            One Axes per residual, or one for all; default a new figure.
+        **kwargs
+            ``diagnosis``, ``thresholds``, ``center``, ``onset``, ``names``, ``title`` and ``path``
+            of :func:`~fdikit.plots.plot_residuals`.
+
+        Returns
+        -------
+        matplotlib.figure.Figure or the given ``ax``
+            A new figure when ``ax`` is None, else ``ax``.
+
+        Examples
+        --------
+        >>> import matplotlib.pyplot as plt
+        >>> fig, ax = plt.subplots()
+        >>> Residuals(np.arange(3.0), np.zeros((3, 1)), ("r",), ()).plot(ax=ax, thresholds=1.0) is ax
+        True
+        >>> plt.close(fig)
+        """
+        from fdikit.plots import plot_residuals
+
+        return plot_residuals(self, ax=ax, **kwargs)
 
 
 def _mat(name, value, shape):
@@ -368,45 +396,6 @@ class ResidualGenerator:
 
         return control.ss(self.A, self.B, self.C, self.D, 0 if self.dt is None else self.dt,
                           inputs=list(self.controls) + list(self.outputs), outputs=list(self.residuals))
-
-
-def check_signals(trace: Trace, controls: Sequence[str], outputs: Sequence[str]) -> None:
-    """Refuse a trace that lacks signals a generator reads.
-
-    Parameters
-    ----------
-    trace : Trace
-        The trace to read.
-    controls, outputs : sequence of str
-        The signal names the generator reads.
-
-    Raises
-    ------
-    DataError
-        Naming each missing control/output, where a misplaced one was found instead (an output
-        recorded as a control or the reverse), and the trace's signals the generator does not read.
-    """
-    problems = []
-    for kind, want, have, other, other_kind in (
-        ("control", controls, trace.controls, trace.outputs, "output"),
-        ("output", outputs, trace.outputs, trace.controls, "control"),
-    ):
-        missing = [nm for nm in want if nm not in have]
-        if missing:
-            moved = [nm for nm in missing if nm in other]
-            text = f"missing {kind}s {missing}"
-            if moved:
-                text += f" ({moved} found as {other_kind}s)"
-            extra = [nm for nm in have if nm not in want]
-            if extra:
-                text += f"; the trace's {kind}s not read: {extra}"
-            problems.append(text)
-    if problems:
-        raise DataError(
-            "the trace does not match the generator's signals: " + "; ".join(problems)
-            + f". The generator reads controls {list(controls)} and outputs {list(outputs)}; rename the "
-            "trace's columns or use the generator designed for this plant"
-        )
 
 
 def _state0(g: ResidualGenerator, x0) -> np.ndarray:

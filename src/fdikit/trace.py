@@ -26,7 +26,7 @@ from fdikit.errors import DataError
 from fdikit.faults import NO_FAULT
 from fdikit.trace_io import COLUMN_PREFIX, read_trace, write_trace
 
-__all__ = ["Trace"]
+__all__ = ["Trace", "check_signals"]
 
 
 # ---------------------------------------------------------------------- validation helpers
@@ -321,6 +321,34 @@ class Trace:
         data["fault"] = self.fault
         return pd.DataFrame(data, index=pd.Index(self.t, name="t"))
 
+    def plot(self, ax=None, **kwargs):
+        """Draw the signals over time with the faulty samples shaded (:func:`fdikit.plots.plot_trace`).
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Draw into it; default a new figure.
+        **kwargs
+            ``signals``, ``kind``, ``title`` and ``path`` of :func:`~fdikit.plots.plot_trace`.
+
+        Returns
+        -------
+        matplotlib.figure.Figure or the given ``ax``
+            A new figure when ``ax`` is None, else ``ax``.
+
+        Examples
+        --------
+        >>> import matplotlib.pyplot as plt
+        >>> tr = Trace(t=np.arange(3) * 0.1, u=np.zeros((3, 1)), y=np.ones((3, 1)), controls=["steer"], outputs=["r"])
+        >>> fig, ax = plt.subplots()
+        >>> tr.plot(ax=ax, kind="u") is ax
+        True
+        >>> plt.close(fig)
+        """
+        from fdikit.plots import plot_trace
+
+        return plot_trace(self, ax=ax, **kwargs)
+
     def save(self, path: str | Path) -> Path:
         """Write the trace to a Parquet file, atomically; the round trip with :meth:`load` is exact.
 
@@ -387,4 +415,43 @@ class Trace:
         return (
             f"Trace({len(self)} samples, {span}, u={len(self.controls)}, y={len(self.outputs)}, "
             f"x={len(self.states)}, faults={sorted(set(self.fault.tolist()) - {NO_FAULT})})"
+        )
+
+
+def check_signals(trace: Trace, controls: Sequence[str], outputs: Sequence[str]) -> None:
+    """Refuse a trace that lacks signals a generator reads.
+
+    Parameters
+    ----------
+    trace : Trace
+        The trace to read.
+    controls, outputs : sequence of str
+        The signal names the generator reads.
+
+    Raises
+    ------
+    DataError
+        Naming each missing control/output, where a misplaced one was found instead (an output
+        recorded as a control or the reverse), and the trace's signals the generator does not read.
+    """
+    problems = []
+    for kind, want, have, other, other_kind in (
+        ("control", controls, trace.controls, trace.outputs, "output"),
+        ("output", outputs, trace.outputs, trace.controls, "control"),
+    ):
+        missing = [nm for nm in want if nm not in have]
+        if missing:
+            moved = [nm for nm in missing if nm in other]
+            text = f"missing {kind}s {missing}"
+            if moved:
+                text += f" ({moved} found as {other_kind}s)"
+            extra = [nm for nm in have if nm not in want]
+            if extra:
+                text += f"; the trace's {kind}s not read: {extra}"
+            problems.append(text)
+    if problems:
+        raise DataError(
+            "the trace does not match the generator's signals: " + "; ".join(problems)
+            + f". The generator reads controls {list(controls)} and outputs {list(outputs)}; rename the "
+            "trace's columns or use the generator designed for this plant"
         )

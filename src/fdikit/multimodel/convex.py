@@ -285,7 +285,7 @@ def weight_regressors(models: ConvexModelSet, x_prev, u_prev, x_filt, u, y, weig
 
     Raises
     ------
-    ModelError
+    ParameterError
         On an unknown ``weighting``.
 
     Examples
@@ -301,7 +301,8 @@ def weight_regressors(models: ConvexModelSet, x_prev, u_prev, x_filt, u, y, weig
     Hallouzi 2008, §2.3.2, Table 2.2 step 2, (2.27), (2.33)–(2.34).
     """
     if weighting not in ("whitened", "inverse"):
-        raise ModelError(f"weighting must be 'whitened' (Q^-1/2, R^-1/2) or 'inverse' (Q^-1, R^-1), got {weighting!r}")
+        raise ParameterError(f"weighting must be 'whitened' (Q^-1/2, R^-1/2) or 'inverse' (Q^-1, R^-1), "
+                             f"got {weighting!r}")
     x_prev, x_filt = np.ravel(x_prev).astype(float), np.ravel(x_filt).astype(float)
     u_prev, u = np.atleast_1d(np.asarray(u_prev, float)).ravel(), np.atleast_1d(np.asarray(u, float)).ravel()
     y = np.ravel(y).astype(float)
@@ -415,6 +416,34 @@ class ConvexFilterResult:
     mu: np.ndarray
     mu_raw: np.ndarray
     names: tuple[str, ...]
+
+    def plot(self, ax=None, **kwargs):
+        """Draw the model weights over time (:func:`fdikit.plots.plot_weights`).
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Draw into it; default a new figure.
+        **kwargs
+            ``t``, ``raw``, ``title`` and ``path`` of :func:`~fdikit.plots.plot_weights`.
+
+        Returns
+        -------
+        matplotlib.figure.Figure or the given ``ax``
+            A new figure when ``ax`` is None, else ``ax``.
+
+        Examples
+        --------
+        >>> import matplotlib.pyplot as plt
+        >>> ms = convex_model_set([[0.9]], [[[0.0]], [[1.0]]], [[1.0]], Q=[[1e-4]], R=[[1e-2]])
+        >>> fig, ax = plt.subplots()
+        >>> dual_convex_filter(ms, np.zeros((4, 1)), np.ones((4, 1)), x0=[0.0], P0=[[1.0]]).plot(ax=ax) is ax
+        True
+        >>> plt.close(fig)
+        """
+        from fdikit.plots import plot_weights
+
+        return plot_weights(self, ax=ax, **kwargs)
 
 
 def check_data(models: ConvexModelSet, y, u):
@@ -568,7 +597,7 @@ def dual_convex_filter(models: ConvexModelSet, y, u, x0, P0, mu0=None, lam: floa
     ParameterError
         On an unknown ``form``, ``metric``, ``constrain``, ``ordering`` or ``weighting``, ``lam`` outside (0, 1],
         or a non-positive ``T0_scale``/``prior_std``.
-    ModelError
+    ParameterError
         With ``form="thesis"`` on a limit-value set (an offset the printed step has no term for).
 
     Notes
@@ -617,7 +646,8 @@ def dual_convex_filter(models: ConvexModelSet, y, u, x0, P0, mu0=None, lam: floa
     if mu0 is not None:
         validate.as_vector("mu0", mu0, models.N)
     if form == "thesis" and models.offset is not None:
-        raise ModelError("the printed weight step (2.33) has no offset term; use form='corrected' for limit-value sets")
+        raise ParameterError("the printed weight step (2.33) has no offset term; use form='corrected' for "
+                             "limit-value sets")
     y, u = check_data(models, y, u)
     N, n = models.N, models.n
     mu = np.full(N, 1.0 / N) if mu0 is None else models.check_weights(mu0)
@@ -691,7 +721,7 @@ def fault_size_from_weights(mu, faulty_models) -> np.ndarray:
 
     Raises
     ------
-    ModelError
+    ParameterError
         If ``faulty_models`` is empty or holds an index outside 0..N−1.
 
     Examples
@@ -706,7 +736,7 @@ def fault_size_from_weights(mu, faulty_models) -> np.ndarray:
     mu = np.asarray(mu, dtype=float)
     idx = np.asarray(faulty_models, dtype=int).ravel()
     if idx.size == 0 or idx.min() < 0 or idx.max() >= mu.shape[-1]:
-        raise ModelError(f"faulty_models must be indices in 0..{mu.shape[-1] - 1}, got {idx.tolist()}")
+        raise ParameterError(f"faulty_models must be indices in 0..{mu.shape[-1] - 1}, got {idx.tolist()}")
     return 1.0 - mu[..., idx].sum(axis=-1)
 
 
@@ -758,7 +788,7 @@ def lv_reciprocal_parameter(mu, value_at_0: float, value_at_1: float):
 
     Raises
     ------
-    ModelError
+    ParameterError
         If a limit value is not positive.
 
     Examples
@@ -771,7 +801,7 @@ def lv_reciprocal_parameter(mu, value_at_0: float, value_at_1: float):
     Hallouzi 2008, §3.6.2, (3.55).
     """
     if value_at_0 <= 0 or value_at_1 <= 0:
-        raise ModelError("a reciprocal LV parameter (mass) needs positive limit values")
+        raise ParameterError("a reciprocal LV parameter (mass) needs positive limit values")
     mu = np.asarray(mu, dtype=float)
     return value_at_0 * value_at_1 / (value_at_1 + mu * (value_at_0 - value_at_1))
 
@@ -795,7 +825,7 @@ def estimated_model_vector(vertices, mu) -> np.ndarray:
 
     Raises
     ------
-    ModelError
+    ParameterError
         If the number of columns of ``vertices`` and of weights differ.
 
     Examples
@@ -810,5 +840,5 @@ def estimated_model_vector(vertices, mu) -> np.ndarray:
     V = np.asarray(vertices, dtype=float)
     mu = np.asarray(mu, dtype=float)
     if V.ndim != 2 or mu.shape[-1] != V.shape[1]:
-        raise ModelError(f"vertices (n_q, N) and weights (..., N) disagree: {V.shape} vs {mu.shape}")
+        raise ParameterError(f"vertices (n_q, N) and weights (..., N) disagree: {V.shape} vs {mu.shape}")
     return mu @ V.T

@@ -138,6 +138,37 @@ class IMMResult:
         """Mode probabilities as a :class:`~fdikit.diagnosis.Diagnosis` (most probable mode, or ``logic``)."""
         return mode_diagnosis(self.t, self.mu, self.modes, self.nominal, logic, self.valid)
 
+    def plot(self, ax=None, **kwargs):
+        """Draw the mode probabilities over time (:func:`fdikit.plots.plot_mode_probabilities`).
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Draw into it; default a new figure.
+        **kwargs
+            ``title`` and ``path`` of :func:`~fdikit.plots.plot_mode_probabilities`.
+
+        Returns
+        -------
+        matplotlib.figure.Figure or the given ``ax``
+            A new figure when ``ax`` is None, else ``ax``.
+
+        Examples
+        --------
+        >>> import matplotlib.pyplot as plt
+        >>> m0 = LinearGaussianModel(A=[[1.0]], C=[[1.0]], Q=[[0.01]], R=[[0.1]], name="nominal")
+        >>> m1 = LinearGaussianModel(A=[[1.0]], C=[[2.0]], Q=[[0.01]], R=[[0.1]], name="gain fault")
+        >>> imm = IMMFilter([m0, m1], [[0.9, 0.1], [0.1, 0.9]], x0=[0.0], P0=[[1.0]])
+        >>> res = imm.run(np.zeros((3, 0)), np.ones((3, 1)))
+        >>> fig, ax = plt.subplots()
+        >>> res.plot(ax=ax) is ax
+        True
+        >>> plt.close(fig)
+        """
+        from fdikit.plots import plot_mode_probabilities
+
+        return plot_mode_probabilities(self, ax=ax, **kwargs)
+
 
 @dataclass(frozen=True, eq=False)
 class IMMFilter:
@@ -163,10 +194,10 @@ class IMMFilter:
     Raises
     ------
     ModelError
-        If the modes are not ``LinearGaussianModel`` s of equal dimensions with unique names, or Π is not
-        an (M, M) row-stochastic matrix.
+        If the modes are not ``LinearGaussianModel`` s of equal dimensions with unique names.
     ParameterError
-        If ``mu0``, ``x0``, ``P0``, ``nominal`` or ``min_probability`` has the wrong shape or range.
+        If Π is not an (M, M) row-stochastic matrix, or ``mu0``, ``x0``, ``P0``, ``nominal`` or
+        ``min_probability`` has the wrong shape or range.
 
     Examples
     --------
@@ -203,11 +234,11 @@ class IMMFilter:
                     f"mode {md.name!r} has (n, m, p) = {(md.n, md.m, md.p)} but the first mode has {(n, m, p)}; "
                     "all modes must share the state, input and output dimensions (pad with zeros)"
                 )
-        Pi = np.atleast_2d(validate.as_array("transition", self.transition, error=ModelError, finite=False))
+        Pi = np.atleast_2d(validate.as_array("transition", self.transition, error=ParameterError, finite=False))
         if not np.all(np.isfinite(Pi)):
-            raise ModelError("transition matrix Π must be finite; every entry is a probability in [0, 1]")
+            raise ParameterError("transition matrix Π must be finite; every entry is a probability in [0, 1]")
         if Pi.shape != (M, M) or np.any(Pi < 0) or not np.allclose(Pi.sum(axis=1), 1.0, atol=1e-10):
-            raise ModelError(
+            raise ParameterError(
                 f"transition matrix Π must be ({M}, {M}), non-negative, with rows summing to 1 "
                 f"(Π[i, j] = P(s_k+1 = j | s_k = i)); got shape {Pi.shape}, row sums {np.round(Pi.sum(axis=1), 6)}"
             )

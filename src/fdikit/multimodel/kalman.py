@@ -129,6 +129,34 @@ class KalmanResult:
     log_likelihood: np.ndarray
     valid: np.ndarray
 
+    def plot(self, ax=None, **kwargs):
+        """Draw the innovations with their ``±2σ`` bands (:func:`fdikit.plots.plot_innovations`).
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Draw into it; default a new figure.
+        **kwargs
+            ``t``, ``names``, ``sigmas``, ``title`` and ``path`` of :func:`~fdikit.plots.plot_innovations`.
+
+        Returns
+        -------
+        matplotlib.figure.Figure or the given ``ax``
+            A new figure when ``ax`` is None, else ``ax``.
+
+        Examples
+        --------
+        >>> import matplotlib.pyplot as plt
+        >>> mdl = LinearGaussianModel(A=[[0.9]], C=[[1.0]], Q=[[0.1]], R=[[1.0]])
+        >>> fig, ax = plt.subplots()
+        >>> kalman_filter(mdl, None, [[1.0], [0.5]], x0=[0.0], P0=[[1.0]]).plot(ax=ax) is ax
+        True
+        >>> plt.close(fig)
+        """
+        from fdikit.plots import plot_innovations
+
+        return plot_innovations(self, ax=ax, **kwargs)
+
 
 def _as_model(model, Q=None, R=None) -> LinearGaussianModel:
     if isinstance(model, LinearGaussianModel):
