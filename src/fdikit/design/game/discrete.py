@@ -385,7 +385,7 @@ class DiscreteGtfdfDesign(FieldReport):
         Pi = np.linalg.inv(self.covariances[k])
         return (Pi + Pi.T) / 2
 
-    REPORT = ("target", "gain", "poles", "levels", "settled", "settling_step")
+    REPORT = ("target", "gain", "filter_gain", "poles", "levels", "settled", "settling_step")
 
 
 def dgtfdf(setup: DiscreteGameSetup, targets: str | Sequence[str] | None = None,
@@ -473,7 +473,7 @@ class DiscreteGtmfdfDesign(FieldReport):
     riccati: GameRiccatiSolution
     notes: tuple[str, ...]
 
-    REPORT = ("gain", "poles", "sigma_min", "cost", "initial_cost", "method", "iterations", "notes")
+    REPORT = ("gain", "filter_gain", "poles", "sigma_min", "cost", "initial_cost", "method", "iterations", "notes")
 
 
 def _try_cost(setup: DiscreteGameSetup, L: np.ndarray, floor: float, max_radius: float):
