@@ -199,7 +199,7 @@ CASES = [
                                                       "f1"), ParameterError, "L", "3 x 2"),
     case("enhancement-not-design", lambda: enhancement_direction("design", "f1"), ParameterError, "design",
          "HinfDesign"),
-    case("uio-bank-also-unknown", lambda: uio_bank(_m(), ["y0_sensor"], also_decouple=["zz"]), ModelError, "zz"),
+    case("uio-bank-nuisance-unknown", lambda: uio_bank(_m(), ["y0_sensor"], nuisance=["zz"]), ModelError, "zz"),
     case("unknown-input-rtol", lambda: unknown_input_matrix(_m(), ["y0_sensor"], rtol=-1.0), ParameterError, "rtol",
          "non-negative"),
     case("parity-W2-shape", lambda: parity_design(_md(), s=2, W2=np.ones((2, 2))), ParameterError, "W2"),

@@ -14,7 +14,8 @@ Examples
 --------
 >>> from fdikit.analysis.gains import fdi_report
 >>> from fdikit.plants import path_vehicle_14
->>> rep = fdi_report(path_vehicle_14(), ["throttle", "brake", "steering", "air_mass:magnitude"])
+>>> rep = fdi_report(path_vehicle_14(), ["throttle_actuator", "brake_actuator", "steering_actuator",
+...                                      "air_mass_sensor:magnitude"])
 >>> [f.nu for f in rep.faults]
 [2, 2, 1, 1]
 """
@@ -29,7 +30,7 @@ import numpy as np
 from fdikit import validate
 from fdikit.analysis.geometry import FaultGeometry, FdiReport, fdi_report
 from fdikit.errors import ModelError, ParameterError
-from fdikit.linalg import resolve_fault
+from fdikit.linalg import check_fault_inputs, resolve_fault
 from fdikit.model import FaultModel
 from fdikit.residuals import ResidualGenerator
 
@@ -118,25 +119,55 @@ class GainTable:
         flat = self.gains.reshape(-1, len(self.groups))
         return pd.DataFrame(conv(flat), index=idx, columns=pd.Index(self.groups, name="residual"))
 
-    def plot(self, path=None, floor_db: float = -200.0, title: str | None = None):
+    def plot(self, path=None, floor_db: float = -200.0, title: str | None = None, ax=None):
         """Fault × residual-group map of the peak gain in dB (the "structure plot").
 
         Cells are coloured by gain (clipped below at ``floor_db`` under the largest entry) and
-        labelled with their value; the figure is written to ``path`` (any matplotlib format) when
-        given.  Uses the Agg canvas directly, so it changes no global matplotlib state.
-        Returns the :class:`matplotlib.figure.Figure`.
+        labelled with their value.
+
+        Parameters
+        ----------
+        path : str, Path or binary file object, optional
+            Write the figure there (any matplotlib format, by the suffix; atomically, see
+            :func:`fdikit.plots.save_figure`).
+        floor_db : float
+            Lowest gain shown, in dB below the largest entry.
+        title : str, optional
+            Axes title (default: the frequency range).
+        ax : matplotlib Axes, optional
+            Draw into it (the colour bar takes room from it); default a new figure on its own Agg
+            canvas, outside pyplot, so no global matplotlib state changes.
+
+        Returns
+        -------
+        matplotlib.figure.Figure or the given ``ax``
+            The new figure when ``ax`` is None, else ``ax``.
+
+        Examples
+        --------
+        >>> import matplotlib.pyplot as plt
+        >>> table = GainTable(np.array([1.0]), np.array([[[1.0, 1e-3]]]), ("f",), ("f", "g"), (("r1",), ("r2",)))
+        >>> fig, ax = plt.subplots()
+        >>> table.plot(ax=ax) is ax, [t.get_text() for t in ax.texts]
+        (True, ['0', '-60'])
+        >>> plt.close(fig)
         """
-        from matplotlib.backends.backend_agg import FigureCanvasAgg
-        from matplotlib.figure import Figure
+        from fdikit.plots import save_figure
 
         peak = self.peak()
         top = peak.max() if peak.size and peak.max() > 0 else 1.0
         with np.errstate(divide="ignore"):
             dbv = 20 * np.log10(np.maximum(peak, top * 10 ** (floor_db / 20)))
         nf, ng = peak.shape
-        fig = Figure(figsize=(1.2 + 0.9 * max(ng, 2), 1.0 + 0.45 * max(nf, 2)), layout="constrained")
-        FigureCanvasAgg(fig)
-        ax = fig.add_subplot()
+        given = ax
+        if ax is None:
+            from matplotlib.backends.backend_agg import FigureCanvasAgg
+            from matplotlib.figure import Figure
+
+            fig = Figure(figsize=(1.2 + 0.9 * max(ng, 2), 1.0 + 0.45 * max(nf, 2)), layout="constrained")
+            FigureCanvasAgg(fig)
+            ax = fig.add_subplot()
+        fig = ax.figure
         im = ax.imshow(dbv, cmap="viridis", aspect="auto", vmin=dbv.min() if dbv.size else 0)
         ax.set_xticks(range(ng), self.groups, rotation=45, ha="right")
         ax.set_yticks(range(nf), self.faults)
@@ -152,8 +183,8 @@ class GainTable:
         lo, hi = (self.omega.min(), self.omega.max()) if self.omega.size else (0, 0)
         ax.set_title(title or f"fault → residual gain, ω ∈ [{lo:.3g}, {hi:.3g}] rad/s", fontsize=9)
         if path is not None:
-            fig.savefig(path, dpi=120)
-        return fig
+            save_figure(fig, path, dpi=120)
+        return fig if given is None else given
 
 
 def _fault_columns(model: FaultModel, faults) -> tuple[tuple[str, ...], list[list[int]]]:
@@ -163,9 +194,9 @@ def _fault_columns(model: FaultModel, faults) -> tuple[tuple[str, ...], list[lis
         faults = [faults]
     if isinstance(faults, Mapping):
         names = tuple(faults)
-        cols = [model.index("f", [v] if isinstance(v, str) else list(v)) for v in faults.values()]
+        cols = [model.index("f", list(check_fault_inputs(model, v))) for v in faults.values()]
     else:
-        names = tuple(faults)
+        names = check_fault_inputs(model, faults)
         cols = [model.index("f", nm) for nm in names]
     if not names:
         raise ModelError("the model has no faults (group f); add them with with_sensor_faults/with_actuator_faults")
@@ -212,7 +243,8 @@ def fault_to_residual_gain(
     ----------
     generator, model : the residual generator and the fault model it runs on.
     freqs : frequencies in rad/s (``<= π/dt`` for a discrete internal form).
-    faults : fault names of the model (default: all), or a mapping ``label -> [fault names]`` that
+    faults : the fault inputs of the model to show (default: all), by fault name (a bare signal name
+        raises :class:`~fdikit.errors.ParameterError`), or a mapping ``label -> [fault names]`` that
         treats several fault inputs as one multi-dimensional fault.
 
     Residual groups: the residuals tied to the same fault by ``generator.isolates`` form one group

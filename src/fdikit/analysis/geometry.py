@@ -7,7 +7,8 @@ separability, mutual detectability and ``Σν`` against ``n``, with advice on wh
 Examples
 --------
 >>> from fdikit.plants import path_vehicle_14
->>> rep = fdi_report(path_vehicle_14(), ["throttle", "brake", "steering", "air_mass:magnitude"])
+>>> rep = fdi_report(path_vehicle_14(), ["throttle_actuator", "brake_actuator", "steering_actuator",
+...                                      "air_mass_sensor:magnitude"])
 >>> [f.nu for f in rep.faults]
 [2, 2, 1, 1]
 """
@@ -185,7 +186,7 @@ def _dependent_sets(images: list[np.ndarray], rtol) -> list[tuple[int, ...]]:
 
 def fdi_report(
     model: FaultModel,
-    faults: Mapping[str, np.ndarray] | Sequence[str],
+    targets: Mapping[str, np.ndarray] | Sequence[str] | str,
     rtol: float | None = None,
     ztol: float = 1e-6,
 ) -> FdiReport:
@@ -194,10 +195,12 @@ def fdi_report(
     Parameters
     ----------
     model : FaultModel (its ``A`` and ``C``; continuous or discrete).
-    faults : fault names (resolved by :func:`resolve_fault`: an output name is its 2-D sensor fault
-        ``[F¹, A F¹]``, ``'<output>:magnitude'`` only ``A F¹`` -- the bias assumption -- and
-        ``'<output>:rate'`` only ``F¹``; a control name is its actuator column of ``Bu``; a fault
-        input of the model its ``Bf`` column), or a mapping ``name -> F`` of explicit n x k maps.
+    targets : the candidate faults of the filter: fault names (resolved by :func:`resolve_fault`:
+        ``'<output>_sensor'`` is the 2-D sensor fault ``[F¹, A F¹]``, ``'<output>_sensor:magnitude'``
+        only ``A F¹`` -- the bias assumption -- and ``'<output>_sensor:rate'`` only ``F¹``;
+        ``'<control>_actuator'`` is the actuator column of ``Bu``; a fault input of the model its
+        ``Bf`` column; a bare signal name raises :class:`~fdikit.errors.ParameterError`), or a
+        mapping ``name -> F`` of explicit n x k maps.
     rtol : relative rank tolerance of the subspace computations (:mod:`fdikit.linalg` default).
     ztol : tolerance for matching zeros, relative to ``max(‖A‖₂, 1)``.
 
@@ -210,8 +213,7 @@ def fdi_report(
     if rtol is not None:
         rtol = validate.non_negative("rtol", rtol)
     ztol = validate.non_negative("ztol", ztol)
-    if isinstance(faults, str):
-        faults = [faults]
+    faults = [targets] if isinstance(targets, str) else targets
     A, C, n = model.A, model.C, model.n
     entries: list[tuple[str, np.ndarray, str]] = []
     if isinstance(faults, Mapping):

@@ -78,7 +78,7 @@ def test_two_dimensional_sensor_faults_and_complex_pairs():
     n = 6
     model = FaultModel(A=rng.standard_normal((n, n)), C=rng.standard_normal((n, n)), Bu=rng.standard_normal((n, 1)),
                        outputs=[f"y{i}" for i in range(n)])
-    d = beard_jones(model, ["y0", "y3"], {"y0_sensor": [-2 + 1j, -2 - 1j], "y3_sensor": [-3, -4]},
+    d = beard_jones(model, ["y0_sensor", "y3_sensor"], {"y0_sensor": [-2 + 1j, -2 - 1j], "y3_sensor": [-3, -4]},
                     complement_poles=[-1, -5])
     assert {k: T.shape[1] for k, T in d.detection_spaces.items()} == {"y0_sensor": 2, "y3_sensor": 2}
     np.testing.assert_allclose(np.sort_complex(d.poles), np.sort_complex(np.array([-5, -4, -3, -2 - 1j, -2 + 1j, -1])),
@@ -116,7 +116,7 @@ def test_infeasible_specifications_raise_with_reasons():
     big = FaultModel(A=model.A, C=np.vstack([model.C, rng.standard_normal((3, 4))]))
     with pytest.raises(DesignError, match="dimensions"):
         beard_jones(big, many, {k: [-1.0 - i] for i, k in enumerate(many)}, [])
-    with pytest.raises(ModelError, match="not an output, control or fault input"):
+    with pytest.raises(ModelError, match="not a fault of the model"):
         resolve_faults(model, ["nope"])
 
 

@@ -314,7 +314,7 @@ def test_bad_input_errors():
     with pytest.raises(DesignError, match="improper"):
         parity_filter(M70, poles=[0.5])
     two = M70.add_faults(["bank_like"], M70.Bd[:, [1]])
-    with pytest.raises(DesignError, match="fault="):
+    with pytest.raises(DesignError, match="targets="):
         parity_filter(two)
     with pytest.raises(DesignError, match="not detectable"):
         parity_filter(two, "bank_like")  # same direction as the bank disturbance: rejected with it

@@ -207,7 +207,7 @@ def _complements(model: LTVModel, targets: Sequence[str] | str,
                 what = "sensor" if kind == "output" else "actuator"
                 raise ParameterError(f"{k!r} is an {kind}; its {what} fault is {fault!r}; faults are named by fault "
                                      f"name, not by signal name (the LTV model has {list(model.faults)})")
-            raise ModelError(f"no fault named {k!r}; the LTV model has {list(model.faults)}")
+            raise ParameterError(f"no fault named {k!r}; the LTV model has {list(model.faults)}")
     both = set(targets) & set(nuisance)
     if both:
         raise DesignError(f"{sorted(both)} given both as target and as nuisance; each fault is one or the other")

@@ -51,7 +51,7 @@ import scipy.linalg
 
 from fdikit import linalg, validate
 from fdikit.design.observers.full_order import observer_generator
-from fdikit.errors import DesignError, ModelError, ParameterError
+from fdikit.errors import DesignError, ParameterError
 from fdikit.linalg import resolve_faults
 from fdikit.model import FaultModel
 from fdikit.protocols import joined_form
@@ -244,7 +244,7 @@ def _check_sets(model, dims, poles, complement_poles):
         sets[name] = validate.as_complex_vector(f"poles[{name!r}]", poles[name])
     unknown = set(poles) - set(dims)
     if unknown:
-        raise ModelError(f"poles given for unknown fault(s) {sorted(unknown)}; faults are {list(dims)}")
+        raise ParameterError(f"poles given for unknown fault(s) {sorted(unknown)}; faults are {list(dims)}")
     nu0 = n - sum(dims.values())
     sets["complement"] = (validate.as_complex_vector("complement_poles", complement_poles)
                           if complement_poles is not None else np.zeros(0, dtype=complex))

@@ -28,7 +28,7 @@ import numpy as np
 import scipy.linalg
 
 from fdikit import linalg
-from fdikit.errors import DesignError, ModelError
+from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.linalg import resolve_faults
 from fdikit.model import FaultModel
 
@@ -77,20 +77,21 @@ class DetectionGainFamily:
         """
         unknown = set(alphas) - set(self.spaces)
         if unknown:
-            raise ModelError(f"alphas given for unknown fault(s) {sorted(unknown)}; faults are {list(self.names)}")
+            raise ParameterError(f"alphas given for unknown fault(s) {sorted(unknown)}; faults are {list(self.names)}")
         L = self.base_gain.copy()
         for name, W in self.spaces.items():
             if name in alphas:
                 a = np.atleast_2d(np.asarray(alphas[name], dtype=float))
                 want = (W.shape[1], self.residual_maps[name].shape[0])
                 if a.shape != want:
-                    raise ModelError(f"alpha of {name!r} has shape {a.shape}; it must be {want} (dim W_i x dim C W_i)")
+                    raise ParameterError(f"alpha of {name!r} has shape {a.shape}; it must be {want} "
+                                         "(dim W_i x dim C W_i)")
                 L = L - W @ a @ self.residual_maps[name]
         k0 = self.complement_map.shape[0]
         if beta is not None and k0:
             b = np.asarray(beta, dtype=float).reshape(self.A.shape[0], -1)
             if b.shape[1] != k0:
-                raise ModelError(f"beta has {b.shape[1]} columns; it must be n x {k0} (the dimension of Im H_0)")
+                raise ParameterError(f"beta has {b.shape[1]} columns; it must be n x {k0} (the dimension of Im H_0)")
             L = L - b @ self.complement_map
         return L
 

@@ -54,7 +54,7 @@ import scipy.linalg
 from fdikit import linalg, validate
 from fdikit.design.observers.detection_gain import DetectionGainFamily, detection_gain_family
 from fdikit.design.observers.full_order import observer_generator
-from fdikit.errors import DesignError, ModelError, ParameterError
+from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import joined_form
 from fdikit.residuals import ResidualGenerator
@@ -279,7 +279,7 @@ def _omega(model: FaultModel, disturbances):
     cols = []
     for nm in names:
         if nm not in pool:
-            raise ModelError(f"{nm!r} is not a disturbance or noise input; the model has {list(pool)}")
+            raise ParameterError(f"{nm!r} is not a disturbance or noise input; the model has {list(pool)}")
         g = "d" if nm in model.disturbances else "w"
         cols.append((model.b(g)[:, model.index(g, nm)], model.d(g)[:, model.index(g, nm)]))
     return names, np.hstack([c[0] for c in cols]), np.hstack([c[1] for c in cols])
@@ -438,7 +438,7 @@ def enhancement_direction(design: HinfDesign, fault: str) -> Enhancement:
     validate.instance("design", design, HinfDesign, "pass the result of hinf_detection_filter(...)")
     fam = design.family
     if fault not in fam.spaces:
-        raise ModelError(f"no fault {fault!r} in the design; faults are {list(fam.names)}")
+        raise ParameterError(f"no fault {fault!r} in the design; faults are {list(fam.names)}")
     A, C, L = fam.A, fam.C, design.gain
     n = A.shape[0]
     others = [W for k, W in fam.spaces.items() if k != fault]

@@ -287,9 +287,10 @@ def uio(
     Raises
     ------
     ParameterError
-        A signal name instead of a fault name, or more than one target (use :func:`uio_bank`).
+        A signal name instead of a fault name, more than one target (use :func:`uio_bank`), a ``model``
+        that is not a FaultModel, or the target among the nuisance faults.
     ModelError
-        Unknown fault names, or the target among the nuisance faults.
+        Unknown fault names.
     DesignError
         ``rank CE < rank E`` (the message gives both ranks and the invisible inputs); no output
         left after decoupling; an unstable fixed mode (invariant zero of ``(A, E, C)``); poles of the
@@ -309,7 +310,7 @@ def uio(
     import control
 
     if not isinstance(model, FaultModel):
-        raise ModelError(f"uio needs a FaultModel, got {type(model).__name__}")
+        raise ParameterError(f"uio needs a FaultModel, got {type(model).__name__}")
     given = linalg.check_fault_inputs(model, targets, "target")
     if len(given) != 1:
         raise ParameterError(f"uio detects one target fault, got {list(given)}; use uio_bank for several")
@@ -322,7 +323,7 @@ def uio(
     else:
         nuisance = tuple(dict.fromkeys(linalg.check_fault_inputs(model, nuisance, "nuisance")))
         if target in nuisance:
-            raise ModelError(f"the target {target!r} is also listed as a nuisance fault; remove it from nuisance")
+            raise ParameterError(f"the target {target!r} is also listed as a nuisance fault; remove it from nuisance")
     A, C, Bu, Du = model.A, model.C, model.Bu, model.Du
     n, p, m = model.n, model.p, len(model.controls)
     discrete = model.is_discrete

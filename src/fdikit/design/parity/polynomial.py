@@ -44,7 +44,7 @@ import numpy as np
 
 from fdikit import linalg
 from fdikit.dae import DAEModel, dae_form
-from fdikit.errors import DesignError, ModelError, ParameterError
+from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import joined_form, no_internal_form
 from fdikit.residuals import ResidualGenerator
@@ -60,6 +60,7 @@ __all__ = [
     "minimal_degree",
     "normal_rank",
     "parity_filter",
+    "target_fault",
     "time_varying_bar",
 ]
 
@@ -75,7 +76,7 @@ def time_varying_bar(rows: Sequence[Sequence[np.ndarray]]) -> np.ndarray:
     """
     rows = [list(r) for r in rows]
     if not rows or not rows[0]:
-        raise ModelError("a bar matrix needs at least one block row with one coefficient")
+        raise ParameterError("a bar matrix needs at least one block row with one coefficient")
     r, c = rows[0][0].shape
     width = max(i + len(coeffs) for i, coeffs in enumerate(rows))
     out = np.zeros((len(rows) * r, width * c))
@@ -97,7 +98,7 @@ def bar(coefficients: Sequence[np.ndarray], degree: int) -> np.ndarray:
            [0., 1., 2.]])
     """
     if int(degree) != degree or degree < 0:
-        raise ModelError(f"the parity degree must be a non-negative integer, got {degree!r}")
+        raise ParameterError(f"the parity degree must be a non-negative integer, got {degree!r}")
     return time_varying_bar([coefficients] * (int(degree) + 1))
 
 
@@ -308,9 +309,32 @@ class PolynomialParityDesign:
                 "dc_gain": self.dc_gain, "fault_zeros": self.fault_zeros}
 
 
+def target_fault(dae: DAEModel, targets: str | Sequence[str] | None, who: str = "the parity filter") -> str:
+    """The one fault of ``dae`` a parity filter detects.
+
+    ``targets``: a fault name (a column of ``F``), a one-element sequence of it, or ``None`` when the
+    DAE has exactly one fault.  A bare signal name (an output or control) raises
+    :class:`ParameterError` giving the fault name (``'<output>_sensor'``, ``'<control>_actuator'``).
+    """
+    if targets is None:
+        return dae.faults[dae.fault_index(None)]
+    given = [targets] if isinstance(targets, str) else list(targets)
+    if len(given) != 1:
+        raise ParameterError(f"{who} detects one target fault, got {given}; design one filter per fault")
+    name = given[0]
+    if name not in dae.faults and isinstance(name, str):
+        if name in dae.outputs:
+            raise ParameterError(f"{name!r} is an output; its sensor fault is '{name}_sensor'; faults are named by "
+                                 f"fault name, not by signal name (the DAE has faults {list(dae.faults)})")
+        if name in dae.controls:
+            raise ParameterError(f"{name!r} is a control; its actuator fault is '{name}_actuator'; faults are named "
+                                 f"by fault name, not by signal name (the DAE has faults {list(dae.faults)})")
+    return dae.faults[dae.fault_index(name)]
+
+
 def parity_filter(
     model: DAEModel | FaultModel,
-    fault: str | None = None,
+    targets: str | Sequence[str] | None = None,
     *,
     degree: int | None = None,
     poles: float | Sequence[float] = 0.9048,
@@ -322,8 +346,10 @@ def parity_filter(
     ----------
     model : DAEModel or FaultModel
         The DAE (2.1), or a discrete FaultModel converted by :func:`dae_form`.
-    fault : str, optional
-        The fault to detect (a column of ``F``); may be omitted when there is one.
+    targets : str, optional
+        The fault to detect, by fault name (a column of ``F``: ``'<control>_actuator'``,
+        ``'<output>_sensor'``, …) or a one-element sequence; may be omitted when there is one.
+        The other faults are not decoupled.
     degree : int, optional
         Parity degree ``d_N``; default the minimal one (:func:`minimal_degree`).
     poles : float or sequence of float
@@ -355,9 +381,8 @@ def parity_filter(
     """
     dae = dae_form(model) if isinstance(model, FaultModel) else model
     if not isinstance(dae, DAEModel):
-        raise ModelError(f"parity_filter needs a DAEModel or a discrete FaultModel, got {type(model).__name__}")
-    j = dae.fault_index(fault)
-    fault = dae.faults[j]
+        raise ParameterError(f"parity_filter needs a DAEModel or a discrete FaultModel, got {type(model).__name__}")
+    fault = target_fault(dae, targets)
     dN = minimal_degree(dae, fault) if degree is None else int(degree)
     Hb, Lb, Fb = bar_matrices(dae, dN, fault)
     V = linalg.null(Hb.T).T

@@ -51,6 +51,7 @@ from fdikit.design.parity.polynomial import (
     dae_form,
     parity_filter,
     real_poles,
+    target_fault,
 )
 from fdikit.design.parity.polynomial import time_varying_bar as _bar
 from fdikit.errors import DataError, DesignError, ModelError, ParameterError
@@ -429,7 +430,7 @@ class ScheduledStepper:
 def scheduled_parity_filter(
     family: Family,
     reference: float,
-    fault: str | None = None,
+    targets: str | Sequence[str] | None = None,
     *,
     degree: int | None = None,
     poles: float | Sequence[float] = 0.9048,
@@ -446,8 +447,8 @@ def scheduled_parity_filter(
         Discrete models with the fault input, e.g. :func:`fdikit.plants.single_track.single_track_lpv`.
     reference : float
         Design point ``ρ`` for the degree search and the checks (e.g. ``70 / 3.6`` m/s).
-    fault : str, optional
-        Fault to detect (default: the model's only fault).
+    targets : str, optional
+        The fault to detect, by fault name (default: the model's only fault).
     degree : int, optional
         ``d_N``; default the minimal degree at ``reference``.
     poles : float or sequence of float
@@ -484,7 +485,7 @@ def scheduled_parity_filter(
     if not isinstance(model, FaultModel) or not model.is_discrete:
         raise ModelError(f"family({reference}) must return a discrete FaultModel, got {model!r}")
     dae = dae_form(model)
-    fault = dae.faults[dae.fault_index(fault)]
+    fault = target_fault(dae, targets, "scheduled_parity_filter")
     ref = parity_filter(dae_form(model, [fault]), fault, degree=degree, poles=poles, name=name)
     min_poles = ref.degree + len(dae.L)
     p = real_poles(poles, min_poles)
