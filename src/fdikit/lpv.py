@@ -189,6 +189,22 @@ class StackedMatrices:
     Every array may carry leading batch axes (one set of matrices per ρ).  ``H_os`` is
     ``(s+1)p × n``; ``H[g]`` is ``(s+1)p × (s+1)k_g`` for input group ``g`` with the
     window's inputs stacked sample by sample, ``[v(k); v(k+1); …; v(k+s)]``.
+
+    Attributes
+    ----------
+    H_os : ndarray
+        Stacked observability matrix, ``(..., (s+1)p, n)``.
+    H : dict of str to ndarray
+        Input maps by group ``"u"``, ``"d"``, ``"f"``, ``"w"`` (also as ``H_us``, ``H_ds``, ``H_fs``, ``H_ws``).
+    s : int
+        Horizon.
+
+    Examples
+    --------
+    >>> from fdikit import FaultModel
+    >>> st = stacked_matrices(FaultModel([[0.5]], [[2.0]], Bu=[[1.0]], dt=1.0), 2)
+    >>> st.H_us.tolist(), st.H_fs.shape
+    ([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [1.0, 2.0, 0.0]], (3, 0))
     """
 
     H_os: np.ndarray
@@ -251,6 +267,20 @@ def stacked_matrices(model: FaultModel | Sequence[FaultModel], s: int | None = N
     s : int, optional
         Horizon for a single model.
 
+    Returns
+    -------
+    StackedMatrices
+        ``H_os`` and the maps of every input group over the window.
+
+    Raises
+    ------
+    ParameterError
+        If ``model`` is not a FaultModel or a non-empty sequence of them, or ``s`` is missing for a single
+        model or not a non-negative integer.
+    ModelError
+        If a model is continuous, the window's models differ in dimensions or inputs, or ``s`` contradicts the
+        length of the window.
+
     Examples
     --------
     >>> from fdikit import FaultModel
@@ -286,13 +316,42 @@ def lpv_stacked_matrices(lpv: LPVModel, rho, s: int, *, mode: str = "frozen", gr
 
     Parameters
     ----------
+    lpv : LPVModel
+        The model.
     rho : array_like
         ``mode="frozen"``: ρ values (any shape, real or complex), one frozen window each.
         ``mode="exact"``: windows of ρ with the last axis of length ``s+1``, oldest sample first.
     s : int
         Horizon.
+    mode : {"frozen", "exact"}
+        ρ constant over each window ((44)–(45), default) or the exact time-varying stacking.
     groups : sequence of str
-        Input groups whose maps are wanted.
+        Input groups whose maps are wanted (default all).
+
+    Returns
+    -------
+    StackedMatrices
+        Arrays with the batch shape of ``rho`` (without the window axis) in front.
+
+    Raises
+    ------
+    ParameterError
+        If ``s`` is not a non-negative integer.
+    ModelError
+        On an unknown ``mode`` or, with ``mode="exact"``, windows whose last axis is not ``s+1`` long.
+
+    Examples
+    --------
+    >>> from fdikit import FaultModel
+    >>> lpv = LPVModel({0: FaultModel([[1.0]], [[1.0]], Bu=[[1.0]], dt=0.1),
+    ...                 1: FaultModel([[-0.5]], [[0.0]], Bu=[[0.0]], dt=0.1)})     # A(ρ) = 1 − 0.5 ρ
+    >>> st = lpv_stacked_matrices(lpv, 0.4, 2)
+    >>> st.H_os.round(6).ravel().tolist(), st.H_us.round(6).tolist()
+    ([1.0, 0.8, 0.64], [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.8, 1.0, 0.0]])
+    >>> lpv_stacked_matrices(lpv, [0.0, 0.4], 1).H_os.shape     # two frozen windows
+    (2, 2, 1)
+    >>> lpv_stacked_matrices(lpv, [0.0, 0.4], 1, mode="exact").H_os.ravel().tolist()   # C; C A(ρ_k = 0)
+    [1.0, 1.0]
     """
     s = check_horizon(s)
     rho = np.asarray(rho)
@@ -332,6 +391,28 @@ class Uncertainty:
     ``n`` and ``p`` are the model's sizes (checked against the LPV model when stacking).
     As in (5), ``B`` and ``D`` are certain; δ is taken constant over the window, as (14) does (its ``ζ_k`` is built
     from ``δ_k`` alone).
+
+    Parameters
+    ----------
+    A : array_like or mapping of int to array_like, optional
+        ``Ã`` (n x n), constant or by power of ρ; zero if omitted.
+    C : array_like or mapping of int to array_like, optional
+        ``C̃`` (p x n), constant or by power of ρ; zero if omitted.
+    n, p : int
+        Numbers of states and outputs of the model (keyword-only).
+    name : str, optional
+        Name of δ (default ``"delta"``).
+
+    Raises
+    ------
+    ModelError
+        If a power is not a non-negative integer, or a coefficient is not a finite matrix of the given size.
+
+    Examples
+    --------
+    >>> u = Uncertainty(A=[[0.1]], n=1, p=1, name="dA")
+    >>> [M.tolist() for M in u.matrices(0.4)]          # Ã(ρ), C̃(ρ)
+    [[[0.1]], [[0.0]]]
     """
 
     A: np.ndarray
@@ -363,6 +444,23 @@ class UncertainStack:
     monomial ``δ^e`` (``e`` an exponent tuple, total degree ≥ 1) in the stacked ``kind``
     map, ``kind`` in ``"os"`` and the input groups ``"u", "d", "f", "w"``.  Printed (14) has
     ``H̃_ds U_s``; it is ``H̃_ds U_ds`` (typo: ``H̃_ds`` multiplies the unknown inputs, as ``H_ds`` does).
+
+    Attributes
+    ----------
+    nominal : StackedMatrices
+        The stacked matrices at δ = 0.
+    tilde : dict
+        ``tilde[kind][e]``: coefficient of ``δ^e`` in the stacked map ``kind`` (``"os"`` or an input group);
+        only non-zero coefficients are kept.
+
+    Examples
+    --------
+    >>> from fdikit import FaultModel
+    >>> lpv = LPVModel({0: FaultModel([[1.0]], [[1.0]], Bu=[[1.0]], dt=0.1),
+    ...                 1: FaultModel([[-0.5]], [[0.0]], Bu=[[0.0]], dt=0.1)})     # A(ρ) = 1 − 0.5 ρ
+    >>> us = uncertain_stacked_matrices(lpv, [Uncertainty(A=[[0.1]], n=1, p=1)], 0.4, 1)
+    >>> us.nominal.H_os.round(6).ravel().tolist(), us.monomials("os"), us.tilde["os"][(1,)].round(6).ravel().tolist()
+    ([1.0, 0.8], [(1,)], [0.0, 0.1])
     """
 
     nominal: StackedMatrices
@@ -389,6 +487,43 @@ def uncertain_stacked_matrices(lpv: LPVModel, uncertainties: Sequence[Uncertaint
     ``Σ_e δ^e tilde[kind][e]`` plus the nominal map equals the stacked map of the model with
     ``Ā = A₀ + Σ δ_i Ã_i`` and ``C̄ = C₀ + Σ δ_i C̃_i`` exactly (a polynomial identity in δ).
     ``rho`` and ``mode`` are as in :func:`lpv_stacked_matrices`.
+
+    Parameters
+    ----------
+    lpv : LPVModel
+        The nominal model ``A₀(ρ), C₀(ρ), B(ρ), D(ρ)``.
+    uncertainties : sequence of Uncertainty
+        The unknowns δ_i with their ``Ã_i``, ``C̃_i``.
+    rho : array_like
+        Scheduling values, as in :func:`lpv_stacked_matrices`.
+    s : int
+        Horizon.
+    mode : {"frozen", "exact"}
+        As in :func:`lpv_stacked_matrices`.
+    groups : sequence of str
+        Input groups whose maps are expanded (default ``("u", "d", "f")``; the others are empty).
+
+    Returns
+    -------
+    UncertainStack
+        The nominal stacked matrices and the coefficients of every monomial of δ.
+
+    Raises
+    ------
+    ParameterError
+        If ``s`` is not a non-negative integer.
+    ModelError
+        If an uncertainty does not match the model's sizes, or ``mode``/``rho`` are invalid.
+
+    Examples
+    --------
+    >>> from fdikit import FaultModel
+    >>> lpv = LPVModel({0: FaultModel([[1.0]], [[1.0]], Bu=[[1.0]], dt=0.1),
+    ...                 1: FaultModel([[-0.5]], [[0.0]], Bu=[[0.0]], dt=0.1)})     # A(ρ) = 1 − 0.5 ρ
+    >>> dA = Uncertainty(A=[[0.1]], n=1, p=1, name="dA")
+    >>> us = uncertain_stacked_matrices(lpv, [dA], 0.4, 2)
+    >>> us.monomials("os"), us.tilde["os"][(2,)].round(6).ravel().tolist()     # δ² in C A²: 0.1²
+    ([(1,), (2,)], [0.0, 0.0, 0.01])
     """
     s = check_horizon(s)
     unc = list(uncertainties)
