@@ -67,8 +67,22 @@ _STATES = ("p_x", "v_x", "p_y", "v_y")
 def tracking_convex_set(dt: float = TS) -> ConvexModelSet:
     """The two-model convex set {left turn, right turn} of §2.4.2 (``Q``, ``R`` of (2.67)).
 
-    Example
+    Parameters
+    ----------
+    dt : float, default TS (1.0)
+        Sample time [s].
+
+    Returns
     -------
+    ConvexModelSet
+        Models ``left_turn`` and ``right_turn`` (``A`` of (2.65), ``B^(2)``, ``B^(3)`` of (2.66), ``C = I_4``).
+
+    References
+    ----------
+    Hallouzi 2008, §2.4.2, (2.65)–(2.67).
+
+    Examples
+    --------
     >>> ms = tracking_convex_set()
     >>> ms.names, bool(np.allclose(ms.blend([0.5, 0.5])[1], 0))
     (('left_turn', 'right_turn'), True)
@@ -79,7 +93,27 @@ def tracking_convex_set(dt: float = TS) -> ConvexModelSet:
 
 
 def tracking_imm_modes(dt: float = TS) -> list:
-    """The three IMM modes (straight, left, right) of §2.4.2 as :class:`~fdikit.gaussian.LinearGaussianModel`."""
+    """The three IMM modes (straight, left, right) of §2.4.2 as :class:`~fdikit.gaussian.LinearGaussianModel`.
+
+    Parameters
+    ----------
+    dt : float, default TS (1.0)
+        Sample time [s].
+
+    Returns
+    -------
+    list of LinearGaussianModel
+        ``straight``, ``left_turn``, ``right_turn``, each with ``Q``, ``R`` of (2.67).
+
+    References
+    ----------
+    Hallouzi 2008, §2.4.2, (2.65)–(2.68).
+
+    Examples
+    --------
+    >>> [mode.name for mode in tracking_imm_modes()]
+    ['straight', 'left_turn', 'right_turn']
+    """
     A = tracking_A(dt)
     return [LinearGaussianModel(A=A, C=np.eye(4), Q=Q_TRACKING, R=R_TRACKING, B=tracking_B(nm), name=nm)
             for nm in TRACKING_MODES]
@@ -88,8 +122,31 @@ def tracking_imm_modes(dt: float = TS) -> list:
 def maneuver_profile(n_samples: int = N_SAMPLES) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """True ``B_k`` (K, 4), convex weights (K, 2) on {left, right}, and labels (K,) of §2.4.2.
 
-    Example
+    Parameters
+    ----------
+    n_samples : int, default N_SAMPLES (400)
+        Number of samples K.
+
+    Returns
     -------
+    B : (K, 4) array
+        True input matrix per sample (``u ≡ 1``).
+    mu : (K, 2) array
+        True convex weights on {left, right}.
+    labels : (K,) array of str
+        ``"left_turn_half"``, ``"right_turn"`` or ``"none"``.
+
+    Raises
+    ------
+    ParameterError
+        If ``n_samples < 1``.
+
+    References
+    ----------
+    Hallouzi 2008, §2.4.2.
+
+    Examples
+    --------
     >>> B, mu, lab = maneuver_profile()
     >>> mu[[0, 100, 150, 151, 250]].tolist(), str(lab[120])
     ([[0.5, 0.5], [0.75, 0.25], [0.75, 0.25], [0.5, 0.5], [0.0, 1.0]], 'left_turn_half')
@@ -112,6 +169,29 @@ def target_tracking_trace(seed=None, n_samples: int = N_SAMPLES) -> Trace:
     """One simulated run (Hallouzi 2008, §2.4.2): ``x_{k+1} = A x_k + B_k u_k + w_k``, ``y_k = x_k + v_k``, ``u ≡ 1``.
 
     ``seed`` is an int or a ``numpy.random.Generator``.  Labels: ``left_turn_half``, ``right_turn``, ``none``.
+
+    Parameters
+    ----------
+    seed : int or numpy.random.Generator, optional
+        Source of the process and measurement noise.
+    n_samples : int, default N_SAMPLES (400)
+        Number of samples.
+
+    Returns
+    -------
+    Trace
+        Control ``u``; outputs ``p_x_meas, v_x_meas, p_y_meas, v_y_meas``; states ``p_x, v_x, p_y, v_y``;
+        fault labels of :func:`maneuver_profile`.
+
+    References
+    ----------
+    Hallouzi 2008, §2.4.2, (2.65)–(2.67).
+
+    Examples
+    --------
+    >>> tr = target_tracking_trace(0, n_samples=20)
+    >>> tr.y.shape, tr.outputs[0]
+    ((20, 4), 'p_x_meas')
     """
     rng = np.random.default_rng(seed)
     B, mu, labels = maneuver_profile(n_samples)
@@ -134,14 +214,37 @@ class TargetTrackingResult:
 
     Attributes
     ----------
-    t : (K,) sample times.  filters : filter names (``"dual_cmf"``, ``"ekf"``, ``"imm"``).
-    rmse_position, rmse_velocity, rmse_B : filter → (K,) RMSE (2.64) per sample over the runs.
-    mean_weights : filter → (K, N) weights averaged over the runs (IMM: its 3 mode probabilities).
-    cm_weights : filter → (K, 2) mean weights in CM coordinates (left, right); for the IMM
+    t : (K,) array
+        Sample times [s].
+    filters : tuple of str
+        Filter names (``"dual_cmf"``, ``"ekf"``, ``"imm"``).
+    rmse_position, rmse_velocity, rmse_B : dict of str to (K,) array
+        Filter → RMSE (2.64) per sample over the runs ([m], [m/s], and of B̂).
+    mean_weights : dict of str to (K, N) array
+        Filter → weights averaged over the runs (IMM: its 3 mode probabilities).
+    cm_weights : dict of str to (K, 2) array
+        Filter → mean weights in CM coordinates (left, right); for the IMM
         ``μ_left = 0.5 + (μ^(2) − μ^(3))/2``, which reconstructs the same B̂.
-    chatter : filter → mean over runs and samples in [100, 150] of ``|Δμ_left|`` per sample.
-    summary : filter → interval → {"position", "velocity", "B"} mean RMSE over the interval.
-    true_weights : (K, 2).  runs, seed : the Monte-Carlo settings.
+    chatter : dict of str to float
+        Filter → mean over runs and samples in [100, 150] of ``|Δμ_left|`` per sample.
+    summary : dict
+        Filter → interval of :data:`INTERVALS` → {"position", "velocity", "B"} mean RMSE over the interval.
+    true_weights : (K, 2) array
+        True CM weights (:func:`maneuver_profile`).
+    runs : int
+        Number of Monte-Carlo runs.
+    seed : int or None
+        Master seed.
+
+    References
+    ----------
+    Hallouzi 2008, §2.4.2, Figs 2.4–2.5, (2.64).
+
+    Examples
+    --------
+    >>> result = target_tracking_monte_carlo(runs=1, n_samples=160, filters=("ekf",))
+    >>> result.rmse_position["ekf"].shape, list(result.summary["ekf"])
+    ((160,), ['straight_1', 'left_half'])
     """
 
     t: np.ndarray
@@ -212,9 +315,18 @@ def target_tracking_monte_carlo(runs: int = 100, seed: int | None = 0, *, lam: f
 
     Parameters
     ----------
-    runs : number of runs (thesis: 100).  seed : master seed (runs use ``SeedSequence(seed).spawn``).
-    lam : dual-CMF forgetting factor (thesis 0.9).  q_mu : EKF ``Q^μ = q_mu I`` (thesis 1e-2).
-    filters : subset of ``("dual_cmf", "ekf", "imm")``.
+    runs : int, default 100
+        Number of runs (thesis: 100).
+    seed : int or None, default 0
+        Master seed (runs use ``SeedSequence(seed).spawn``).
+    lam : float, default 0.9
+        Dual-CMF forgetting factor (thesis 0.9).
+    q_mu : float, default 1e-2
+        EKF ``Q^μ = q_mu I`` (thesis 1e-2).
+    filters : sequence of str, default ("dual_cmf", "ekf", "imm")
+        Subset of ``("dual_cmf", "ekf", "imm")``.
+    n_samples : int, default N_SAMPLES (400)
+        Samples per run; intervals of :data:`INTERVALS` beyond the run are left out of ``summary``.
     store : :class:`fdikit.resume.RunStore`, optional
         Keeps the sums of every chunk of runs (``min(CHUNK_RUNS, max(1, runs // 4))`` runs) as a part as
         soon as they are complete and reuses the parts already there, so a killed run resumes.  The runs
@@ -223,10 +335,25 @@ def target_tracking_monte_carlo(runs: int = 100, seed: int | None = 0, *, lam: f
     progress : callable, optional
         Called with the number of runs done after each chunk.
 
+    Returns
+    -------
+    TargetTrackingResult
+        RMSE per sample, mean weights, chatter and per-interval summary of each filter.
+
     Raises
     ------
     ParameterError
         For unknown filters or fewer than one run.
+
+    References
+    ----------
+    Hallouzi 2008, §2.4.2, Figs 2.4–2.5, (2.64), (2.68); Tables 2.2–2.3 (dual CMF, augmented EKF).
+
+    Examples
+    --------
+    >>> result = target_tracking_monte_carlo(runs=1, n_samples=160, filters=("imm",))
+    >>> result.mean_weights["imm"].shape, result.cm_weights["imm"].shape
+    ((160, 3), (160, 2))
     """
     filters = tuple(filters)
     bad = set(filters) - {"dual_cmf", "ekf", "imm"}
@@ -273,6 +400,27 @@ def plot_target_tracking(result: TargetTrackingResult, path) -> None:
     """Figs 2.4–2.5 style plot (position, velocity and B RMSE, mean left-turn weight) to ``path`` (Agg).
 
     ``path`` is written atomically (:func:`fdikit.plots.save_figure`); a binary file object also works.
+
+    Parameters
+    ----------
+    result : TargetTrackingResult
+        From :func:`target_tracking_monte_carlo`.
+    path : str, PathLike or binary file object
+        Where the PNG goes.
+
+    References
+    ----------
+    Hallouzi 2008, §2.4.2, Figs 2.4–2.5.
+
+    Examples
+    --------
+    Drawing the four panels takes over a second, so it is not run here:
+
+    >>> import io
+    >>> buffer = io.BytesIO()
+    >>> plot_target_tracking(target_tracking_monte_carlo(runs=1, n_samples=160), buffer)  # doctest: +SKIP
+    >>> buffer.getvalue()[1:4]  # doctest: +SKIP
+    b'PNG'
     """
     import matplotlib.pyplot as plt
 
