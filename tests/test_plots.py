@@ -205,3 +205,34 @@ def test_importing_fdikit_and_the_result_modules_does_not_import_matplotlib():
             "print('matplotlib' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip()
     assert out == "False"
+
+
+def _gain_table():
+    from fdikit.analysis.gains import GainTable
+
+    gains = np.array([[[1.0, 1e-3], [1e-4, 2.0]], [[0.5, 1e-3], [1e-4, 1.0]]])
+    return GainTable(np.array([0.1, 1.0]), gains, ("f1", "f2"), ("g1", "g2"), (("r1",), ("r2",)))
+
+
+def test_gain_table_plot_draws_into_the_given_axes(tmp_path):
+    table = _gain_table()
+    backend = matplotlib.get_backend()
+    fig, ax = plt.subplots()
+    n_figs = plt.get_fignums()
+    assert table.plot(ax=ax) is ax
+    assert plt.get_fignums() == n_figs and len(ax.images) == 1
+    assert [t.get_text() for t in ax.texts] == ["0", "-60", "-80", "6"]  # peak gains in dB
+    assert [t.get_text() for t in ax.get_yticklabels()] == ["f1", "f2"]
+    assert table.plot(tmp_path / "s.png", ax=ax) is ax  # the caller's figure is written, and left open
+    assert (tmp_path / "s.png").read_bytes()[:4] == b"\x89PNG" and plt.fignum_exists(fig.number)
+    assert matplotlib.get_backend() == backend
+
+
+def test_gain_table_plot_without_ax_makes_a_figure_outside_pyplot(tmp_path):
+    from matplotlib.figure import Figure
+
+    n_figs = plt.get_fignums()
+    fig = _gain_table().plot(tmp_path / "s.svg")
+    assert isinstance(fig, Figure) and plt.get_fignums() == n_figs  # its own Agg canvas, not a pyplot figure
+    assert (tmp_path / "s.svg").read_bytes().lstrip().startswith(b"<?xml")
+    assert list(tmp_path.iterdir()) == [tmp_path / "s.svg"]  # written atomically: no temporary file left
