@@ -54,7 +54,7 @@ class Comparison:
     >>> comp = compare_evaluators(evaluators, [(truth, res)])
     >>> comp.table["detection rate"].to_dict(), len(comp.scores["cusum"])
     ({'threshold': 0.0, 'cusum': 1.0}, 1)
-    >>> comp.to_markdown().splitlines()[0][:36]
+    >>> comp.to_markdown().splitlines()[0][:37]
     '| evaluator | runs | detection rate |'
     """
 
