@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import solve_discrete_are
 
-from fdikit.errors import ModelError
+from fdikit.errors import ParameterError
 from fdikit.faults import NO_FAULT
 from fdikit.multimodel.convex import ConvexModelSet, convex_model_set, dual_convex_filter
 from fdikit.multimodel.convex_ekf import augmented_ekf
@@ -86,8 +86,22 @@ _FILTERS = ("dual_cmf", "ekf", "imm")
 def b747_convex_set(a35: str = "corrected") -> ConvexModelSet:
     """The five models of Table 2.5 as a convex model set with ``Q``, ``R`` of §2.4.1 (ZOH, ``T_s = 0.01``).
 
-    Example
+    Parameters
+    ----------
+    a35 : {"corrected", "printed"}, default "corrected"
+        ``A(3, 5)`` of the model (:func:`~fdikit.plants.b747.b747_longitudinal`).
+
+    Returns
     -------
+    ConvexModelSet
+        Five local models named as :data:`~fdikit.plants.b747.B747_MODEL_NAMES`, A (5, 5), B (5, 6), C (4, 5).
+
+    References
+    ----------
+    Hallouzi 2008, §2.4.1, Table 2.5.
+
+    Examples
+    --------
     >>> ms = b747_convex_set()
     >>> ms.N, ms.varying
     (5, (False, True, True, False))
@@ -101,8 +115,22 @@ def b747_convex_set(a35: str = "corrected") -> ConvexModelSet:
 def b747_lq_gain(a35: str = "corrected") -> np.ndarray:
     """Discrete LQ gain ``K`` (6 x 5), ``u = −K x``, on the nominal ZOH model (substitute weights, module docstring).
 
-    Example
+    Parameters
+    ----------
+    a35 : {"corrected", "printed"}, default "corrected"
+        ``A(3, 5)`` of the model.
+
+    Returns
     -------
+    numpy.ndarray
+        (6, 5) gain ``K``.
+
+    References
+    ----------
+    Hallouzi 2008, §2.4.1 (LQ state feedback; the weights are fdikit's).
+
+    Examples
+    --------
     >>> K = b747_lq_gain()
     >>> ms = b747_convex_set()
     >>> bool(np.max(np.abs(np.linalg.eigvals(ms.A[0] - ms.B[0] @ K))) < 1)
@@ -118,14 +146,35 @@ def b747_lq_gain(a35: str = "corrected") -> np.ndarray:
 def b747_weight_profile(n_samples: int = N_SAMPLES) -> tuple[np.ndarray, np.ndarray]:
     """True convex weights (K, 5) and fault labels (K,) of Table 2.6 (Hallouzi 2008, §2.4.1).
 
-    Example
+    Parameters
+    ----------
+    n_samples : int, default N_SAMPLES (1000)
+        Number of samples K.
+
+    Returns
     -------
+    mu : (K, 5) array
+        True convex weights over the five models.
+    labels : (K,) array of str
+        The faulty model's name in each fault interval, ``"none"`` elsewhere.
+
+    Raises
+    ------
+    ParameterError
+        If ``n_samples < 1``.
+
+    References
+    ----------
+    Hallouzi 2008, §2.4.1, Table 2.6.
+
+    Examples
+    --------
     >>> mu, lab = b747_weight_profile()
     >>> mu[[0, 250, 450, 650, 850]].tolist()[1:3], str(lab[650])
     ([[0.7, 0.0, 0.0, 0.0, 0.3], [0.6, 0.0, 0.4, 0.0, 0.0]], 'delta_c_loss')
     """
     if n_samples < 1:
-        raise ModelError(f"n_samples must be positive, got {n_samples}")
+        raise ParameterError(f"n_samples must be positive, got {n_samples}")
     mu = np.zeros((n_samples, 5))
     mu[:, 0] = 1.0
     labels = np.full(n_samples, NO_FAULT, dtype=object)
@@ -145,11 +194,45 @@ def b747_trace(seed=None, n_samples: int = N_SAMPLES, *, a35: str = "corrected",
     ``seed`` is an int or a ``numpy.random.Generator``.  ``input_std`` overrides the 6 control-noise std's;
     ``input_tau`` [s] makes the control noise first-order low-pass (``e_k = a e_{k−1} + √(1−a²) σ n_k``,
     ``a = exp(−T_s/τ)``, same variance; default 0.5 s); ``None`` makes it white.
+
+    Parameters
+    ----------
+    seed : int or numpy.random.Generator, optional
+        Source of the control, process and measurement noise.
+    n_samples : int, default N_SAMPLES (1000)
+        Number of samples.
+    a35 : {"corrected", "printed"}, default "corrected"
+        ``A(3, 5)`` of the model.
+    input_std : array_like, optional
+        The 6 control-noise standard deviations (δ_c, δ_s [rad], four thrusts [N]); default 2, 2, 10³ × 4.
+    input_tau : float or None, default 0.5
+        Time constant [s] of the low-pass control noise; ``None`` for white noise.
+
+    Returns
+    -------
+    Trace
+        Controls ``delta_c, delta_s, T_n1 … T_n4``; outputs ``q_meas, V_TAS_meas, alpha_meas, h_meas``;
+        the 5 true states; fault labels of :func:`b747_weight_profile`; ``meta["a35"]``.
+
+    Raises
+    ------
+    ParameterError
+        If ``input_std`` is not 6 non-negative values or ``input_tau`` is not positive.
+
+    References
+    ----------
+    Hallouzi 2008, §2.4.1, (2.54)–(2.55), Table 2.6.
+
+    Examples
+    --------
+    >>> tr = b747_trace(0, n_samples=50)
+    >>> tr.y.shape, tr.outputs[2], str(tr.fault[-1])
+    ((50, 4), 'alpha_meas', 'none')
     """
     rng = np.random.default_rng(seed)
     sig = _INPUT_STD if input_std is None else np.asarray(input_std, dtype=float).ravel()
     if sig.shape != (6,) or np.any(sig < 0):
-        raise ModelError(f"input_std must be 6 non-negative standard deviations (δ_c, δ_s, 4 thrusts), got {sig}")
+        raise ParameterError(f"input_std must be 6 non-negative standard deviations (δ_c, δ_s, 4 thrusts), got {sig}")
     ms = b747_convex_set(a35)
     K = b747_lq_gain(a35)
     mu, labels = b747_weight_profile(n_samples)
@@ -158,7 +241,7 @@ def b747_trace(seed=None, n_samples: int = N_SAMPLES, *, a35: str = "corrected",
     e = rng.standard_normal((n_samples, 6)) * sig
     if input_tau is not None:
         if not input_tau > 0:
-            raise ModelError(f"input_tau must be a positive time constant in seconds, got {input_tau}")
+            raise ParameterError(f"input_tau must be a positive time constant in seconds, got {input_tau}")
         a = np.exp(-TS / input_tau)
         for k in range(1, n_samples):
             e[k] = a * e[k - 1] + np.sqrt(1 - a * a) * e[k]
@@ -183,6 +266,25 @@ def b747_snr(trace: Trace) -> np.ndarray:
     """SNR [dB] of the four measurements by the §2.4.1 definition ``20 log10(rms(ȳ)/rms(ỹ))``.
 
     The noise-free part ``ȳ`` is taken as ``C_μk x_k`` with the true states of the trace.
+
+    Parameters
+    ----------
+    trace : Trace
+        A run of :func:`b747_trace`.
+
+    Returns
+    -------
+    numpy.ndarray
+        (4,) SNR [dB] of ``q, V_TAS, alpha, h``.
+
+    References
+    ----------
+    Hallouzi 2008, §2.4.1 (the SNR definition).
+
+    Examples
+    --------
+    >>> b747_snr(b747_trace(0, n_samples=50)).shape
+    (4,)
     """
     mu, _ = b747_weight_profile(trace.t.size)
     ms = b747_convex_set(trace.meta.get("a35", "corrected"))
@@ -197,12 +299,34 @@ class B747MonteCarloResult:
 
     Attributes
     ----------
-    t : (K,) sample times.  filters : filter names (``"dual_cmf"``, ``"ekf"``, ``"imm"``).
-    rmse_state : filter → (K,) RMSE (2.64) per sample over the runs of the full state (unitless sum).
-    rmse_weights : filter → (K,) RMSE per sample of the weight vector (IMM: mode probabilities).
-    mean_weights : filter → (K, 5) weights averaged over the runs.
-    summary : filter → interval → {"state", "weights"}: mean of the per-sample RMSE over the interval.
-    true_weights : (K, 5).  runs, seed : the Monte-Carlo settings.
+    t : (K,) array
+        Sample times [s].
+    filters : tuple of str
+        Filter names (``"dual_cmf"``, ``"ekf"``, ``"imm"``).
+    rmse_state : dict of str to (K,) array
+        Filter → RMSE (2.64) per sample over the runs of the full state (unitless sum).
+    rmse_weights : dict of str to (K,) array
+        Filter → RMSE per sample of the weight vector (IMM: mode probabilities).
+    mean_weights : dict of str to (K, 5) array
+        Filter → weights averaged over the runs.
+    summary : dict
+        Filter → interval of :data:`INTERVALS` → {"state", "weights"}: mean of the per-sample RMSE over the interval.
+    true_weights : (K, 5) array
+        True convex weights (:func:`b747_weight_profile`).
+    runs : int
+        Number of Monte-Carlo runs.
+    seed : int or None
+        Master seed.
+
+    References
+    ----------
+    Hallouzi 2008, §2.4.1, Figs 2.2–2.3, (2.64).
+
+    Examples
+    --------
+    >>> result = b747_monte_carlo(runs=1, n_samples=50, filters=("ekf",))
+    >>> result.rmse_state["ekf"].shape, result.true_weights.shape
+    ((50,), (50, 5))
     """
 
     t: np.ndarray
@@ -223,24 +347,57 @@ def b747_monte_carlo(runs: int = 100, seed: int | None = 0, *, lam: float = 0.85
 
     Parameters
     ----------
-    runs : number of runs (thesis: 100).  seed : master seed (runs use ``SeedSequence(seed).spawn``).
-    lam : dual-CMF forgetting factor (thesis 0.85).  q_mu : EKF ``Q^μ = q_mu I_5`` (thesis 1e-2).
-    prior_std : the corrected dual CMF's weight prior (:func:`~fdikit.multimodel.convex.dual_convex_filter`;
+    runs : int, default 100
+        Number of runs (thesis: 100).
+    seed : int or None, default 0
+        Master seed (runs use ``SeedSequence(seed).spawn``).
+    lam : float, default 0.85
+        Dual-CMF forgetting factor (thesis 0.85).
+    q_mu : float, default 1e-2
+        EKF ``Q^μ = q_mu I_5`` (thesis 1e-2).
+    prior_std : float or None, default 0.3
+        The corrected dual CMF's weight prior (:func:`~fdikit.multimodel.convex.dual_convex_filter`;
         not in the thesis).  At the start the states are near zero and the sensor-fault models cannot be
         told from the nominal one; without a prior the weights wander there (weight RMSE 0.93 in [0, 199]
         over 10 runs, against 0.14 with σ = 0.3).
-    ekf_projection : the augmented EKF's weight projection (:func:`~fdikit.multimodel.convex_ekf.augmented_ekf`).
+    ekf_projection : str, default "covariance"
+        The augmented EKF's weight projection (:func:`~fdikit.multimodel.convex_ekf.augmented_ekf`).
         With the thesis's Euclidean projection that leaves P unchanged, the EKF keeps variance along ``1ᵀμ``,
         which the common altitude row of C couples to h, and its altitude estimate drifts (full-state RMSE up to
         20 by the end of 1000 samples, 20 runs); ``"covariance"`` (Simon & Chia, W = P⁻¹) keeps it at 0.02–0.13.
-    filters : subset of ``("dual_cmf", "ekf", "imm")``.  The IMM uses Π of (2.63) and ``Q``, ``R`` of §2.4.1.
+    filters : sequence of str, default ("dual_cmf", "ekf", "imm")
+        Subset of ``("dual_cmf", "ekf", "imm")``.  The IMM uses Π of (2.63) and ``Q``, ``R`` of §2.4.1.
+    n_samples : int, default N_SAMPLES (1000)
+        Samples per run; intervals of :data:`INTERVALS` beyond the run are left out of ``summary``.
+    a35 : {"corrected", "printed"}, default "corrected"
+        ``A(3, 5)`` of the B747 model (:func:`~fdikit.plants.b747.b747_longitudinal`).
+
+    Returns
+    -------
+    B747MonteCarloResult
+        RMSE per sample of states and weights, mean weights and the per-interval summary of each filter.
+
+    Raises
+    ------
+    ParameterError
+        For unknown filters or fewer than one run.
+
+    References
+    ----------
+    Hallouzi 2008, §2.4.1, Figs 2.2–2.3, (2.63)–(2.64); Tables 2.2–2.3 (dual CMF, augmented EKF).
+
+    Examples
+    --------
+    >>> result = b747_monte_carlo(runs=1, n_samples=50, filters=("ekf",))
+    >>> result.filters, result.mean_weights["ekf"].shape
+    (('ekf',), (50, 5))
     """
     filters = tuple(filters)
     bad = set(filters) - set(_FILTERS)
     if bad or not filters:
-        raise ModelError(f"unknown filters {sorted(bad)}; choose from 'dual_cmf', 'ekf', 'imm'")
+        raise ParameterError(f"unknown filters {sorted(bad)}; choose from 'dual_cmf', 'ekf', 'imm'")
     if runs < 1:
-        raise ModelError(f"runs must be at least 1, got {runs}")
+        raise ParameterError(f"runs must be at least 1, got {runs}")
     ms = b747_convex_set(a35)
     mu_true, _ = b747_weight_profile(n_samples)
     mu_nom = np.eye(5)[0]
