@@ -397,14 +397,14 @@ class ConvexFilterResult:
     --------
     >>> ms = convex_model_set([[0.9]], [[[0.0]], [[1.0]]], [[1.0]], Q=[[1e-4]], R=[[1e-2]],
     ...                       names=["stuck", "nominal"])
-    >>> u = np.sin(0.3 * np.arange(20)).reshape(-1, 1)
+    >>> u = np.sin(0.3 * np.arange(12)).reshape(-1, 1)
     >>> x, y = 0.0, []
     >>> for uk in u[:, 0]:                      # the "nominal" model, noise-free
     ...     y.append([x])
     ...     x = 0.9 * x + uk
     >>> res = dual_convex_filter(ms, np.array(y), u, x0=[0.0], P0=[[1.0]])
     >>> res.x.shape, res.P.shape, res.mu.shape, res.names
-    ((20, 1), (20, 1, 1), (20, 2), ('stuck', 'nominal'))
+    ((12, 1), (12, 1, 1), (12, 2), ('stuck', 'nominal'))
 
     References
     ----------
@@ -611,7 +611,7 @@ def dual_convex_filter(models: ConvexModelSet, y, u, x0, P0, mu0=None, lam: floa
     --------
     >>> ms = convex_model_set([[0.9]], [[[0.0]], [[1.0]]], [[1.0]], Q=[[1e-4]], R=[[1e-2]],
     ...                       names=["stuck", "nominal"])
-    >>> u = np.sin(0.3 * np.arange(20)).reshape(-1, 1)
+    >>> u = np.sin(0.3 * np.arange(12)).reshape(-1, 1)
     >>> x, y = 0.0, []
     >>> for uk in u[:, 0]:                      # the "nominal" model, noise-free
     ...     y.append([x])
