@@ -76,13 +76,31 @@ class GainTable:
 
     Attributes
     ----------
-    omega : (N,) frequencies, rad/s.
-    gains : (N, q_f, q_g) largest singular value of the transfer from fault ``faults[j]`` to the
+    omega : (N,) ndarray
+        Frequencies [rad/s].
+    gains : (N, q_f, q_g) ndarray
+        ``gains[k, j, g]``: largest singular value of the transfer from fault ``faults[j]`` to the
         residuals of group ``groups[g]`` at ``omega[k]``.
-    faults : fault names (rows of the map).
-    groups : residual-group names (columns): the fault a group isolates, or the residual's own name.
-    members : the residual names of each group.
-    dt : sample time of the internal form (None: continuous).
+    faults : tuple of str
+        Fault names (rows of the map).
+    groups : tuple of str
+        Residual-group names (columns): the fault a group isolates, or the residual's own name.
+    members : tuple of tuple of str
+        The residual names of each group.
+    dt : float or None
+        Sample time of the internal form [s] (None: continuous).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit import FaultModel
+    >>> from fdikit.design import observer_generator
+    >>> m = FaultModel(A=np.diag([-1.0, -2.0]), C=np.eye(2), Bu=np.eye(2), outputs=["y0", "y1"],
+    ...                controls=["u0", "u1"]).with_actuator_faults(["u0", "u1"])
+    >>> gen = observer_generator(m, np.diag([4.0, 5.0]))  # residual poles −5, −7
+    >>> table = fault_to_residual_gain(gen, m, [0.0, 1.0])
+    >>> table.faults, table.groups, np.round(table.peak(), 6).tolist()
+    (('u0_actuator', 'u1_actuator'), ('y0', 'y1'), [[0.2, 0.0], [0.0, 0.142857]])
     """
 
     omega: np.ndarray
@@ -218,7 +236,26 @@ def _check_omega(omega, dt: float | None) -> np.ndarray:
 
 
 def default_freqs(dt: float | None, num: int = 200) -> np.ndarray:
-    """Default grid: ``logspace(-2, 3)`` rad/s, capped at ``0.999 π/dt`` in discrete time."""
+    """Default grid: ``logspace(-2, 3)`` rad/s, capped at ``0.999 π/dt`` in discrete time.
+
+    Parameters
+    ----------
+    dt : float or None
+        Sample time [s] of a discrete internal form; None for continuous time.
+    num : int, default 200
+        Number of frequencies.
+
+    Returns
+    -------
+    (num,) ndarray
+        Log-spaced frequencies [rad/s] from ``1e-2`` to ``1e3`` (or ``0.999 π/dt`` when lower).
+
+    Examples
+    --------
+    >>> from fdikit.analysis.gains import default_freqs
+    >>> default_freqs(None, 3).round(6).tolist(), round(float(default_freqs(0.1, 5)[-1]), 6)
+    ([0.01, 3.162278, 1000.0], 31.384511)
+    """
     num = validate.integer("num", num, minimum=1)
     if dt is not None:
         dt = validate.positive("dt", dt)
@@ -239,16 +276,46 @@ def fault_to_residual_gain(
     ``z = e^{jω dt}`` (discrete) by :meth:`FaultModel.freqresp`.  For fault ``j`` and residual
     group ``g`` the entry is ``σ_max(R_f(z)[rows of g, columns of j])``.
 
+    Residual groups: the residuals tied to the same fault by ``generator.isolates`` form one group
+    named after that fault; a residual with ``isolates`` None is a group of its own, named after it.
+
     Parameters
     ----------
-    generator, model : the residual generator and the fault model it runs on.
-    freqs : frequencies in rad/s (``<= π/dt`` for a discrete internal form).
-    faults : the fault inputs of the model to show (default: all), by fault name (a bare signal name
+    generator : ResidualGenerator
+        The residual generator (a design's ``.generator``).
+    model : FaultModel
+        The fault model it runs on.
+    freqs : array_like
+        Frequencies [rad/s], non-negative (``<= π/dt`` for a discrete internal form).
+    faults : sequence of str or mapping, optional
+        The fault inputs of the model to show (default: all), by fault name (a bare signal name
         raises :class:`~fdikit.errors.ParameterError`), or a mapping ``label -> [fault names]`` that
         treats several fault inputs as one multi-dimensional fault.
 
-    Residual groups: the residuals tied to the same fault by ``generator.isolates`` form one group
-    named after that fault; a residual with ``isolates`` None is a group of its own, named after it.
+    Returns
+    -------
+    GainTable
+        The gains ``(len(freqs), faults, groups)`` with the fault, group and member names.
+
+    Raises
+    ------
+    ParameterError
+        When ``generator`` or ``model`` is of the wrong type, ``freqs`` is empty, negative, not finite or above
+        Nyquist, or a fault name is unknown or a bare signal name.
+    ModelError
+        When the model has no faults.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit import FaultModel
+    >>> from fdikit.design import observer_generator
+    >>> m = FaultModel(A=np.diag([-1.0, -2.0]), C=np.eye(2), Bu=np.eye(2), outputs=["y0", "y1"],
+    ...                controls=["u0", "u1"]).with_actuator_faults(["u0", "u1"])
+    >>> gen = observer_generator(m, np.diag([4.0, 5.0]))  # residual poles −5, −7
+    >>> table = fault_to_residual_gain(gen, m, [0.0, 1.0])  # 1/|jω + 5| and 1/|jω + 7| on the diagonal
+    >>> table.gains.shape, np.round(table.gains[:, 0, 0], 6).tolist()
+    ((2, 2, 2), [0.2, 0.196116])
     """
     validate.instance("generator", generator, ResidualGenerator, "pass a design's .generator")
     validate.instance("model", model, FaultModel)
@@ -284,6 +351,42 @@ def structure_matrix(
     response.  ``atol`` (default ``1e-10 ·`` the largest entry of the table) keeps a group that
     responds to nothing (a column of round-off) all False.  ``freqs`` defaults to
     :func:`default_freqs` (``1e-2 … 1e3`` rad/s, capped below Nyquist).
+
+    Parameters
+    ----------
+    generator : ResidualGenerator
+        The residual generator.
+    model : FaultModel
+        The fault model it runs on.
+    freqs : array_like, optional
+        Frequencies [rad/s]; default :func:`default_freqs` for the generator's (else the model's) ``dt``.
+    rtol : float, default 1e-6
+        Relative threshold per residual group, ``>= 0``.
+    faults : sequence of str or mapping, optional
+        The faults (rows), as for :func:`fault_to_residual_gain`.
+    atol : float, optional
+        Absolute floor on the gain, ``>= 0``; default ``1e-10`` times the largest entry.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Booleans, index ``fault`` (the fault names), columns ``residual`` (the residual groups).
+
+    Raises
+    ------
+    ParameterError
+        When ``rtol`` or ``atol`` is negative, or for the arguments :func:`fault_to_residual_gain` refuses.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit import FaultModel
+    >>> from fdikit.design import observer_generator
+    >>> m = FaultModel(A=np.diag([-1.0, -2.0]), C=np.eye(2), Bu=np.eye(2), outputs=["y0", "y1"],
+    ...                controls=["u0", "u1"]).with_actuator_faults(["u0", "u1"])
+    >>> gen = observer_generator(m, np.diag([4.0, 5.0]))  # residual poles −5, −7
+    >>> structure_matrix(gen, m).to_numpy().tolist()
+    [[True, False], [False, True]]
     """
     import pandas as pd
 
