@@ -301,9 +301,9 @@ def fault_to_residual_gain(
     ------
     ParameterError
         When ``generator`` or ``model`` is of the wrong type, ``freqs`` is empty, negative, not finite or above
-        Nyquist, or a fault name is unknown or a bare signal name.
+        Nyquist, or a fault is given by a bare signal name.
     ModelError
-        When the model has no faults.
+        When the model has no faults, or a fault name is not one of its fault inputs.
 
     Examples
     --------
