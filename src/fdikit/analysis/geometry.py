@@ -32,7 +32,38 @@ __all__ = ["FaultGeometry", "FdiReport", "fdi_report"]
 
 @dataclass(frozen=True, eq=False)
 class FaultGeometry:
-    """Geometry of one fault: map ``F`` (n x k), ``dim W*``, ``ν = dim T*``, ``dim C T*``, invariant zeros."""
+    """Geometry of one fault: map ``F`` (n x k), ``dim W*``, ``ν = dim T*``, ``dim C T*``, invariant zeros.
+
+    Attributes
+    ----------
+    name : str
+        The fault's name as given.
+    kind : str
+        Where the map comes from: ``'sensor'``, ``'sensor:magnitude'``, ``'sensor:rate'``, ``'actuator'``,
+        ``'fault input'`` (a ``Bf`` column) or ``'matrix'`` (given explicitly).
+    F : (n, k) ndarray
+        The fault map.
+    caisa_dim : int
+        ``dim W*``, the minimal (C, A)-invariant subspace containing ``Im F`` (CAISA, Douglas et al. 1996,
+        Thm. A.1).
+    nu : int
+        ``ν = dim T*``, the dimension of the detection space.
+    output_dim : int
+        ``dim C T*``, the dimension of the fault's output image.
+    zeros : ndarray
+        Invariant zeros of ``(C, A, F)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit import FaultModel
+    >>> from fdikit.analysis.geometry import fdi_report
+    >>> m = FaultModel(A=np.diag([-1.0, -2.0]), C=np.eye(2), Bu=np.eye(2), outputs=["y0", "y1"],
+    ...                controls=["u0", "u1"]).with_actuator_faults(["u0", "u1"])
+    >>> g = fdi_report(m, ["u0_actuator"]).faults[0]
+    >>> g.name, g.kind, g.F.shape, g.nu, g.output_dim, g.zeros.size
+    ('u0_actuator', 'fault input', (2, 1), 1, 1, 0)
+    """
 
     name: str
     kind: str
@@ -49,20 +80,50 @@ class FdiReport:
 
     Attributes
     ----------
-    n, p : states and outputs of the model; ``discrete`` whether it is discrete.
-    faults : per fault, a :class:`FaultGeometry`.
-    output_separable : whether the ``C T_i*`` are independent (Def. A.1, test (a.7)).
-    separation : smallest singular value of the side-by-side orthonormal bases of the ``C T_i*``
+    n, p : int
+        States and outputs of the model.
+    discrete : bool
+        Whether the model is discrete.
+    faults : tuple of FaultGeometry
+        Per fault, a :class:`FaultGeometry`.
+    output_separable : bool
+        Whether the ``C T_i*`` are independent (Def. A.1, test (a.7)).
+    separation : float
+        Smallest singular value of the side-by-side orthonormal bases of the ``C T_i*``
         (1: orthogonal images, 0: dependent) -- how robust output separability is.
-    inseparable_pairs : pairs of fault names whose output images intersect.
-    dependent_sets : minimal sets of three or more faults whose images are dependent although no
+    inseparable_pairs : tuple of (str, str)
+        Pairs of fault names whose output images intersect.
+    dependent_sets : tuple of tuple of str
+        Minimal sets of three or more faults whose images are dependent although no
         pair of them is (found only when separability fails without an inseparable pair).
-    mutually_detectable : zeros of ``(C, A, [F_1 … F_q])`` equal the union of the zeros of each
+    mutually_detectable : bool or None
+        Zeros of ``(C, A, [F_1 … F_q])`` equal the union of the zeros of each
         ``(C, A, F_i)``; None when undefined: the joint system is not left invertible (its
         Rosenbrock pencil loses column rank at every ``s``, e.g. output-inseparable faults), so it
-        has no well-defined zeros.  ``joint_zeros``, ``extra_zeros`` (joint but of no single fault)
-        and ``lost_zeros`` (of a single fault but not joint; only possible in the undefined case).
-    advice : what to change, one sentence each.
+        has no well-defined zeros.
+    joint_zeros : ndarray
+        Invariant zeros of the joint system ``(C, A, [F_1 … F_q])``.
+    extra_zeros : ndarray
+        Zeros of the joint system but of no single fault.
+    lost_zeros : ndarray
+        Zeros of a single fault but not of the joint system (only possible in the undefined case).
+    advice : tuple of str
+        What to change, one sentence each (empty when nothing needs changing).
+    nu_total : int
+        ``Σ ν_i``.
+    nu_0 : int
+        ``n − Σν``, the dimension left for the complementary space (negative: too many faults for one filter).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit import FaultModel
+    >>> from fdikit.analysis.geometry import fdi_report
+    >>> m = FaultModel(A=np.diag([-1.0, -2.0]), C=np.eye(2), Bu=np.eye(2), outputs=["y0", "y1"],
+    ...                controls=["u0", "u1"]).with_actuator_faults(["u0", "u1"])
+    >>> rep = fdi_report(m, {"a": [1.0, 1.0], "b": [1.0, 1.0]})  # the same direction twice
+    >>> rep.output_separable, rep.inseparable_pairs, rep.mutually_detectable, len(rep.advice)
+    (False, (('a', 'b'),), None, 2)
     """
 
     n: int
@@ -192,22 +253,54 @@ def fdi_report(
 ) -> FdiReport:
     """Detection and isolation geometry of a candidate fault set for one detection filter.
 
+    For each fault: ``dim W*`` (:func:`linalg.caisa`), ``ν = dim T*`` (:func:`linalg.detection_space`),
+    ``dim C T*`` and the invariant zeros of ``(C, A, F)``.  For the set: output separability
+    (:func:`linalg.output_separable`), mutual detectability (:func:`linalg.mutually_detectable`)
+    and ``Σν`` against ``n`` (Douglas et al. 1996, §4.1; App. A).
+
     Parameters
     ----------
-    model : FaultModel (its ``A`` and ``C``; continuous or discrete).
-    targets : the candidate faults of the filter: fault names (resolved by :func:`resolve_fault`:
+    model : FaultModel
+        The model (its ``A`` and ``C``; continuous or discrete).
+    targets : str, sequence of str or mapping
+        The candidate faults of the filter: fault names (resolved by :func:`resolve_fault`:
         ``'<output>_sensor'`` is the 2-D sensor fault ``[F¹, A F¹]``, ``'<output>_sensor:magnitude'``
         only ``A F¹`` -- the bias assumption -- and ``'<output>_sensor:rate'`` only ``F¹``;
         ``'<control>_actuator'`` is the actuator column of ``Bu``; a fault input of the model its
         ``Bf`` column; a bare signal name raises :class:`~fdikit.errors.ParameterError`), or a
         mapping ``name -> F`` of explicit n x k maps.
-    rtol : relative rank tolerance of the subspace computations (:mod:`fdikit.linalg` default).
-    ztol : tolerance for matching zeros, relative to ``max(‖A‖₂, 1)``.
+    rtol : float, optional
+        Relative rank tolerance of the subspace computations (:mod:`fdikit.linalg` default).
+    ztol : float, default 1e-6
+        Tolerance for matching zeros, relative to ``max(‖A‖₂, 1)``.
 
-    For each fault: ``dim W*`` (:func:`linalg.caisa`), ``ν = dim T*`` (:func:`linalg.detection_space`),
-    ``dim C T*`` and the invariant zeros of ``(C, A, F)``.  For the set: output separability
-    (:func:`linalg.output_separable`), mutual detectability (:func:`linalg.mutually_detectable`)
-    and ``Σν`` against ``n`` (Douglas et al. 1996, §4.1; App. A).
+    Returns
+    -------
+    FdiReport
+        The per-fault geometry, separability, mutual detectability and advice; ``print(report)`` gives the
+        text, ``report.to_pandas()`` the table.
+
+    Raises
+    ------
+    ModelError
+        When an explicit fault map is not a finite ``n x k`` matrix, a fault name is not a fault of the model,
+        or no fault is given.
+    ParameterError
+        When ``model`` is not a :class:`~fdikit.model.FaultModel`, ``rtol`` or ``ztol`` is negative, or a fault
+        is given by a bare signal name.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit import FaultModel
+    >>> from fdikit.analysis.geometry import fdi_report
+    >>> m = FaultModel(A=np.diag([-1.0, -2.0]), C=np.eye(2), Bu=np.eye(2), outputs=["y0", "y1"],
+    ...                controls=["u0", "u1"]).with_actuator_faults(["u0", "u1"])
+    >>> rep = fdi_report(m, ["u0_actuator", "u1_actuator"])
+    >>> [f.nu for f in rep.faults], rep.output_separable, round(rep.separation, 6), rep.mutually_detectable
+    ([1, 1], True, 1.0, True)
+    >>> rep.nu_total, rep.nu_0, rep.advice
+    (2, 0, ())
     """
     validate.instance("model", model, FaultModel)
     if rtol is not None:
