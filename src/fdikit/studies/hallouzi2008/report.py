@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fdikit.plots import save_figure
+from fdikit.plots import axes_or_new, finish_plot
 
 __all__ = ["multiple_model_report", "check_multiple_model_arguments", "plot_b747", "plot_msd", "PARTS"]
 
@@ -31,52 +31,102 @@ def _table(header: list[str], rows: list[list[str]]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _pyplot():
-    import matplotlib.pyplot as plt  # the backend is the caller's (Agg when there is no display)
+def plot_b747(result, path=None, axes=None):
+    """Fig. 2.3 style: weight and state RMSE per sample of the three filters, fault intervals shaded.
 
-    return plt
+    Parameters
+    ----------
+    result : B747MonteCarloResult
+        From :func:`fdikit.studies.hallouzi2008.b747.b747_monte_carlo`.
+    path : str, Path or binary file object, optional
+        Write the figure there (atomically, :func:`fdikit.plots.save_figure`).
+    axes : sequence of two matplotlib Axes, optional
+        The weight-RMSE and state-RMSE panels; default a new figure.
 
+    Returns
+    -------
+    matplotlib.figure.Figure or the given ``axes``
+        A new figure (closed once written to ``path``) when ``axes`` is None, else ``axes``.
 
-def plot_b747(result, path) -> None:
-    """Fig. 2.3 style: weight and state RMSE per sample of the three filters, fault intervals shaded."""
+    References
+    ----------
+    Hallouzi 2008, §2.4.1, Fig. 2.3, Table 2.6.
+
+    Examples
+    --------
+    The plot needs a full 1000-sample Monte Carlo (the fault intervals of Table 2.6) and matplotlib, so
+    it is not run here:
+
+    >>> from fdikit.studies.hallouzi2008.b747 import b747_monte_carlo
+    >>> fig = plot_b747(b747_monte_carlo(runs=1, filters=("ekf",)))  # doctest: +SKIP
+    >>> len(fig.axes)  # doctest: +SKIP
+    2
+    """
     from fdikit.studies.hallouzi2008.b747 import FAULT_INTERVALS, INTERVALS
 
-    plt = _pyplot()
-    fig, axes = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
+    fig, panels = axes_or_new(axes, 2, figsize=(8, 6), sharex=True)
     for f in result.filters:
-        axes[0].plot(result.t, result.rmse_weights[f], label=f, lw=1)
-        axes[1].semilogy(result.t, result.rmse_state[f], label=f, lw=1)
-    axes[0].set_ylabel("weight RMSE")
-    axes[1].set_ylabel("state RMSE")
-    axes[1].set_xlabel("t [s]")
-    for ax in axes:
+        panels[0].plot(result.t, result.rmse_weights[f], label=f, lw=1)
+        panels[1].semilogy(result.t, result.rmse_state[f], label=f, lw=1)
+    panels[0].set_ylabel("weight RMSE")
+    panels[1].set_ylabel("state RMSE")
+    panels[1].set_xlabel("t [s]")
+    for ax in panels:
         for name in FAULT_INTERVALS:
             a, b = INTERVALS[name]
             ax.axvspan(result.t[a], result.t[b], color="0.9")
         ax.legend(fontsize=7)
-    axes[0].set_title(f"Hallouzi 2008 §2.4.1 (substitute B), {result.runs} Monte-Carlo runs")
-    fig.tight_layout()
-    save_figure(fig, path, dpi=120)
-    plt.close(fig)
+    panels[0].set_title(f"Hallouzi 2008 §2.4.1 (substitute B), {result.runs} Monte-Carlo runs")
+    return finish_plot(fig, axes, path)
 
 
-def plot_msd(sim, runs: dict, path) -> None:
-    """Figs 3.7–3.11 style: k1, m3, f1, f2 reconstructed by the OD, CP and LV sets against the truth."""
-    plt = _pyplot()
-    fig, axes = plt.subplots(4, 1, figsize=(8, 9), sharex=True)
+def plot_msd(sim, runs: dict, path=None, axes=None):
+    """Figs 3.7–3.11 style: k1, m3, f1, f2 reconstructed by the OD, CP and LV sets against the truth.
+
+    Parameters
+    ----------
+    sim : MSDSimulation
+        From :func:`fdikit.studies.hallouzi2008.msd.simulate_msd` (the true parameters).
+    runs : dict
+        Model-set key → run with ``params`` (N, 4), e.g.
+        :func:`fdikit.studies.hallouzi2008.msd_model_sets.msd_table_3_3`.
+    path : str, Path or binary file object, optional
+        Write the figure there (atomically, :func:`fdikit.plots.save_figure`).
+    axes : sequence of four matplotlib Axes, optional
+        The k1, m3, f1 and f2 panels; default a new figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure or the given ``axes``
+        A new figure (closed once written to ``path``) when ``axes`` is None, else ``axes``.
+
+    References
+    ----------
+    Hallouzi 2008, §3.6.2, Figs 3.7–3.11.
+
+    Examples
+    --------
+    Not run here (matplotlib):
+
+    >>> from fdikit.studies.hallouzi2008.msd import simulate_msd
+    >>> from fdikit.studies.hallouzi2008.msd_model_sets import run_msd_model_set
+    >>> sim = simulate_msd(duration=1.0, dt=0.01)
+    >>> fig = plot_msd(sim, {"lv": run_msd_model_set(sim, "lv")})  # doctest: +SKIP
+    >>> len(fig.axes)  # doctest: +SKIP
+    4
+    """
+    fig, panels = axes_or_new(axes, 4, figsize=(8, 9), sharex=True)
     limits = ((0.0, 2.0), (0.0, 2.2), (-0.1, 1.3), (-0.1, 1.3))  # a blend near 1/m3 = 0 sends m3 off the chart
-    for j, (ax, name) in enumerate(zip(axes, ("k1", "m3", "f1", "f2"))):
+    for j, (ax, name) in enumerate(zip(panels, ("k1", "m3", "f1", "f2"))):
         ax.plot(sim.t, sim.params[:, j], "k--", lw=1, label="true")
         for key, run in runs.items():
             ax.plot(sim.t, run.params[:, j], lw=0.8, label=key.upper())
         ax.set_ylabel(name)
         ax.set_ylim(*limits[j])
         ax.legend(fontsize=7, loc="upper right")
-    axes[-1].set_xlabel("t [s]")
-    axes[0].set_title("Hallouzi 2008 §3.6.2: parameters from the weights (augmented EKF)")
-    fig.tight_layout()
-    save_figure(fig, path, dpi=120)
-    plt.close(fig)
+    panels[-1].set_xlabel("t [s]")
+    panels[0].set_title("Hallouzi 2008 §3.6.2: parameters from the weights (augmented EKF)")
+    return finish_plot(fig, axes, path)
 
 
 #: The parts of the report, in order: (key, progress label).
@@ -89,12 +139,37 @@ PLOTS = {"item17": "target_tracking.png", "item18": "b747.png", "item20": "msd.p
 def check_multiple_model_arguments(*, runs=100, seed=0, msd_dt=0.01, model_sets=15) -> dict:
     """Validate the arguments of :func:`multiple_model_report` (before any work); return them normalised.
 
+    Parameters
+    ----------
+    runs : int, default 100
+        Monte-Carlo size, >= 1.
+    seed : int, default 0
+        Master seed, >= 0.
+    msd_dt : float, default 0.01
+        MSD sample time [s], in (0, 0.02].
+    model_sets : int, default 15
+        Number of random sets of Example 3.1, >= 1.
+
+    Returns
+    -------
+    dict
+        ``runs``, ``seed``, ``msd_dt``, ``model_sets``, checked.
+
     Raises
     ------
     ParameterError
         Naming the argument: ``runs`` and ``model_sets`` integers >= 1, ``seed`` an integer >= 0,
         ``msd_dt`` finite in (0, 0.02] s (the series ZOH of :func:`fdikit.studies.hallouzi2008.msd.simulate_msd`
         is too coarse above 0.02 s).
+
+    References
+    ----------
+    Hallouzi 2008, §2.4, §3.3.1, §3.6 (the reproductions the arguments size).
+
+    Examples
+    --------
+    >>> check_multiple_model_arguments(runs=3)
+    {'runs': 3, 'seed': 0, 'msd_dt': 0.01, 'model_sets': 15}
     """
     from fdikit.resume import check_count, check_positive, check_seed
 
@@ -126,6 +201,11 @@ def multiple_model_report(out, *, runs: int = 100, seed: int = 0, msd_dt: float 
     fresh : bool
         Start over even when ``out`` holds a resumable run (see :class:`fdikit.resume.RunStore`).
 
+    Returns
+    -------
+    pathlib.Path
+        ``out/summary.md``.
+
     Notes
     -----
     Every argument is checked before any work.  Each part (its summary section and its plot) is stored
@@ -138,6 +218,18 @@ def multiple_model_report(out, *, runs: int = 100, seed: int = 0, msd_dt: float 
     ------
     ParameterError
         For a bad argument or an output folder holding a run of other arguments.
+
+    References
+    ----------
+    Hallouzi 2008, §2.4.1–2.4.2, §3.3.1 (Table 3.1), §3.6.2 (Table 3.3), §3.6.4 (Table 3.4).
+
+    Examples
+    --------
+    Even with one Monte-Carlo run the four parts take over a minute, so the call is not run here:
+
+    >>> path = multiple_model_report("out/multiple-model", runs=1, model_sets=1)  # doctest: +SKIP
+    >>> path.name  # doctest: +SKIP
+    'summary.md'
     """
     from fdikit.resume import RunStore
 
