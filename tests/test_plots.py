@@ -236,3 +236,96 @@ def test_gain_table_plot_without_ax_makes_a_figure_outside_pyplot(tmp_path):
     assert isinstance(fig, Figure) and plt.get_fignums() == n_figs  # its own Agg canvas, not a pyplot figure
     assert (tmp_path / "s.svg").read_bytes().lstrip().startswith(b"<?xml")
     assert list(tmp_path.iterdir()) == [tmp_path / "s.svg"]  # written atomically: no temporary file left
+
+
+# ---------------------------------------------------------------- the studies' figures
+def _b747_result():
+    from types import SimpleNamespace
+
+    from fdikit.studies.hallouzi2008.b747 import N_SAMPLES, TS
+
+    t = TS * np.arange(N_SAMPLES)
+    ones = {f: np.linspace(1.0, 2.0, t.size) for f in ("ekf", "imm")}
+    return SimpleNamespace(t=t, filters=("ekf", "imm"), rmse_weights=ones, rmse_state=ones, runs=1)
+
+
+def _msd_inputs():
+    from types import SimpleNamespace
+
+    t = np.arange(50) * 0.1
+    sim = SimpleNamespace(t=t, params=np.ones((50, 4)))
+    return sim, {"od": SimpleNamespace(params=np.ones((50, 4))), "lv": SimpleNamespace(params=np.zeros((50, 4)))}
+
+
+def _target_tracking_result():
+    from types import SimpleNamespace
+
+    from fdikit.studies.hallouzi2008.target_tracking import N_SAMPLES, TS
+
+    t = TS * np.arange(N_SAMPLES)
+    per = {f: np.ones(t.size) for f in ("ekf", "imm")}
+    return SimpleNamespace(t=t, filters=("ekf", "imm"), rmse_position=per, rmse_velocity=per, rmse_B=per,
+                           cm_weights={f: np.full((t.size, 2), 0.5) for f in ("ekf", "imm")},
+                           true_weights=np.full((t.size, 2), 0.5), runs=1)
+
+
+def _bank_panels():
+    from types import SimpleNamespace
+
+    from fdikit.diagnosis import Diagnosis
+
+    t = np.arange(100) * 0.1
+    res = Residuals(t, np.column_stack([np.sin(t), np.cos(t), t]), ("F1:a", "F1:b", "F2:c"), ("a", "b", "c"))
+    fired = np.abs(res.r) > 0.9
+    diag = Diagnosis(t, fired.any(axis=1), fired, res.names, np.where(fired.any(axis=1), "a", "none"))
+    band = SimpleNamespace(center=np.zeros(3), thresholds=np.full(3, 0.9))
+    return [("one", res, diag, ["F1:a", "F1:b"]), ("two", res, diag, ["F2:c"])], band
+
+
+def _study_plots():
+    from fdikit.studies.hallouzi2008.report import plot_b747, plot_msd
+    from fdikit.studies.hallouzi2008.target_tracking import plot_target_tracking
+    from fdikit.studies.path1996.demo import plot_bank_report
+
+    panels, band = _bank_panels()
+    # name: (draw(path=, axes=), the axes layout it needs, lines per panel)
+    return {
+        "b747": (lambda **kw: plot_b747(_b747_result(), **kw), (2, 1), [2, 2]),
+        "msd": (lambda **kw: plot_msd(*_msd_inputs(), **kw), (4, 1), [3] * 4),
+        "target_tracking": (lambda **kw: plot_target_tracking(_target_tracking_result(), **kw), (4, 1),
+                            [2, 2, 2, 3]),
+        # per residual: the series, two threshold lines, the fired samples and the onset; unused panel empty
+        "bank_report": (lambda **kw: plot_bank_report(panels, band, 5.0, **kw), (2, 2), [5, 5, 5, 0]),
+    }
+
+
+@pytest.mark.parametrize("name", ["b747", "msd", "target_tracking", "bank_report"])
+def test_study_figures_draw_into_the_given_axes(name, tmp_path):
+    draw, shape, lines = _study_plots()[name]
+    backend = matplotlib.get_backend()
+    fig, axes = plt.subplots(*shape, squeeze=False)
+    axes = axes if shape[1] > 1 else axes[:, 0]
+    n_figs = plt.get_fignums()
+    assert draw(axes=axes) is axes
+    assert plt.get_fignums() == n_figs  # no new figure
+    assert [len(ax.lines) for ax in np.ravel(axes)] == lines
+    assert draw(axes=axes, path=tmp_path / "f.png") is axes  # the caller's figure is written and left open
+    assert (tmp_path / "f.png").read_bytes()[:4] == b"\x89PNG" and plt.fignum_exists(fig.number)
+    assert matplotlib.get_backend() == backend
+    with pytest.raises(ParameterError, match="panel"):
+        draw(axes=np.ravel(axes)[:-1])
+
+
+@pytest.mark.parametrize("name", ["b747", "msd", "target_tracking", "bank_report"])
+def test_study_figures_without_axes_make_a_figure(name, tmp_path):
+    import io
+
+    draw, shape, _ = _study_plots()[name]
+    n_figs = len(plt.get_fignums())
+    fig = draw()
+    assert len(fig.axes) == shape[0] * shape[1] and len(plt.get_fignums()) == n_figs + 1
+    plt.close(fig)
+    buf = io.BytesIO()
+    fig = draw(path=buf)  # as the report stores its parts: written, then closed
+    assert buf.getvalue()[1:4] == b"PNG" and not plt.fignum_exists(fig.number)
+    assert len(plt.get_fignums()) == n_figs

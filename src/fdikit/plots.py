@@ -31,7 +31,29 @@ def save_figure(fig, path, dpi: int = 120):
     """Write ``fig`` to ``path`` atomically (:mod:`fdikit.atomic`); the format follows the suffix (PNG default).
 
     A kill or an error during the write leaves the previous file at ``path`` (if any) untouched.
-    ``path`` may also be a binary file object (written as PNG, not atomic: the caller owns it).
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    path : str, Path or binary file object
+        The file; a file object is written as PNG (not atomic: the caller owns it).
+    dpi : int
+        Resolution.
+
+    Returns
+    -------
+    Path or the file object
+        ``path``.
+
+    Examples
+    --------
+    >>> import io
+    >>> import matplotlib.pyplot as plt
+    >>> fig, ax = plt.subplots()
+    >>> save_figure(fig, io.BytesIO()).getvalue()[1:4]
+    b'PNG'
+    >>> plt.close(fig)
     """
     from fdikit.atomic import atomic_path
 
@@ -46,7 +68,30 @@ def save_figure(fig, path, dpi: int = 120):
 
 
 def figure_bytes(fig, dpi: int = 120, fmt: str = "png") -> bytes:
-    """The figure encoded as ``fmt`` (PNG by default), for storing it with a result part."""
+    """The figure encoded as ``fmt`` (PNG by default), for storing it with a result part.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    dpi : int
+        Resolution.
+    fmt : str
+        Any format matplotlib writes (``'png'``, ``'svg'``, ``'pdf'`` ...).
+
+    Returns
+    -------
+    bytes
+        The encoded figure.
+
+    Examples
+    --------
+    >>> import matplotlib.pyplot as plt
+    >>> fig, ax = plt.subplots()
+    >>> figure_bytes(fig, fmt="svg").lstrip()[:5]
+    b'<?xml'
+    >>> plt.close(fig)
+    """
     import io
 
     buf = io.BytesIO()
@@ -80,7 +125,23 @@ def plot_residuals(
     Returns
     -------
     matplotlib.figure.Figure or the given ``ax``
-        A new figure when ``ax`` is None, else ``ax``.  The backend is never changed.
+        A new figure when ``ax`` is None (closed once written to ``path``), else ``ax``.  The backend is
+        never changed.
+
+    Raises
+    ------
+    ParameterError
+        When ``ax`` holds neither one Axes nor one per residual.
+
+    Examples
+    --------
+    >>> import matplotlib.pyplot as plt
+    >>> t = np.arange(100) * 0.1
+    >>> res = Residuals(t, np.c_[np.sin(t), np.cos(t)], ("a", "b"), ())
+    >>> fig, axes = plt.subplots(2, 1)
+    >>> plot_residuals(res, thresholds=0.9, onset=5.0, ax=axes) is axes, len(axes[0].lines)
+    (True, 4)
+    >>> plt.close(fig)
     """
     names = list(names or residuals.names)
     idx = [residuals.names.index(n) for n in names]

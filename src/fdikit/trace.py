@@ -433,6 +433,15 @@ def check_signals(trace: Trace, controls: Sequence[str], outputs: Sequence[str])
     DataError
         Naming each missing control/output, where a misplaced one was found instead (an output
         recorded as a control or the reverse), and the trace's signals the generator does not read.
+
+    Examples
+    --------
+    >>> tr = Trace(t=np.arange(3) * 0.1, u=np.zeros((3, 1)), y=np.ones((3, 1)), controls=["steer"], outputs=["r"])
+    >>> check_signals(tr, ["steer"], ["r"])
+    >>> check_signals(tr, [], ["steer"])
+    Traceback (most recent call last):
+    ...
+    fdikit.errors.DataError: the trace does not match the generator's signals: missing outputs ['steer'] ...
     """
     problems = []
     for kind, want, have, other, other_kind in (

@@ -396,8 +396,8 @@ def target_tracking_monte_carlo(runs: int = 100, seed: int | None = 0, *, lam: f
                                 summary=summary, true_weights=mu_true, runs=runs, seed=seed)
 
 
-def plot_target_tracking(result: TargetTrackingResult, path) -> None:
-    """Figs 2.4–2.5 style plot (position, velocity and B RMSE, mean left-turn weight) to ``path`` (Agg).
+def plot_target_tracking(result: TargetTrackingResult, path=None, axes=None):
+    """Figs 2.4–2.5 style plot (position, velocity and B RMSE, mean left-turn weight), into ``axes`` or to ``path``.
 
     ``path`` is written atomically (:func:`fdikit.plots.save_figure`); a binary file object also works.
 
@@ -405,8 +405,15 @@ def plot_target_tracking(result: TargetTrackingResult, path) -> None:
     ----------
     result : TargetTrackingResult
         From :func:`target_tracking_monte_carlo`.
-    path : str, PathLike or binary file object
+    path : str, PathLike or binary file object, optional
         Where the PNG goes.
+    axes : sequence of four matplotlib Axes, optional
+        The position, velocity, B and weight panels; default a new figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure or the given ``axes``
+        A new figure (closed once written to ``path``) when ``axes`` is None, else ``axes``.
 
     References
     ----------
@@ -422,28 +429,24 @@ def plot_target_tracking(result: TargetTrackingResult, path) -> None:
     >>> buffer.getvalue()[1:4]  # doctest: +SKIP
     b'PNG'
     """
-    import matplotlib.pyplot as plt
+    from fdikit.plots import axes_or_new, finish_plot
 
-    from fdikit.plots import save_figure
-
-    fig, axes = plt.subplots(4, 1, figsize=(8, 10), sharex=True)
+    fig, panes = axes_or_new(axes, 4, figsize=(8, 10), sharex=True)
     panels = (("position RMSE [m]", result.rmse_position), ("velocity RMSE [m/s]", result.rmse_velocity),
               ("B reconstruction RMSE [-]", result.rmse_B))
-    for ax, (label, data) in zip(axes, panels):
+    for ax, (label, data) in zip(panes, panels):
         for f in result.filters:
             ax.plot(result.t, data[f], label=f, lw=1)
         ax.set_ylabel(label)
     for f in result.filters:
-        axes[3].plot(result.t, result.cm_weights[f][:, 0], label=f, lw=1)
-    axes[3].plot(result.t, result.true_weights[:, 0], "k--", label="true", lw=1)
-    axes[3].set_ylabel("mean μ_left (CM coord.)")
-    axes[3].set_xlabel("sample k")
-    for ax in axes:
+        panes[3].plot(result.t, result.cm_weights[f][:, 0], label=f, lw=1)
+    panes[3].plot(result.t, result.true_weights[:, 0], "k--", label="true", lw=1)
+    panes[3].set_ylabel("mean μ_left (CM coord.)")
+    panes[3].set_xlabel("sample k")
+    for ax in panes:
         for name in ("left_half", "right"):
             a, b = INTERVALS[name]
             ax.axvspan(result.t[0] + a * TS, result.t[0] + b * TS, color="0.9")
         ax.legend(fontsize=7, loc="upper right")
-    axes[0].set_title(f"Hallouzi 2008 §2.4.2, {result.runs} Monte-Carlo runs")
-    fig.tight_layout()
-    save_figure(fig, path, dpi=120)
-    plt.close(fig)
+    panes[0].set_title(f"Hallouzi 2008 §2.4.2, {result.runs} Monte-Carlo runs")
+    return finish_plot(fig, axes, path)

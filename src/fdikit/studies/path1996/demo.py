@@ -39,7 +39,7 @@ from fdikit.simulate import simulate
 from fdikit.trace import Trace
 
 __all__ = ["DemoResult", "BankDemoResult", "demo_model", "run_demo", "run_kalman_demo", "check_demo_arguments",
-           "SENSOR_NOISE_STD", "ACTUATOR_NOISE_STD"]
+           "plot_bank_report", "SENSOR_NOISE_STD", "ACTUATOR_NOISE_STD"]
 
 #: Sensor noise standard deviations (per sample at 100 Hz), in App. D output order.
 SENSOR_NOISE_STD = {
@@ -401,21 +401,69 @@ def run_demo(
         files[f"trace ({label})"] = trace.save(out / f"trace_{signal}.parquet")
         group = next(g for g, iso in zip(bank.groups, residuals.isolates) if iso == fault)
         panels.append((label, residuals, diagnosis, [n for n, g in zip(residuals.names, bank.groups) if g == group]))
-    files["report"] = _bank_report(panels, evaluator, onset, out / "report.png")
+    plot_bank_report(panels, evaluator, onset, out / "report.png")
+    files["report"] = out / "report.png"
     table = fault_to_residual_gain(gen, plant, np.logspace(-2, np.log10(np.pi / dt), 40))
     files["structure"] = save_figure(table.plot(), out / "structure.png")
     return BankDemoResult(traces, diagnoses, scores, evaluator, noise, files)
 
 
-def _bank_report(panels, evaluator, onset, path: Path) -> Path:
-    """One column per scenario: the residuals of the filter that holds the fault, with thresholds."""
-    import matplotlib.pyplot as plt
+def plot_bank_report(panels, evaluator, onset, path=None, axes=None):
+    """The bank demo's report figure: one column per scenario, the residuals of the filter that holds the fault.
 
-    rows = max(len(p[3]) for p in panels)
-    fig, axes = plt.subplots(rows, len(panels), figsize=(6 * len(panels), 1.3 * rows + 1), sharex=True, squeeze=False)
+    Parameters
+    ----------
+    panels : sequence of (str, Residuals, Diagnosis, list of str)
+        Per scenario: its label, the bank's residuals and decisions, and the names of the residuals
+        to draw (one row each).
+    evaluator : ThresholdEvaluator
+        The fitted evaluator (``center`` and ``thresholds`` give the threshold band).
+    onset : float
+        Fault onset time [s] (a dotted line).
+    path : str, Path or binary file object, optional
+        Write the figure there (atomically, :func:`fdikit.plots.save_figure`).
+    axes : 2-D array of matplotlib Axes, optional
+        ``rows × len(panels)`` axes, ``rows`` the largest number of residuals of a panel; default a new figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure or the given ``axes``
+        A new figure (closed once written to ``path``) when ``axes`` is None, else ``axes``.
+
+    References
+    ----------
+    Douglas et al. 1996, §5.1.1 (the nominal yaw-rate sensor fault), Figs. 5.13–5.14 (the throttle fault).
+
+    Examples
+    --------
+    :func:`run_demo` draws it from its two scenarios; here one made-up scenario, into given axes (only
+    ``center`` and ``thresholds`` of the evaluator are read):
+
+    >>> import matplotlib.pyplot as plt
+    >>> from types import SimpleNamespace
+    >>> t = np.arange(100) * 0.1
+    >>> res = Residuals(t, np.c_[np.sin(t), np.cos(t)], ("F1:a", "F1:b"), ("a", "b"))
+    >>> fired = np.abs(res.r) > 0.9
+    >>> diag = Diagnosis(t, fired.any(axis=1), fired, res.names, np.where(fired.any(axis=1), "a", "none"))
+    >>> band = SimpleNamespace(center=np.zeros(2), thresholds=np.full(2, 0.9))
+    >>> fig, axes = plt.subplots(2, 1, squeeze=False)
+    >>> plot_bank_report([("bias", res, diag, ["F1:a", "F1:b"])], band, 5.0, axes=axes) is axes
+    True
+    >>> plt.close(fig)
+    """
+    from fdikit.plots import axes_or_new, finish_plot
+
+    rows, cols = max(len(p[3]) for p in panels), len(panels)
+    if axes is None:
+        import matplotlib.pyplot as plt
+
+        fig, grid = plt.subplots(rows, cols, figsize=(6 * cols, 1.3 * rows + 1), sharex=True, squeeze=False)
+    else:
+        fig, flat = axes_or_new(axes, rows * cols)
+        grid = np.asarray(flat, dtype=object).reshape(rows, cols)
     for col, (label, res, diag, names) in enumerate(panels):
         for row in range(rows):
-            ax = axes[row, col]
+            ax = grid[row, col]
             if row >= len(names):
                 ax.axis("off")
                 continue
@@ -428,9 +476,6 @@ def _bank_report(panels, evaluator, onset, path: Path) -> Path:
             ax.axvline(onset, color="k", ls=":", lw=0.8)
             ax.set_ylabel(names[row].split(":", 1)[1], rotation=0, ha="right", fontsize=7)
             ax.tick_params(labelsize=7)
-        axes[0, col].set_title(f"{label}: {names[0].split(':')[0]} residuals (scaled, nominal fault = 1)", fontsize=9)
-        axes[-1, col].set_xlabel("time [s]")
-    fig.tight_layout()
-    save_figure(fig, path, dpi=110)
-    plt.close(fig)
-    return path
+        grid[0, col].set_title(f"{label}: {names[0].split(':')[0]} residuals (scaled, nominal fault = 1)", fontsize=9)
+        grid[-1, col].set_xlabel("time [s]")
+    return finish_plot(fig, axes, path, dpi=110)
