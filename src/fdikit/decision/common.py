@@ -28,16 +28,16 @@ def is_count(value, minimum: int) -> bool:
     bool
         Whether ``value`` is an integral number ``>= minimum``.
 
+    References
+    ----------
+    No source document: bookkeeping shared by the evaluators of ``fdikit.decision`` (see its module
+    docstring for the rules on invalid samples and residual names).
+
     Examples
     --------
     >>> from fdikit.decision.common import is_count
     >>> is_count(3, 1), is_count(2.0, 1), is_count(0, 1), is_count(True, 1)
     (True, True, False, False)
-
-    References
-    ----------
-    No source document: bookkeeping shared by the evaluators of :mod:`fdikit.decision` (see its module
-    docstring for the rules on invalid samples and residual names).
     """
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         return False
@@ -63,6 +63,11 @@ def k_of_n(exceed: np.ndarray, k: int, n: int) -> np.ndarray:
     (N, q) bool array
         The persistent decision per sample and column (``exceed`` itself for ``k = n = 1``).
 
+    References
+    ----------
+    Douglas et al. 1996, Ch. 1 (threshold detection balancing false against missed alarms); the k-of-n
+    persistence rule itself is not from the source documents.
+
     Examples
     --------
     >>> import numpy as np
@@ -70,11 +75,6 @@ def k_of_n(exceed: np.ndarray, k: int, n: int) -> np.ndarray:
     >>> x = np.array([[1], [0], [1], [1], [0]], dtype=bool)
     >>> k_of_n(x, 2, 3).ravel().tolist()
     [False, False, True, True, True]
-
-    References
-    ----------
-    Douglas et al. 1996, Ch. 1 (threshold detection balancing false against missed alarms); the k-of-n
-    persistence rule itself is not from the source documents.
     """
     if k == 1 and n == 1:
         return exceed
@@ -101,17 +101,17 @@ def held(values: np.ndarray, valid: np.ndarray, initial) -> np.ndarray:
     (N, ...) array
         One row per sample, of the dtype of ``values``.
 
+    References
+    ----------
+    No source document: bookkeeping shared by the evaluators of ``fdikit.decision`` (see its module
+    docstring for the rules on invalid samples and residual names).
+
     Examples
     --------
     >>> import numpy as np
     >>> from fdikit.decision.common import held
     >>> held(np.array([1.0, 2.0, 3.0]), np.array([False, True, False, True, True]), 0.0).tolist()
     [0.0, 1.0, 1.0, 2.0, 3.0]
-
-    References
-    ----------
-    No source document: bookkeeping shared by the evaluators of :mod:`fdikit.decision` (see its module
-    docstring for the rules on invalid samples and residual names).
     """
     pos = np.cumsum(valid) - 1
     out = np.empty((valid.size,) + values.shape[1:], dtype=values.dtype)
@@ -140,6 +140,11 @@ def isolate_cached(cache: dict, fired: np.ndarray, isolates, groups=None) -> str
     str
         The isolated fault name, ``"none"`` or ``"unknown"`` (:func:`fdikit.diagnosis.isolate`).
 
+    References
+    ----------
+    No source document: bookkeeping shared by the evaluators of ``fdikit.decision`` (see its module
+    docstring for the rules on invalid samples and residual names).
+
     Examples
     --------
     >>> import numpy as np
@@ -147,11 +152,6 @@ def isolate_cached(cache: dict, fired: np.ndarray, isolates, groups=None) -> str
     >>> cache = {}
     >>> isolate_cached(cache, np.array([True, False]), ("a_sensor", "b_sensor")), len(cache)
     ('a_sensor', 1)
-
-    References
-    ----------
-    No source document: bookkeeping shared by the evaluators of :mod:`fdikit.decision` (see its module
-    docstring for the rules on invalid samples and residual names).
     """
     key = fired.tobytes()
     label = cache.get(key)
@@ -183,16 +183,16 @@ def checked_names(q: int, residuals, fitted) -> tuple[str, ...]:
     DataError
         When the chosen names are not ``q``.
 
+    References
+    ----------
+    No source document: bookkeeping shared by the evaluators of ``fdikit.decision`` (see its module
+    docstring for the rules on invalid samples and residual names).
+
     Examples
     --------
     >>> from fdikit.decision.common import checked_names
     >>> checked_names(2, None, None), checked_names(2, None, ("x", "y"))
     (('r0', 'r1'), ('x', 'y'))
-
-    References
-    ----------
-    No source document: bookkeeping shared by the evaluators of :mod:`fdikit.decision` (see its module
-    docstring for the rules on invalid samples and residual names).
     """
     names = residuals.names if residuals is not None else (fitted or tuple(f"r{i}" for i in range(q)))
     if len(names) != q:
@@ -201,7 +201,7 @@ def checked_names(q: int, residuals, fitted) -> tuple[str, ...]:
 
 
 def check_fitted_names(names, fitted, evaluator: str = "the evaluator") -> None:
-    """Raise :class:`DataError` unless the residual ``names`` are exactly the ``fitted`` ones, in order.
+    """Raise :class:`~fdikit.errors.DataError` unless the residual ``names`` are exactly the ``fitted`` ones, in order.
 
     The message names the difference: the missing and the extra residuals, or, for the same set in
     another order, the positions that differ.  ``fitted`` None (an evaluator set up by hand, not fitted)
@@ -221,6 +221,11 @@ def check_fitted_names(names, fitted, evaluator: str = "the evaluator") -> None:
     DataError
         When ``names`` differ from ``fitted`` (missing or extra residuals, or the same residuals reordered).
 
+    References
+    ----------
+    No source document: bookkeeping shared by the evaluators of ``fdikit.decision`` (see its module
+    docstring for the rules on invalid samples and residual names).
+
     Examples
     --------
     >>> from fdikit.decision.common import check_fitted_names
@@ -230,11 +235,6 @@ def check_fitted_names(names, fitted, evaluator: str = "the evaluator") -> None:
     ... except Exception as exc:
     ...     print(type(exc).__name__)
     DataError
-
-    References
-    ----------
-    No source document: bookkeeping shared by the evaluators of :mod:`fdikit.decision` (see its module
-    docstring for the rules on invalid samples and residual names).
     """
     if fitted is None or names is None:
         return
@@ -280,6 +280,11 @@ def checked_residuals(residuals, fitted, evaluator: str = "the evaluator") -> Re
         When ``residuals`` is not a ``Residuals``, or its names differ from ``fitted``
         (:func:`check_fitted_names`).
 
+    References
+    ----------
+    No source document: bookkeeping shared by the evaluators of ``fdikit.decision`` (see its module
+    docstring for the rules on invalid samples and residual names).
+
     Examples
     --------
     >>> import numpy as np
@@ -288,11 +293,6 @@ def checked_residuals(residuals, fitted, evaluator: str = "the evaluator") -> Re
     >>> r = Residuals(np.arange(3) * 0.1, np.zeros((3, 2)), ("a", "b"), ("fa", "fb"))
     >>> checked_residuals(r, ("a", "b")).names
     ('a', 'b')
-
-    References
-    ----------
-    No source document: bookkeeping shared by the evaluators of :mod:`fdikit.decision` (see its module
-    docstring for the rules on invalid samples and residual names).
     """
     if not isinstance(residuals, Residuals):
         raise DataError(f"residuals must be a fdikit.residuals.Residuals (from a generator's run), got "
@@ -328,16 +328,16 @@ def step_vector(r, fitted=None, names=None, evaluator: str = "the evaluator") ->
         When ``r`` is not numeric, when the number of names differs from the number of values, or when the
         names differ from ``fitted``.
 
+    References
+    ----------
+    No source document: bookkeeping shared by the evaluators of ``fdikit.decision`` (see its module
+    docstring for the rules on invalid samples and residual names).
+
     Examples
     --------
     >>> from fdikit.decision.common import step_vector
     >>> step_vector({"a": 1.0, "b": float("nan")}, fitted=("a", "b")).tolist()
     [1.0, nan]
-
-    References
-    ----------
-    No source document: bookkeeping shared by the evaluators of :mod:`fdikit.decision` (see its module
-    docstring for the rules on invalid samples and residual names).
     """
     from collections.abc import Mapping
 

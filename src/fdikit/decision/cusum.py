@@ -104,13 +104,6 @@ def cusum_arl(drift, threshold, shift=0.0, two_sided: bool = True):
         Expected number of samples up to and including the alarm, starting from ``g = 0``
         (``inf`` when it overflows).
 
-    Examples
-    --------
-    >>> round(float(cusum_arl(0.5, 4.0, two_sided=False)), 1)
-    338.1
-    >>> round(float(cusum_arl(0.5, 4.0, shift=1.0)), 2)
-    8.34
-
     Raises
     ------
     ParameterError
@@ -120,6 +113,13 @@ def cusum_arl(drift, threshold, shift=0.0, two_sided: bool = True):
     ----------
     Siegmund 1985 (the overshoot-corrected approximation); Basseville & Nikiforov 1993, §5.2, (5.2.44);
     van Dobben de Bruyn 1968 (the two-sided combination).
+
+    Examples
+    --------
+    >>> round(float(cusum_arl(0.5, 4.0, two_sided=False)), 1)
+    338.1
+    >>> round(float(cusum_arl(0.5, 4.0, shift=1.0)), 2)
+    8.34
     """
     nu, h = np.asarray(drift, dtype=float), np.asarray(threshold, dtype=float)
     if not np.all(nu >= 0):
@@ -187,16 +187,16 @@ def cusum_design(arl0: float, shift: float, two_sided: bool = True) -> tuple[flo
         above 1, or when ``arl0`` is not above the run length of ``h = 0`` with that drift (no threshold
         reaches it).
 
+    References
+    ----------
+    Basseville & Nikiforov 1993, §2.2 (the drift half-way between the two means) and §5.2, (5.2.44)
+    (Siegmund's ARL).
+
     Examples
     --------
     >>> nu, h = cusum_design(500.0, 1.0)
     >>> nu, round(h, 3)
     (0.5, 5.063)
-
-    References
-    ----------
-    Basseville & Nikiforov 1993, §2.2 (the drift half-way between the two means) and §5.2, (5.2.44)
-    (Siegmund's ARL).
     """
     if not np.isfinite(shift) or not shift > 0:
         raise ParameterError(f"fault size (shift) must be positive, in units of sigma; got {shift}")
@@ -331,6 +331,11 @@ class CusumEvaluator:
         Fault tied to each residual, and the filter of each residual in a bank, as in
         :class:`~fdikit.decision.threshold.ThresholdEvaluator`.
 
+    References
+    ----------
+    Page 1954 (the one-sided cumulative sum); Basseville & Nikiforov 1993, §2.2 (the two-sided CUSUM);
+    Douglas et al. 1996, Ch. 7 introduction (the CUSUM compared with the Shiryayev SPRT).
+
     Examples
     --------
     >>> import numpy as np
@@ -340,11 +345,6 @@ class CusumEvaluator:
     >>> ev = CusumEvaluator().fit(healthy, arl0=1000.0, shift=1.0)
     >>> ev.drift.round(2).tolist(), ev.threshold.round(2).tolist()
     ([0.5, 0.5], [6.46, 6.44])
-
-    References
-    ----------
-    Page 1954 (the one-sided cumulative sum); Basseville & Nikiforov 1993, §2.2 (the two-sided CUSUM);
-    Douglas et al. 1996, Ch. 7 introduction (the CUSUM compared with the Shiryayev SPRT).
     """
 
     def __init__(
@@ -497,7 +497,7 @@ class CusumEvaluator:
 
         ``valid=False`` (e.g. ``valid=stepper.last_valid`` for a recovering sample after a gap) is
         treated like a NaN sample: the statistics and the decision hold.  ``names`` (optional) are
-        checked against the residual names of the fit (:class:`DataError` on a difference).
+        checked against the residual names of the fit (:class:`~fdikit.errors.DataError` on a difference).
 
         After the call, ``g_plus`` and ``g_minus`` hold the current statistics.  The
         parameters are read at the first step after :meth:`reset` (or :meth:`fit`).

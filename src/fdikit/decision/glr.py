@@ -424,6 +424,11 @@ class GlrEvaluator:
     ``change_size`` (one (N, p_g) array per block), all held on invalid samples.  After
     :meth:`step` the same are in ``statistic``, ``change_index``, ``change_size``.
 
+    References
+    ----------
+    Willsky & Jones 1976 (the GLR for a jump of unknown size); Basseville & Nikiforov 1993, §2.4; Douglas et al.
+    1996, §7.2.3 (the GLR test compared with the Shiryayev SPRT in likelihood-ratio form).
+
     Examples
     --------
     >>> import numpy as np
@@ -434,11 +439,6 @@ class GlrEvaluator:
     >>> d = GlrEvaluator(window=30, threshold=glr_threshold(1e-3, 30)).run(res)
     >>> a = d.first_alarm(); a.fault, a.index - 300, int(d.meta["change_index"][a.index, 0])
     ('fa', 6, 301)
-
-    References
-    ----------
-    Willsky & Jones 1976 (the GLR for a jump of unknown size); Basseville & Nikiforov 1993, §2.4; Douglas et al.
-    1996, §7.2.3 (the GLR test compared with the Shiryayev SPRT in likelihood-ratio form).
     """
 
     def __init__(
@@ -581,7 +581,7 @@ class GlrEvaluator:
 
         ``valid=False`` (e.g. ``valid=stepper.last_valid`` for a recovering sample after a gap) is
         treated like a NaN sample: the statistics and the decision hold.  ``names`` (optional) are
-        checked against the residual names of the fit (:class:`DataError` on a difference).
+        checked against the residual names of the fit (:class:`~fdikit.errors.DataError` on a difference).
 
 
         The parameters are read at the first step after :meth:`reset` (or :meth:`fit`).

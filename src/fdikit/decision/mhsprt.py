@@ -155,6 +155,12 @@ class MhsprtEvaluator:
     A bad sample (NaN/inf, ``valid`` False, or zero density under every hypothesis) holds the posterior and is
     marked invalid; there is no time update for it.  Fault states are absorbing: :meth:`reset` after a repair.
 
+    References
+    ----------
+    Douglas et al. 1996, §7.2.1, Prop. 7.1, (7.1a)–(7.1c) (the posterior recursion; (7.1c) corrected as above),
+    Prop. 7.2 (its bounds), §7.2.3 (the thresholds ``F_{T,i}``), §7.3.1 (Example 1) and §7.4 (the vehicle
+    application).
+
     Examples
     --------
     Example 1 of §7.3.1: ``N(0.5 i, 1)``, a unit bias (``H_0 → H_2``) at t = 1 s.
@@ -167,12 +173,6 @@ class MhsprtEvaluator:
     >>> d = MhsprtEvaluator(dens, p=1e-3, pi=1e-3).run(Residuals(t, x[:, None], ("x",), ()))
     >>> d.hypotheses, d.first_alarm().fault, round(d.first_alarm().time, 2)
     (('none', 'H1', 'H2', 'H3', 'H4'), 'H2', 1.45)
-
-    References
-    ----------
-    Douglas et al. 1996, §7.2.1, Prop. 7.1, (7.1a)–(7.1c) (the posterior recursion; (7.1c) corrected as above),
-    Prop. 7.2 (its bounds), §7.2.3 (the thresholds ``F_{T,i}``), §7.3.1 (Example 1) and §7.4 (the vehicle
-    application).
     """
 
     def __init__(self, densities: Mapping | None = None, *, p=1e-4, pi=1e-3, threshold=0.95,
@@ -252,8 +252,8 @@ class MhsprtEvaluator:
         """Gaussian densities from recorded or simulated residuals (§7.4: sample means and covariances).
 
         ``data``: ``{'none': fault-free residuals, fault: residuals while the fault is active, ...}``; each value
-        one :class:`Residuals` or a list of runs (slice off start-up transients first).  Only valid, finite
-        samples are used.  ``'none'`` is always ``N(mean, cov)`` of its samples.  Faults, by ``mean``:
+        one :class:`~fdikit.residuals.Residuals` or a list of runs (slice off start-up transients first).  Only valid,
+        finite samples are used.  ``'none'`` is always ``N(mean, cov)`` of its samples.  Faults, by ``mean``:
 
         * ``'fixed'``: ``N(mean, cov)`` of all their samples;
         * ``'gaussian'``: runs of different fault sizes; within-run covariance ``Λ``, run means ``~ N(m*, Σ_μ)``
@@ -263,7 +263,7 @@ class MhsprtEvaluator:
 
         ``diagonal`` keeps only the variances of the fitted ``Λ`` (all hypotheses; ``Σ_μ`` stays full);
         ``regularization`` as in :class:`GaussianDensity`
-        (a singular fitted covariance is refused with :class:`DataError` otherwise).
+        (a singular fitted covariance is refused with :class:`~fdikit.errors.DataError` otherwise).
         """
         if mean not in ("fixed", "gaussian", "uniform"):
             raise ParameterError(f"unknown mean model {mean!r}; use 'fixed', 'gaussian' or 'uniform'")
@@ -397,7 +397,7 @@ class MhsprtEvaluator:
 
         ``valid=False`` (e.g. ``valid=stepper.last_valid`` for a recovering sample after a gap) is
         treated like a NaN sample: the statistics and the decision hold.  ``names`` (optional) are
-        checked against the residual names of the fit (:class:`DataError` on a difference).
+        checked against the residual names of the fit (:class:`~fdikit.errors.DataError` on a difference).
         """
         self._need()
         r = step_vector(r, self.names, names, "the MHSPRT")

@@ -212,6 +212,11 @@ class SprtEvaluator:
     isolates, groups : sequence, optional
         Fault tied to each residual, filter of each residual (bank).
 
+    References
+    ----------
+    Wald 1947 (the SPRT, its thresholds and expected sample numbers); Basseville & Nikiforov 1993, §2.2 and §4.3;
+    Douglas et al. 1996, Ch. 7 introduction (the Wald SPRT compared with the Shiryayev SPRT).
+
     Examples
     --------
     >>> import numpy as np
@@ -221,11 +226,6 @@ class SprtEvaluator:
     >>> d = SprtEvaluator(shift=1.0, alpha=1e-3, beta=1e-3).run(Residuals(np.arange(300.0), r, ("r",), ("f",)))
     >>> d.first_alarm().index, d.first_alarm().fault
     (207, 'f')
-
-    References
-    ----------
-    Wald 1947 (the SPRT, its thresholds and expected sample numbers); Basseville & Nikiforov 1993, §2.2 and §4.3;
-    Douglas et al. 1996, Ch. 7 introduction (the Wald SPRT compared with the Shiryayev SPRT).
     """
 
     def __init__(
@@ -346,7 +346,7 @@ class SprtEvaluator:
 
         ``valid=False`` (e.g. ``valid=stepper.last_valid`` for a recovering sample after a gap) is
         treated like a NaN sample: the statistics and the decision hold.  ``names`` (optional) are
-        checked against the residual names of the fit (:class:`DataError` on a difference).
+        checked against the residual names of the fit (:class:`~fdikit.errors.DataError` on a difference).
 
 
         After the call ``llr`` holds ``Λ_k`` and ``decision`` the decision as in ``meta``.

@@ -57,15 +57,15 @@ def alpha_from_rate(false_alarms_per_hour: float, dt: float) -> float:
     ParameterError
         When the rate or ``dt`` is not positive.
 
+    References
+    ----------
+    Douglas et al. 1996, Ch. 1 (a threshold per residual, traded between the rates of false and missed alarms).
+
     Examples
     --------
     >>> from fdikit.decision.threshold import alpha_from_rate
     >>> alpha_from_rate(36.0, 0.1)
     0.001
-
-    References
-    ----------
-    Douglas et al. 1996, Ch. 1 (a threshold per residual, traded between the rates of false and missed alarms).
     """
     if not false_alarms_per_hour > 0 or not dt > 0:
         raise ParameterError(f"need a positive rate and sample time, got {false_alarms_per_hour}/h and dt={dt}")
@@ -91,6 +91,11 @@ class ThresholdEvaluator:
         The filter each residual belongs to, for a bank: filters whose residuals point to
         two or more faults are discarded (:func:`fdikit.diagnosis.isolate`).
 
+    References
+    ----------
+    Douglas et al. 1996, Ch. 1 (a simple threshold per residual, set from empirical studies that balance the
+    rate of false alarms against the rate of missed alarms).
+
     Examples
     --------
     >>> import numpy as np
@@ -101,11 +106,6 @@ class ThresholdEvaluator:
     >>> ev = ThresholdEvaluator().fit(healthy, false_alarm_prob=1e-3)
     >>> round(float(ev.thresholds[0]), 1)
     3.3
-
-    References
-    ----------
-    Douglas et al. 1996, Ch. 1 (a simple threshold per residual, set from empirical studies that balance the
-    rate of false alarms against the rate of missed alarms).
     """
 
     def __init__(
@@ -213,7 +213,7 @@ class ThresholdEvaluator:
 
         ``valid=False`` (e.g. ``valid=stepper.last_valid`` for a recovering sample after a gap) is
         treated like a NaN sample: the statistics and the decision hold.  ``names`` (optional) are
-        checked against the residual names of the fit (:class:`DataError` on a difference).
+        checked against the residual names of the fit (:class:`~fdikit.errors.DataError` on a difference).
         """
         r = step_vector(r, self.names, names, "the threshold evaluator")
         tau, c, iso = self._ready(r.size)

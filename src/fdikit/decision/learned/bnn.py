@@ -208,6 +208,12 @@ class BnnEvaluator:
     rng : numpy.random.Generator or int
         Generator or seed for the initial weights and the random windows.
 
+    References
+    ----------
+    Douglas et al. 1996, §6.1, (6.1) (the network with output feedback), §6.2.2 (outputs as posterior
+    probabilities, one-hot targets), §6.3.1–6.3.2 (DFP and Robbins–Monro training), §6.4 (one network per
+    filter on the residual magnitudes) and §6.5 (step and ramp faults).
+
     Examples
     --------
     >>> import numpy as np
@@ -221,12 +227,6 @@ class BnnEvaluator:
     >>> ev = BnnEvaluator(max_iter=60, rm_steps=20, rng=1).fit(data)
     >>> str(ev.run(run([1, 0])).isolated[-1])
     'a'
-
-    References
-    ----------
-    Douglas et al. 1996, §6.1, (6.1) (the network with output feedback), §6.2.2 (outputs as posterior
-    probabilities, one-hot targets), §6.3.1–6.3.2 (DFP and Robbins–Monro training), §6.4 (one network per
-    filter on the residual magnitudes) and §6.5 (step and ramp faults).
     """
 
     def __init__(
@@ -423,7 +423,7 @@ class BnnEvaluator:
 
         ``valid=False`` (e.g. ``valid=stepper.last_valid`` for a recovering sample after a gap) is
         treated like a NaN sample: the decision (and any feedback state) holds.  ``names`` (optional)
-        are checked against the residual names of the fit (:class:`DataError` on a difference).
+        are checked against the residual names of the fit (:class:`~fdikit.errors.DataError` on a difference).
         """
         net, spec = self._ready()
         x = spec(step_vector(r, self.names, names, "the BNN"))

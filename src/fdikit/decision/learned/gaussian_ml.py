@@ -223,7 +223,7 @@ class GaussianMlEvaluator:
 
         ``valid=False`` (e.g. ``valid=stepper.last_valid`` for a recovering sample after a gap) is
         treated like a NaN sample: the decision (and any feedback state) holds.  ``names`` (optional)
-        are checked against the residual names of the fit (:class:`DataError` on a difference).
+        are checked against the residual names of the fit (:class:`~fdikit.errors.DataError` on a difference).
         """
         x = self._ready()(step_vector(r, self.names, names, "the Gaussian ML classifier"))
         valid = bool(valid) and bool(np.all(np.isfinite(x)))
