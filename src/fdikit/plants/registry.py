@@ -63,7 +63,7 @@ def get_plant(name: str, **params) -> FaultModel:
 
     References
     ----------
-    The plant modules of :mod:`fdikit.plants` cite their sources (e.g. Douglas et al. 1996, App. D for ``"path12"``).
+    The plant modules of ``fdikit.plants`` cite their sources (e.g. Douglas et al. 1996, App. D for ``"path12"``).
 
     Examples
     --------
