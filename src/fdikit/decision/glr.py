@@ -82,8 +82,7 @@ def glr_threshold(false_alarm_prob: float, window: int, dof: int = 1) -> float:
 
     References
     ----------
-    Willsky & Jones 1976 (the GLR for a jump of unknown size); Basseville & Nikiforov 1993, §2.4; Douglas et al.
-    1996, §7.2.3 (the GLR test compared with the Shiryayev SPRT in likelihood-ratio form).
+    Willsky & Jones 1976; Basseville & Nikiforov 1993, §2.4; Douglas et al. 1996, §7.2.3 (GLR vs. Shiryayev SPRT).
 
     Examples
     --------
@@ -110,10 +109,8 @@ def residual_blocks(
         ``'isolates'``: the residuals tied to the same fault form a block (an untied
         residual is a block of its own); ``'each'``: one block per residual (scalar
         tests); ``'all'``: one block of all residuals; a sequence: one label per residual.
-    names : sequence of str
-        The residuals' names.
-    isolates : sequence of str or None
-        The fault tied to each residual (None: untied).
+    names, isolates : sequence of str
+        The residuals' names and tied faults (None: untied).
 
     Returns
     -------
@@ -128,12 +125,10 @@ def residual_blocks(
 
     References
     ----------
-    Willsky & Jones 1976 (the GLR for a jump of unknown size); Basseville & Nikiforov 1993, §2.4; Douglas et al.
-    1996, §7.2.3 (the GLR test compared with the Shiryayev SPRT in likelihood-ratio form).
+    Basseville & Nikiforov 1993, §2.4 (see :class:`GlrEvaluator`).
 
     Examples
     --------
-    >>> from fdikit.decision.glr import residual_blocks
     >>> residual_blocks("isolates", ("a", "b", "c"), ("fa", "fa", None))
     (('fa', (0, 1)), ('c', (2,)))
     """
@@ -181,39 +176,19 @@ class BlockLayout:
     ``gather(e)`` maps ``(..., q)`` residuals to ``(..., G, P)`` (zeros in the padding,
     which leave sums and squares unchanged); ``chol`` and ``whiten`` are the padded
     Cholesky factors ``L_g`` of the block covariances and their inverses.  ``cov`` is a
-    (q, q) matrix or a (q,) vector of variances.
+    (q, q) matrix or a (q,) vector of variances.  Attributes: ``blocks`` (:func:`residual_blocks`), ``names``
+    (of the blocks), ``dims`` (``p_g``), ``index`` (the residual of each padded slot, ``q`` in the padding),
+    ``chol``, ``whiten``, and ``isolates``/``groups`` per block (None where its residuals differ).
 
     Parameters
     ----------
     blocks : 'isolates', 'each', 'all' or sequence
         The grouping (:func:`residual_blocks`).
-    names : sequence of str
-        The ``q`` residual names.
-    isolates : sequence of str or None
-        Fault tied to each residual.
-    groups : sequence or None
-        Filter of each residual in a bank (a block must lie within one filter), or None.
+    names, isolates, groups : sequence
+        The ``q`` residual names, their tied faults, and their filters in a bank (None: no bank; a block must
+        lie within one filter).
     cov : (q,) or (q, q) ndarray
         Variances or covariance of the residuals (:func:`as_covariance`); only the diagonal blocks are used.
-
-    Attributes
-    ----------
-    blocks : tuple of (name, residual indices)
-        As returned by :func:`residual_blocks`.
-    names : tuple of str
-        Block names.
-    q : int
-        Number of residuals.
-    dims : (G,) int ndarray
-        ``p_g``, the size of each block.
-    index : (G, P) int ndarray
-        Residual index of each padded slot (``q``, the zero column, in the padding).
-    chol, whiten : (G, P, P) ndarray
-        ``L_g`` and ``L_g⁻¹`` per block, zero-padded.
-    isolates : tuple of str or None
-        Each block's fault (its residuals' common fault, None when they differ).
-    groups : tuple or None
-        Each block's filter.
 
     Raises
     ------
@@ -224,13 +199,10 @@ class BlockLayout:
 
     References
     ----------
-    Willsky & Jones 1976 (the GLR for a jump of unknown size); Basseville & Nikiforov 1993, §2.4; Douglas et al.
-    1996, §7.2.3 (the GLR test compared with the Shiryayev SPRT in likelihood-ratio form).
+    Basseville & Nikiforov 1993, §2.4 (see :class:`GlrEvaluator`).
 
     Examples
     --------
-    >>> import numpy as np
-    >>> from fdikit.decision.glr import BlockLayout
     >>> lay = BlockLayout("isolates", ("a", "b", "c"), ("fa", "fa", "fb"), None, np.array([1.0, 4.0, 9.0]))
     >>> lay.names, lay.dims.tolist(), lay.gather(np.array([1.0, 2.0, 3.0])).tolist()
     (('fa', 'fb'), [2, 1], [[1.0, 2.0], [3.0, 0.0]])
@@ -315,12 +287,10 @@ def as_covariance(cov, q: int) -> np.ndarray:
 
     References
     ----------
-    Willsky & Jones 1976 (the GLR for a jump of unknown size); Basseville & Nikiforov 1993, §2.4; Douglas et al.
-    1996, §7.2.3 (the GLR test compared with the Shiryayev SPRT in likelihood-ratio form).
+    Basseville & Nikiforov 1993, §2.4 (see :class:`GlrEvaluator`).
 
     Examples
     --------
-    >>> from fdikit.decision.glr import as_covariance
     >>> as_covariance(2.0, 3).tolist()
     [2.0, 2.0, 2.0]
     """
@@ -361,10 +331,8 @@ def fit_moments(residuals: Residuals, minimum: int = 10) -> tuple[np.ndarray, np
 
     Returns
     -------
-    mean : (q,) ndarray
-        Sample mean ``μ0``.
-    cov : (q, q) ndarray
-        Sample covariance (``ddof=1``).
+    (mean, cov) : tuple of ndarray
+        The (q,) sample mean ``μ0`` and the (q, q) sample covariance (``ddof=1``).
 
     Raises
     ------
@@ -373,14 +341,10 @@ def fit_moments(residuals: Residuals, minimum: int = 10) -> tuple[np.ndarray, np
 
     References
     ----------
-    Willsky & Jones 1976 (the GLR for a jump of unknown size); Basseville & Nikiforov 1993, §2.4; Douglas et al.
-    1996, §7.2.3 (the GLR test compared with the Shiryayev SPRT in likelihood-ratio form).
+    Basseville & Nikiforov 1993, §2.4 (see :class:`GlrEvaluator`).
 
     Examples
     --------
-    >>> import numpy as np
-    >>> from fdikit.residuals import Residuals
-    >>> from fdikit.decision.glr import fit_moments
     >>> rng = np.random.default_rng(0)
     >>> healthy = Residuals(np.arange(200) * 0.01, rng.standard_normal((200, 2)), ("a", "b"), ("fa", "fb"))
     >>> mean, cov = fit_moments(healthy)
@@ -426,8 +390,7 @@ class GlrEvaluator:
 
     References
     ----------
-    Willsky & Jones 1976 (the GLR for a jump of unknown size); Basseville & Nikiforov 1993, §2.4; Douglas et al.
-    1996, §7.2.3 (the GLR test compared with the Shiryayev SPRT in likelihood-ratio form).
+    Willsky & Jones 1976; Basseville & Nikiforov 1993, §2.4; Douglas et al. 1996, §7.2.3 (GLR vs. Shiryayev SPRT).
 
     Examples
     --------
