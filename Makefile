@@ -21,7 +21,7 @@ demo: $(VENV)/.installed
 	$(BIN)/fdikit demo
 
 test: $(VENV)/.installed-dev
-	$(BIN)/ruff check src tests benchmarks
+	$(BIN)/ruff check src tests benchmarks tools docs/hooks
 	$(BIN)/python -m pytest -q -p no:cacheprovider --doctest-modules src tests
 
 $(VENV)/.installed-docs: $(BIN)/python pyproject.toml
