@@ -133,7 +133,33 @@ class ThresholdEvaluator:
         false_alarms_per_hour: float | None = None,
         method: str = "gaussian",
     ) -> ThresholdEvaluator:
-        """Calibrate centres and thresholds on fault-free residuals; returns ``self``."""
+        """Calibrate centres and thresholds on fault-free residuals; returns ``self``.
+
+        Parameters
+        ----------
+        residuals : Residuals
+            Fault-free residuals (invalid and non-finite rows are skipped; at least 10 must remain).
+        false_alarm_prob : float, optional
+            ``α`` in (0, 1), the family-wise false-alarm probability per sample.
+        false_alarms_per_hour : float, optional
+            A rate instead, converted by :func:`alpha_from_rate` with the median sample time; give exactly
+            one of the two.
+        method : {'gaussian', 'empirical'}, default 'gaussian'
+            ``τ_i = σ_i Φ⁻¹(1 − α/(2q))``, or the ``1 − α/q`` quantile of ``|r_i − c_i|`` (needs
+            ``10 q/α`` samples).
+
+        Returns
+        -------
+        ThresholdEvaluator
+            ``self``, with ``center``, ``thresholds``, ``alpha``, ``names`` (and ``isolates`` when unset).
+
+        Raises
+        ------
+        ParameterError
+            When neither or both targets are given, ``α`` is not in (0, 1) or ``method`` is unknown.
+        DataError
+            When there are too few samples, or a residual is constant on the data.
+        """
         if (false_alarm_prob is None) == (false_alarms_per_hour is None):
             raise ParameterError("give exactly one of false_alarm_prob and false_alarms_per_hour")
         residuals = checked_residuals(residuals, None)
