@@ -257,7 +257,26 @@ class SprtEvaluator:
         self.reset()
 
     def fit(self, residuals: Residuals) -> SprtEvaluator:
-        """Estimate ``μ0`` and ``Σ`` on fault-free residuals; returns ``self``."""
+        """Estimate ``μ0`` and ``Σ`` on fault-free residuals; returns ``self``.
+
+        Parameters
+        ----------
+        residuals : Residuals
+            Fault-free residuals (invalid and non-finite rows skipped; at least 10 must remain).
+
+        Returns
+        -------
+        SprtEvaluator
+            ``self``, with ``mean``, ``cov`` and ``names`` set (and ``isolates`` when unset).
+
+        Raises
+        ------
+        DataError
+            When there are too few samples, a block covariance is singular, or the shifts, means or
+            ``isolates`` do not fit the residuals.
+        ParameterError
+            When a block's shift is zero.
+        """
         self.mean, self.cov = fit_moments(residuals)
         self.names = residuals.names
         if self.isolates is None:
