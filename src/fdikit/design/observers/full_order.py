@@ -1,7 +1,7 @@
 """Observer-based residual generators: pole placement and the steady-state Kalman filter.
 
 The residual is the output estimation error (innovation) of a full-order observer
-(Douglas et al. 1996, §3.1, eq. (3.2))::
+(Douglas et al. 1996, Ch. 3, eq. (3.2))::
 
     x̂' = A x̂ + Bu u + L (y − C x̂ − Du u)
     r   = y − C x̂ − Du u
@@ -37,12 +37,31 @@ class ObserverDesign:
 
     Attributes
     ----------
-    generator : the residual generator (residual names = output names).
-    gain : observer gain ``L`` (n x p).
-    poles : eigenvalues of ``A − L C``.
-    covariance : steady-state estimation-error covariance ``P`` (Kalman only).
-    innovation_covariance : covariance of the residual in steady state (Kalman only;
-        ``C P Cᵀ + R`` in discrete time, ``R`` — the white-noise intensity — in continuous time).
+    generator : ResidualGenerator
+        The residual generator (residual names = output names).
+    gain : (n, p) array
+        Observer gain ``L`` (python-control's ``lqe`` sign: the filter's state matrix is ``A − L C``).
+    poles : (n,) complex array
+        Eigenvalues of ``A − L C``.
+    covariance : (n, n) array or None
+        Steady-state estimation-error covariance ``P`` (Kalman only).
+    innovation_covariance : (p, p) array or None
+        Covariance of the residual in steady state (Kalman only; ``C P Cᵀ + R`` in discrete time,
+        ``R`` — the white-noise intensity — in continuous time).
+    model : FaultModel or None
+        The model the design was made for (keyword-only; set by the design function).
+
+    Examples
+    --------
+    >>> from fdikit import FaultModel
+    >>> from fdikit.design import observer
+    >>> d = observer(FaultModel(A=[[0, 1], [-2, -3]], C=[[1, 0]], Bu=[[0], [1]]), poles=[-5, -6])
+    >>> d.gain.ravel().round(6).tolist(), d.generator.residuals, d.covariance is None
+    ([8.0, 4.0], ('y0',), True)
+
+    References
+    ----------
+    Douglas et al. 1996, Ch. 3, (3.2) (the observer; the report writes ``A + L C``, i.e. ``−gain``).
     """
 
     generator: ResidualGenerator
@@ -70,7 +89,29 @@ class ObserverDesign:
 
 
 def unobservable_modes(A: np.ndarray, C: np.ndarray) -> np.ndarray:
-    """Eigenvalues λ of ``A`` with ``rank [A − λI; C] < n`` (PBH test, scale-aware tolerance)."""
+    """Eigenvalues λ of ``A`` with ``rank [A − λI; C] < n`` (PBH test, scale-aware tolerance).
+
+    Parameters
+    ----------
+    A : (n, n) array_like
+        State matrix.
+    C : (p, n) array_like
+        Output matrix.
+
+    Returns
+    -------
+    (k,) complex array
+        The unobservable eigenvalues of ``(C, A)`` (empty when the pair is observable).
+
+    Examples
+    --------
+    >>> unobservable_modes([[-1.0, 0.0], [0.0, -2.0]], [[1.0, 0.0]]).real.tolist()
+    [-2.0]
+
+    References
+    ----------
+    Douglas et al. 1996, Ch. 3 (a stable observer detects every fault when ``(C, A)`` is observable).
+    """
     A = validate.as_square("A", A)
     n = A.shape[0]
     C = validate.as_matrix("C", C, (None, n))
@@ -94,8 +135,36 @@ def observer_generator(
 
     The residual is ``r = y − C x̂ − Du u``, or its coordinates ``Qᵀ r`` in the columns of an
     output ``projection`` Q (p x k; e.g. the projected residuals of a detection filter).
-    ``outputs`` names the generator's residual outputs (default: the model's output names, or
-    ``r0, r1 …`` with a projection).
+
+    Parameters
+    ----------
+    model : FaultModel
+        The plant (continuous or discrete); the generator reads its controls and outputs.
+    L : (n, p) array_like
+        Observer gain (the filter's state matrix is ``A − L C``).
+    outputs : sequence of str, optional
+        Names of the residuals (default: the model's output names, or ``r0, r1 …`` with a projection).
+    projection : (p, k) array_like, optional
+        Output projection ``Q``; the residuals are ``Qᵀ r`` (default: identity, all ``p`` residuals).
+    isolates : sequence of str or None, optional
+        The fault each residual is tied to (one entry per residual; default none).
+
+    Returns
+    -------
+    ResidualGenerator
+        ``z' = (A − L C) z + [Bu − L Du, L] [u; y]``, ``r = Qᵀ (y − C z − Du u)``.
+
+    Examples
+    --------
+    >>> from fdikit import FaultModel
+    >>> m = FaultModel(A=[[0, 1], [-2, -3]], C=[[1, 0]], Bu=[[0], [1]])
+    >>> g = observer_generator(m, [[9.0], [4.0]])
+    >>> g.residuals, g.A.tolist()
+    (('y0',), [[-9.0, 1.0], [-6.0, -3.0]])
+
+    References
+    ----------
+    Douglas et al. 1996, Ch. 3, (3.2) (with the innovation sign ``r = y − ŷ``).
     """
     validate.instance("model", model, FaultModel)
     A, C, Bu, Du = model.A, model.C, model.Bu, model.Du
@@ -137,11 +206,19 @@ def observer(model: FaultModel, poles: Sequence[complex], method: str = "place")
     method : ``'place'`` (:func:`control.place`, Tits–Yang; repeated poles up to the
         number of outputs) or ``'varga'`` (:func:`control.place_varga`, Schur method).
 
+    Returns
+    -------
+    ObserverDesign
+        Generator, gain ``L``, the attained poles; ``covariance`` and ``innovation_covariance`` are None.
+
     Raises
     ------
+    ParameterError
+        When ``model`` is not a FaultModel, ``poles`` is not ``n`` finite values, or ``method`` is unknown.
+    ------
     DesignError
-        When the pair (C, A) is not observable (the unobservable modes are named) or the
-        requested poles cannot be placed.
+        When the pair (C, A) is not observable (the unobservable modes are named), the
+        requested poles cannot be placed, or the placed observer is not stable.
 
     Examples
     --------
@@ -152,6 +229,10 @@ def observer(model: FaultModel, poles: Sequence[complex], method: str = "place")
     >>> d = observer(m, poles=[-5, -6])
     >>> np.sort(d.poles.real)
     array([-6., -5.])
+
+    References
+    ----------
+    Douglas et al. 1996, Ch. 3, (3.2).
     """
     import control
 
@@ -200,25 +281,47 @@ def _cov(name: str, value, k: int) -> np.ndarray:
 def kalman(model: FaultModel, Q, R) -> ObserverDesign:
     """Steady-state Kalman filter residual generator (the innovation).
 
-    Parameters
-    ----------
-    model : FaultModel
-        Process noise enters through the noise group ``w`` (``Bw``, ``Dw``); a model
-        without a noise group takes ``Q`` as the covariance of noise added to every state.
-    Q : covariance of ``w`` (or of the state noise), per sample in discrete time,
-        intensity (PSD) in continuous time.
-    R : p x p covariance (intensity) of measurement noise added to every output.
-
     The Riccati equation is solved by :func:`scipy.linalg.solve_discrete_are` or
     :func:`scipy.linalg.solve_continuous_are` in its filtering form, with the
     cross-covariance ``S = Bw Q Dwᵀ`` when the noise also reaches the outputs.
     Discrete gain (predictor form): ``L = (A P Cᵀ + S)(C P Cᵀ + R̄)⁻¹``; continuous:
     ``L = (P Cᵀ + S) R̄⁻¹`` with ``R̄ = R + Dw Q Dwᵀ``.
 
+    Parameters
+    ----------
+    model : FaultModel
+        Process noise enters through the noise group ``w`` (``Bw``, ``Dw``); a model
+        without a noise group takes ``Q`` as the covariance of noise added to every state.
+    Q : float or (k, k) array_like
+        Covariance of ``w`` (k = number of noise inputs, or n state noises), per sample in discrete
+        time, intensity (PSD) in continuous time; a scalar means ``Q I``.
+    R : float or (p, p) array_like
+        Covariance (intensity) of measurement noise added to every output; a scalar means ``R I``.
+
+    Returns
+    -------
+    ObserverDesign
+        Generator, gain ``L``, poles of ``A − L C``, ``covariance`` ``P`` and ``innovation_covariance``.
+
     Raises
     ------
+    ParameterError
+        When ``model`` is not a FaultModel, or ``Q`` or ``R`` is not a symmetric positive semidefinite
+        matrix of the right size.
     DesignError
         When the Riccati equation has no stabilising solution (e.g. an undetectable mode).
+
+    Examples
+    --------
+    >>> from fdikit import FaultModel
+    >>> m = FaultModel(A=[[0, 1], [-2, -3]], C=[[1, 0]], Bu=[[0], [1]])
+    >>> k = kalman(m, Q=1.0, R=0.1)
+    >>> k.gain.ravel().round(6).tolist(), k.innovation_covariance.tolist()
+    ([2.94946, -0.650342], [[0.1]])
+
+    References
+    ----------
+    Hallouzi 2008, §2.3.1, Table 2.1 step 2 (the Kalman cycle; here its steady state).
     """
     validate.instance("model", model, FaultModel)
     n, p = model.n, model.p
