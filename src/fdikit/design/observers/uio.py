@@ -91,6 +91,20 @@ class UIODesign:
     target_gain : ``max_ω ‖G_r,target(jω)‖`` (internal form).
     decoupling : per decoupled input and control, ``max_ω ‖G_r,input‖ / target_gain`` (≈ 1e-15 when exact).
     notes : remarks of the design (partial pole placement, fixed modes kept).
+    model : the FaultModel the design was made for (keyword-only; set by :func:`uio`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit import FaultModel
+    >>> m = FaultModel(A=np.diag([-1.0, -2.0, -3.0]), C=np.eye(3), Bu=[[1.0], [1.0], [0.0]]).with_sensor_faults(["y0"])
+    >>> d = uio(m, "y0_sensor", poles=[-4.0, -5.0, -6.0])
+    >>> d.target, d.fixed_modes.size, sorted(d.poles.real.round(6).tolist())
+    ('y0_sensor', 0, [-6.0, -5.0, -4.0])
+
+    References
+    ----------
+    Murray 2012, §1.1.1, Remark 2.4 (the single-fault filter this UIO implements).
     """
 
     generator: ResidualGenerator
@@ -137,16 +151,49 @@ def unknown_input_matrix(
 ) -> tuple[np.ndarray, dict[str, slice]]:
     """Unknown-input directions ``E`` of named faults (and of every disturbance) as state inputs.
 
-    Returns ``E`` (n x k) and, per input name, its column slice.  See the module docstring
-    for the sensor-fault substitution ``[F¹, A F¹ − b]``.
+    See the module docstring for the sensor-fault substitution ``[F¹, A F¹ − b]``.
+
+    Parameters
+    ----------
+    model : FaultModel
+        The plant with fault inputs (group ``f``).
+    faults : str or sequence of str
+        Fault inputs of the model to treat as unknown inputs (default none).
+    disturbances : bool
+        Also append every disturbance column ``Bd`` (default True).
+    rtol : float
+        Relative tolerance of ``‖C F¹ − d‖ ≤ rtol ‖d‖`` for a fault that reaches the outputs (default 1e-9).
+
+    Returns
+    -------
+    E : (n, k) array
+        Unknown-input directions: one column per state fault or disturbance, two (``[F¹, A F¹ − b]``)
+        per fault that reaches the outputs.
+    where : dict of str to slice
+        Per input name, its columns of ``E``.
 
     Raises
     ------
+    ParameterError
+        When ``model`` is not a FaultModel or ``rtol`` is negative.
     ModelError
         For an unknown fault name.
     DesignError
         For a fault whose output direction is not in the range of ``C``, or a disturbance
         with ``Dd ≠ 0``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit import FaultModel
+    >>> m = FaultModel(A=np.diag([-1.0, -2.0]), C=np.eye(2)).with_sensor_faults(["y0"])
+    >>> E, where = unknown_input_matrix(m, ["y0_sensor"])
+    >>> E.tolist(), where
+    ([[1.0, -1.0], [0.0, 0.0]], {'y0_sensor': slice(0, 2, None)})
+
+    References
+    ----------
+    Douglas et al. 1996, §3.1, (3.4)–(3.5) (sensor fault as the state-fault pair ``[F¹, A F¹]``).
     """
     validate.instance("model", model, FaultModel)
     rtol = validate.non_negative("rtol", rtol)
@@ -306,6 +353,10 @@ def uio(
     >>> d = uio(m, "y2_sensor", nuisance="others", poles=[-4.0, -5.0, -6.0])
     >>> d.generator.residuals, d.decoupling["y0_sensor"] < 1e-12, d.decoupling["u"] < 1e-12
     (('y2_sensor[0]', 'y2_sensor[1]'), True, True)
+
+    References
+    ----------
+    Murray 2012, §1.1.1, Remark 2.4; Douglas et al. 1996, §3.1, (3.4)–(3.5) (sensor-fault directions).
     """
     import control
 
@@ -453,6 +504,10 @@ def uio_bank(
 ) -> list[UIODesign]:
     """A bank of UIOs (generalised observer scheme): one per fault, each decoupled from the others.
 
+    Stack the bank into one generator with ``stack_generators([d.generator for d in bank])``
+    (:func:`~fdikit.residuals.stack_generators`).  Unlike a Beard–Jones bank, no mutual
+    detectability is needed (Murray 2012, §1.1): each UIO only needs its own rank and zero conditions.
+
     Parameters
     ----------
     model : FaultModel
@@ -463,9 +518,32 @@ def uio_bank(
         that are neither targets nor nuisance are neither targeted nor decoupled.
     poles : passed to every :func:`uio` (``None``: each design's default).
 
-    Stack the bank into one generator with ``stack_generators([d.generator for d in bank])``.
-    Unlike a Beard–Jones bank, no mutual detectability is needed (Murray 2012, §1.1): each
-    UIO only needs its own rank and zero conditions.
+    Returns
+    -------
+    list of UIODesign
+        One design per target, in the order of ``targets``.
+
+    Raises
+    ------
+    ParameterError
+        A signal name instead of a fault name, or ``nuisance=None``; and what :func:`uio` raises.
+    ModelError
+        A model without fault inputs, or an unknown fault name.
+    DesignError
+        A member that cannot be designed (the message names its target and gives :func:`uio`'s reason).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit import FaultModel
+    >>> m = FaultModel(A=np.diag([-1.0, -2.0, -3.0]), C=np.eye(3)).with_sensor_faults(["y0", "y2"])
+    >>> bank = uio_bank(m, poles=[-4.0, -5.0, -6.0])
+    >>> [(d.target, d.decoupled) for d in bank]
+    [('y0_sensor', ('y2_sensor',)), ('y2_sensor', ('y0_sensor',))]
+
+    References
+    ----------
+    Murray 2012, §1.1.1, Remark 2.4.
     """
     faults = model.faults if targets is None else linalg.check_fault_inputs(model, targets, "target")
     if not faults:
