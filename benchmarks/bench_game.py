@@ -18,9 +18,10 @@ import control
 import numpy as np
 import scipy.linalg
 
-from fdikit.design.game.continuous import game_filter, game_filter_bank, single_fault_game_filter
+from fdikit.design.game.multi_fault import game_filter
 from fdikit.design.game.reduced_order import goh_detector
 from fdikit.design.game.riccati import solve_game_are
+from fdikit.design.game.single_fault import game_filter_bank, single_fault_game_filter
 from fdikit.plants.f16xl import f16xl_longitudinal
 from fdikit.plants.path_longitudinal import path_longitudinal_7, path_longitudinal_7_fault_maps
 from timing import best

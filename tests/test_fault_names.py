@@ -13,9 +13,10 @@ import pytest
 from fdikit import FaultModel
 from fdikit import linalg as la
 from fdikit.analysis.gains import fault_to_residual_gain, fdi_report
-from fdikit.design.game.continuous import game_filter, game_filter_bank, single_fault_game_filter
+from fdikit.design.game.multi_fault import game_filter
 from fdikit.design.game.reduced_order import goh_detector
 from fdikit.design.game.setup import game_problem
+from fdikit.design.game.single_fault import game_filter_bank, single_fault_game_filter
 from fdikit.design.game.time_varying import ltv_game_filter
 from fdikit.design.observers.beard_jones import beard_jones, restricted_diagonal
 from fdikit.design.observers.detection_gain import detection_gain_family

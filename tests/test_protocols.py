@@ -93,21 +93,21 @@ def _enhancement():
 
 
 def _single_game():
-    from fdikit.design.game.continuous import single_fault_game_filter
+    from fdikit.design.game.single_fault import single_fault_game_filter
 
     m = white_speyer("stable-zero")
     return single_fault_game_filter(m, "f1", ["f2"], gamma=1e-6, Q=0.002, M=0.05), m
 
 
 def _game_bank():
-    from fdikit.design.game.continuous import game_filter_bank
+    from fdikit.design.game.single_fault import game_filter_bank
 
     m = white_speyer("stable-extra-zero")
     return game_filter_bank(m, ["f1", "f2"], Q=1e-3, M=0.05), m
 
 
 def _game():
-    from fdikit.design.game.continuous import game_filter
+    from fdikit.design.game.multi_fault import game_filter
 
     m = white_speyer("stable-extra-zero")
     return game_filter(m, ["f1", "f2"], M=0.05, Q={"f1": 1e-3, "f2": 2e-3}, K=0.1, N=1.0), m

@@ -26,9 +26,10 @@ import numpy as np
 import pytest
 
 from fdikit import FaultModel
-from fdikit.design.game.continuous import game_filter, game_filter_bank, single_fault_game_filter
 from fdikit.design.game.discrete import dgtfdf, dgtmfdf, discrete_game_setup
+from fdikit.design.game.multi_fault import game_filter
 from fdikit.design.game.reduced_order import goh_detector, goh_filter
+from fdikit.design.game.single_fault import game_filter_bank, single_fault_game_filter
 from fdikit.design.observers.beard_jones import beard_jones, restricted_diagonal
 from fdikit.design.observers.full_order import kalman, observer
 from fdikit.design.observers.hinf import hinf_detection_filter

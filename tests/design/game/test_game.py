@@ -13,10 +13,11 @@ import pytest
 import scipy.linalg
 import scipy.signal
 
-from fdikit.design.game.continuous import game_filter, game_filter_bank, single_fault_game_filter
 from fdikit.design.game.discrete import DiscreteGtfdfDesign
+from fdikit.design.game.multi_fault import game_filter
 from fdikit.design.game.riccati import game_cost, game_riccati, solve_game_are
 from fdikit.design.game.setup import game_problem
+from fdikit.design.game.single_fault import game_filter_bank, single_fault_game_filter
 from fdikit.errors import DesignError, ParameterError
 from fdikit.linalg import resolve_faults
 from fdikit.plants.f16xl import f16xl_longitudinal

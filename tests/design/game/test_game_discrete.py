@@ -9,7 +9,6 @@ import pytest
 import scipy.linalg
 
 from fdikit import FaultModel
-from fdikit.design.game.continuous import game_filter, single_fault_game_filter
 from fdikit.design.game.discrete import (
     DiscreteGtfdfDesign,
     DiscreteGtmfdfDesign,
@@ -21,7 +20,9 @@ from fdikit.design.game.discrete import (
     gain_update,
     secondary_cost,
 )
+from fdikit.design.game.multi_fault import game_filter
 from fdikit.design.game.setup import game_problem
+from fdikit.design.game.single_fault import single_fault_game_filter
 from fdikit.errors import DesignError, ParameterError
 from fdikit.plants.f16xl import f16xl_longitudinal
 from fdikit.plants.white_speyer import white_speyer

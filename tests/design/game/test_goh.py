@@ -4,7 +4,7 @@ Oracles: the minimal (C, A)-invariant subspace recursion (``fdikit.linalg.caisa`
 equation as printed in Douglas et al. 1996 (9.44) and Murray 2012 (4.69), coded here independently of
 the solver's Murray (4.33) form; PATH's reduced filter (9.62)–(9.63); eigenvalues printed by Murray 2012
 Remarks 6.3/6.4/6.6/6.8 (the single-fault GTFDF at γ = 1e−6, whose slow poles tend to the limit filter's);
-the full-order game filter of ``fdikit.design.game.continuous`` at small γ; exact decoupling via the internal form.
+the full-order game filter of ``fdikit.design.game.single_fault`` at small γ; exact decoupling via the internal form.
 """
 
 from __future__ import annotations
@@ -14,9 +14,9 @@ import pytest
 import scipy.linalg
 
 from fdikit import FaultModel, linalg
-from fdikit.design.game.continuous import single_fault_game_filter
 from fdikit.design.game.goh import goh_riccati, goh_riccati_transient, goh_transformation, oblique_projector
 from fdikit.design.game.reduced_order import goh_detector, goh_filter
+from fdikit.design.game.single_fault import single_fault_game_filter
 from fdikit.errors import DesignError, ParameterError
 from fdikit.linalg import resolve_faults
 from fdikit.plants.f16xl import f16xl_longitudinal

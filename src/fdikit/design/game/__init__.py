@@ -5,8 +5,10 @@ discrete and time-varying filters, and the γ → 0 limit (Goh transformation, r
   theoretic filters.
 * :mod:`fdikit.design.game.riccati` — Indefinite (H∞-type) algebraic Riccati equations of the game-theoretic
   detection filters.
-* :mod:`fdikit.design.game.continuous` — Continuous steady-state game-theoretic (disturbance-attenuation) detection
-  filters.
+* :mod:`fdikit.design.game.single_fault` — Single-fault game-theoretic detection filter (GTFDF) and the bank of them
+  (steady state; a discrete model runs Murray 2012, Ch. 5).
+* :mod:`fdikit.design.game.multi_fault` — Multiple-fault game-theoretic detection filter (GTMFDF): one gain for all
+  targets (steady state; a discrete model runs Murray 2012, Ch. 5).
 * :mod:`fdikit.design.game.discrete` — Discrete-time game-theoretic detection filters: DGTFDF and DGTMFDF (Murray
   2012, Ch. 5).
 * :mod:`fdikit.design.game.time_varying` — Finite-horizon, time-varying game-theoretic detection filters (Murray
@@ -28,9 +30,11 @@ __getattr__, __dir__, __all__ = lazy.attach(
         "riccati": [
             "RiccatiSolution", "game_cost", "game_riccati", "hamiltonian_margin", "solve_game_are",
         ],
-        "continuous": [
-            "GameBankDesign", "GameDesign", "SingleFaultGameDesign", "game_filter", "game_filter_bank",
-            "single_fault_game_filter",
+        "single_fault": [
+            "GameBankDesign", "SingleFaultGameDesign", "game_filter_bank", "single_fault_game_filter",
+        ],
+        "multi_fault": [
+            "GameDesign", "game_filter",
         ],
         "discrete": [
             "DiscreteGameSetup", "DiscreteGtfdfDesign", "DiscreteGtmfdfDesign", "GameRiccatiSolution", "dgtfdf",

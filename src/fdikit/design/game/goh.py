@@ -39,7 +39,7 @@ driven negative and blows up in finite time (the ill-conditioning warned of at t
 
 Weights: ``V`` is Murray's ``V = V̄/γ`` held fixed as γ → 0, which is PATH's ``V̄`` of (9.35)
 (PATH defines ``V̄ = lim γV`` but uses ``V̄⁻¹ = lim γ V⁻¹``; with ``V_PATH = ν I`` it is ``ν/γ``, 0.8 in
-§9.6 — the same number as the ``V`` argument of :func:`fdikit.design.game.continuous.single_fault_game_filter`).
+§9.6 — the same number as the ``V`` argument of :func:`fdikit.design.game.single_fault.single_fault_game_filter`).
 ``Q`` weights ``Ĥ C e``.  ``Ψ ≥ 0`` (e.g. scalar ``Q ≤ 1/V``) guarantees a solution; otherwise it is
 an indefinite (H∞-type) equation that may have none.
 """

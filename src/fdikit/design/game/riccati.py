@@ -23,7 +23,7 @@ symplectic diagonal balancing of ``A``, followed by Newton refinement steps (Lya
 a residual check.
 
 The module also holds the per-target Riccati solution for a given gain (:func:`game_riccati`) and the
-GTMFDF cost with its analytic gradient (:func:`game_cost`) that :func:`fdikit.design.game.continuous.game_filter`
+GTMFDF cost with its analytic gradient (:func:`game_cost`) that :func:`fdikit.design.game.multi_fault.game_filter`
 minimises.
 """
 
