@@ -78,6 +78,20 @@ class BeardJonesDesign:
     left_eigenvectors : ``𝒱`` (n x n, complex in general), columns in the order of ``order``.
     order : the eigenvalue of each column of ``𝒱``.
     sigma, sigma_bound : ``σ(𝒱)`` and the upper bounds ``σ([V_ij])`` (report (4.3)/(4.8)).
+    model : the FaultModel the design was made for (keyword-only; set by the design function).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit import FaultModel
+    >>> m = FaultModel(A=np.diag([-1.0, -2.0, -3.0]), C=np.eye(3), Bf=[[1.0, 0], [0, 1.0], [0, 0]], faults=["f1", "f2"])
+    >>> d = beard_jones(m, ["f1", "f2"], {"f1": [-4.0], "f2": [-5.0]}, [-6.0])
+    >>> d.generator.residuals, np.allclose(d.report_gain, -d.gain), round(d.condition_number, 6)
+    (('f1[0]', 'f2[0]'), True, 1.0)
+
+    References
+    ----------
+    Douglas et al. 1996, App. B, Alg. B.1, (b.10), (b.12); §4.2.1, (4.3).
     """
 
     generator: ResidualGenerator
@@ -305,7 +319,8 @@ def beard_jones(
         :class:`ParameterError`.
     poles : for each fault, ``ν_i = dim T_i`` distinct eigenvalues of ``A − L C`` (Ξ_i).
     complement_poles : the ``ν_0 = n − Σ ν_i`` remaining eigenvalues (Ξ_0).
-    sweeps, seed : eigenvector selection (sweep limit, seeded start).
+    sweeps, seed : eigenvector selection (sweep limit, default 100; seed of the random start, default 0).
+    rtol : relative rank tolerance of the subspace computations (default ``None``: fdikit.linalg's default).
 
     Returns
     -------
@@ -320,7 +335,23 @@ def beard_jones(
         its set; a set of the wrong size, unstable, not self-conjugate or repeated; an
         eigenvalue that admits no left eigenvector.
     ParameterError
-        A bad argument: not a FaultModel, poles that are not finite numbers, negative sweeps.
+        A bad argument: not a FaultModel, ``poles`` not a mapping or keyed by a non-target, poles that are not
+        finite numbers, negative ``sweeps``/``seed``/``rtol``, a bare signal name.
+    ModelError
+        A name that is not a fault of the model.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit import FaultModel
+    >>> m = FaultModel(A=np.diag([-1.0, -2.0, -3.0]), C=np.eye(3), Bf=[[1.0, 0], [0, 1.0], [0, 0]], faults=["f1", "f2"])
+    >>> d = beard_jones(m, ["f1", "f2"], {"f1": [-4.0], "f2": [-5.0]}, complement_poles=[-6.0])
+    >>> {k: T.shape[1] for k, T in d.detection_spaces.items()}, np.sort(d.poles.real).round(6).tolist()
+    ({'f1': 1, 'f2': 1}, [-6.0, -5.0, -4.0])
+
+    References
+    ----------
+    Douglas et al. 1996, App. B, Alg. B.1, (b.9)–(b.12); §4.2.1, (4.3).
     """
     validate.integer("sweeps", sweeps, minimum=0)
     validate.integer("seed", seed, minimum=0)
@@ -373,6 +404,30 @@ class RestrictedDiagonalDesign:
 
     ``filters[name]`` is the single-group design whose nuisance detection space ``T̂_i``
     (minimal UOS of all other faults together) is invariant; ``generator`` stacks them.
+
+    Attributes
+    ----------
+    generator : ResidualGenerator
+        The stacked bank; residuals ``<target>[k]``, each tied to its target.
+    filters : dict of str to BeardJonesDesign
+        Per target, its filter (``gain`` is the observer gain of ``A − L C``).
+    nuisance_spaces : dict of str to (n, k) array
+        Per target, an orthonormal basis of ``T̂_i``.
+    model : FaultModel or None
+        The model the design was made for (keyword-only; set by :func:`restricted_diagonal`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit import FaultModel
+    >>> m = FaultModel(A=np.diag([-1.0, -2.0, -3.0]), C=np.eye(3), Bf=[[1.0, 0], [0, 1.0], [0, 0]], faults=["f1", "f2"])
+    >>> rd = restricted_diagonal(m, ["f1", "f2"], poles=[-4.0, -5.0, -6.0])
+    >>> list(rd.filters), {k: T.shape for k, T in rd.nuisance_spaces.items()}
+    (['f1', 'f2'], {'f1': (3, 1), 'f2': (3, 1)})
+
+    References
+    ----------
+    Douglas et al. 1996, App. A.4, (a.10)–(a.11).
     """
 
     generator: ResidualGenerator
@@ -416,12 +471,43 @@ def restricted_diagonal(
     ``F_i``.  Unlike :func:`beard_jones` this needs neither mutual detectability nor
     ``Σ ν_i ≤ n`` — only that each target stays visible: ``C T_i ⊄ C T̂_i``.
 
-    ``targets``: at least two fault names (as in :func:`beard_jones`) or a mapping name → ``F``;
-    each is the target of one filter and a complementary (nuisance) fault of all the others.
+    Parameters
+    ----------
+    model : FaultModel (continuous or discrete).
+    targets : at least two fault names (as in :func:`beard_jones`) or a mapping name → ``F``;
+        each is the target of one filter and a complementary (nuisance) fault of all the others.
+    poles : n stable, distinct, self-conjugate eigenvalues of ``A − L C`` used by every filter;
+        the first ``dim T̂_i`` go to the nuisance space (keep conjugate pairs adjacent).
+    sweeps, seed, rtol : as in :func:`beard_jones`.
 
-    ``poles``: n stable, distinct, self-conjugate eigenvalues of ``A − L C`` used by every filter;
-    the first ``dim T̂_i`` go to the nuisance space (keep conjugate pairs adjacent).  Each filter's
-    ``gain`` is the observer gain (``A − L C``), as in :func:`beard_jones`.
+    Returns
+    -------
+    RestrictedDiagonalDesign
+        One filter per target and their stack; each filter's ``gain`` is the observer gain (``A − L C``).
+
+    Raises
+    ------
+    DesignError
+        Fewer than two targets; nuisance faults that fill the state space or hide a target
+        (``C T_i ⊆ C T̂_i``); a conjugate pair split at ``dim T̂_i``; poles unstable, repeated or
+        not self-conjugate; an eigenvalue that admits no left eigenvector.
+    ParameterError
+        Not ``n`` finite poles, a negative ``sweeps``, a bare signal name.
+    ModelError
+        A name that is not a fault of the model.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit import FaultModel
+    >>> m = FaultModel(A=np.diag([-1.0, -2.0, -3.0]), C=np.eye(3), Bf=[[1.0, 0], [0, 1.0], [0, 0]], faults=["f1", "f2"])
+    >>> rd = restricted_diagonal(m, ["f1", "f2"], poles=[-4.0, -5.0, -6.0])
+    >>> rd.generator.residuals
+    ('f1[0]', 'f1[1]', 'f2[0]', 'f2[1]')
+
+    References
+    ----------
+    Douglas et al. 1996, App. A.4, (a.10)–(a.11); App. B, Alg. B.1.
     """
     maps = resolve_faults(model, targets)
     if len(maps) < 2:
