@@ -39,6 +39,19 @@ class GameProblem:
     complementary : ``F̂_i`` by target name.
     projectors : ``Ĥ_i`` (p x p, symmetric, idempotent, kernel ``C Ŵ_i*``) by target name.
     invariant_subspaces : orthonormal basis of ``Ŵ_i*`` by target name.
+
+    Made by :func:`game_problem`; :attr:`names` gives the target names in design order.
+
+    Examples
+    --------
+    >>> from fdikit.plants.white_speyer import white_speyer
+    >>> prob = game_problem(white_speyer(), ["f1", "f2"])
+    >>> prob.names, prob.complementary["f1"].shape, prob.nuisance.shape
+    (('f1', 'f2'), (3, 1), (3, 0))
+
+    References
+    ----------
+    Murray 2012, §2.1.1 and §3.1.1, (3.10).
     """
 
     model: FaultModel
@@ -59,7 +72,37 @@ def weight(name: str, value, dim: int) -> np.ndarray:
     """A symmetric positive (semi)definite design weight as a ``dim x dim`` matrix.
 
     A scalar means ``value · I``; a vector a diagonal; a matrix is checked for shape and
-    symmetry.  Raises :class:`DesignError` naming the weight when it is not usable.
+    symmetry.
+
+    Parameters
+    ----------
+    name : str
+        Name of the weight in the error messages (``'Q'``, ``'M'``, ``'V'``, …).
+    value : float, (dim,) array or (dim, dim) array
+        The weight: a scalar (``value · I``), the diagonal, or the full symmetric matrix.
+    dim : int
+        Its size.
+
+    Returns
+    -------
+    numpy.ndarray
+        The (dim, dim) symmetric weight.
+
+    Raises
+    ------
+    ParameterError
+        A wrong number of diagonal entries or shape, non-finite entries, an asymmetric matrix, or a
+        negative eigenvalue (beyond rounding).
+
+    Examples
+    --------
+    >>> weight("Q", [1.0, 2.0], 2)
+    array([[1., 0.],
+           [0., 2.]])
+
+    References
+    ----------
+    Murray 2012, §3.1.1, (3.11).
     """
     W = validate.as_array(f"weight {name}", value, finite=False)
     if W.ndim == 0:
@@ -85,8 +128,40 @@ def per_target(name: str, value, targets: GameProblem | Sequence[str], given: Se
     ``targets`` is a :class:`GameProblem` (its target names) or the target names.  A mapping may be keyed by the
     target names or by the names the caller wrote, ``given`` (aligned with the target names: the ``targets=``
     argument of the design as given).  A key that names no target, or a target without a key, is a
-    :class:`ParameterError` naming the weight and the targets.  The values are returned as given (check them
-    with :func:`weight`).
+    :class:`~fdikit.errors.ParameterError` naming the weight and the targets.  The values are returned as given
+    (check them with :func:`weight`).
+
+    Parameters
+    ----------
+    name : str
+        Name of the weight in the error messages.
+    value : object or mapping
+        One weight for every target, or a mapping target name → weight.
+    targets : GameProblem or sequence of str
+        The problem (its target names) or the target names, in design order.
+    given : sequence of str, optional
+        The target names as the caller wrote them, aligned with ``targets`` (accepted as keys too).
+
+    Returns
+    -------
+    dict
+        Target name → weight, in target order.
+
+    Raises
+    ------
+    ParameterError
+        A mapping key that names no target, or a target without a key.
+
+    Examples
+    --------
+    >>> per_target("Q", {"f2": 2e-3, "f1": 1e-3}, ["f1", "f2"])
+    {'f1': 0.001, 'f2': 0.002}
+    >>> per_target("M", 0.01, ["f1", "f2"])
+    {'f1': 0.01, 'f2': 0.01}
+
+    References
+    ----------
+    Murray 2012, §3.2.3, (3.27)–(3.28) (one ``Q_i``, ``M_i``, ``K_i``, ``N_i`` per target).
     """
     names = list(targets.names if isinstance(targets, GameProblem) else targets)
     if not isinstance(value, Mapping):
@@ -128,12 +203,19 @@ def game_problem(
     rtol : float, optional
         Relative rank tolerance of the subspace computations.
 
+    Returns
+    -------
+    GameProblem
+        The target maps ``F_i``, the nuisance ``F̂``, and by target the complementary faults ``F̂_i``,
+        the subspaces ``Ŵ_i*`` and the projectors ``Ĥ_i``.
+
     Raises
     ------
+    ParameterError
+        If there is no target (and, from the name resolution, an unknown or bare signal name).
     DesignError
-        If there is no target, a name is both target and nuisance, or a target is
-        hidden by its complementary faults (``Ĥ_i C F_i = 0``: not output separable,
-        Murray Assumption 3.2).
+        If a name is both target and nuisance, or a target is hidden by its complementary faults
+        (``Ĥ_i C W_i* = 0``: not output separable, Murray Assumption 3.2).
 
     Examples
     --------
@@ -141,6 +223,10 @@ def game_problem(
     >>> prob = game_problem(white_speyer(), ["f1", "f2"])
     >>> [int(round(float(np.trace(H)))) for H in prob.projectors.values()]
     [1, 1]
+
+    References
+    ----------
+    Murray 2012, §2.1.1–2.1.2, (2.4)–(2.11), and §3.1.1, (3.10); Douglas et al. 1996, Ch. 9.
     """
     T = resolve_faults(model, targets)
     N = resolve_nuisance(model, nuisance, list(T))
