@@ -51,6 +51,19 @@ class DetectionGainFamily:
     projectors : ``C W_i F̂_i H_i`` (p x p), the (oblique) projection onto ``C W_i``.
     base_gain : the observer gain ``Σ A W_i F̂_i H_i`` (``A − base_gain C`` = the report's ``Â = A + L̂C``;
         the report's (c.17h) ``L̂ = −Σ A W_i F̂_i H_i`` is its negative).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.plants.f16xl import f16xl_gust
+    >>> fam = detection_gain_family(f16xl_gust(), ["y_Az_sensor", "elevon_actuator"])
+    >>> L = fam.gain({"y_Az_sensor": -np.eye(2), "elevon_actuator": [[-2.0]]})
+    >>> fam.names, fam.coordinates.shape, max(fam.invariance_defect(L).values()) < 1e-9
+    (('y_Az_sensor', 'elevon_actuator'), (4, 4), True)
+
+    References
+    ----------
+    Douglas et al. 1996, App. C.1, Prop. C.3/C.4, (c.2), (c.7), (c.17).
     """
 
     A: np.ndarray
@@ -135,13 +148,22 @@ def detection_gain_family(
     targets : fault names resolved by :func:`fdikit.linalg.resolve_faults` (``'<output>_sensor'`` is
         the sensor fault ``[F¹, A F¹]`` with ``C F¹ = e_i``, ``'<control>_actuator'`` a column of ``Bu``),
         or a mapping name → fault map ``F``.
-    rtol : relative rank tolerance of the subspace computations.
+    rtol : relative rank tolerance of the subspace computations (default ``None``: fdikit.linalg's default).
+
+    Returns
+    -------
+    DetectionGainFamily
+        The spaces ``W_i``, projections ``H_i``, ``H_0`` and the base gain; ``gain(alphas, beta)`` gives a member.
 
     Raises
     ------
+    ModelError
+        A discrete model, or a name that is not a fault of the model.
+    ParameterError
+        A bare signal name instead of a fault name.
     DesignError
-        Dependent fault columns, detection spaces that overlap, or images ``C W_i`` that are
-        not independent (not output separable, Def. A.1).
+        No fault given, dependent fault columns, detection spaces that overlap, a fault that does not
+        reach the outputs, or images ``C W_i`` that are not independent (not output separable, Def. A.1).
 
     Examples
     --------
@@ -154,6 +176,10 @@ def detection_gain_family(
     >>> np.round(np.linalg.lstsq(fam.spaces["elevon_actuator"],
     ...          (fam.A - L @ fam.C) @ fam.spaces["elevon_actuator"], rcond=None)[0], 12)
     array([[-2.]])
+
+    References
+    ----------
+    Douglas et al. 1996, App. C.1, Prop. C.3/C.4, (c.2), (c.7).
     """
     if model.is_discrete:
         raise ModelError("the H∞ detection filter of App. C is continuous-time; pass a continuous model")
