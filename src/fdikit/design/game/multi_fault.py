@@ -85,6 +85,19 @@ class GameDesign:
     cost : ``J(gain)`` of (3.27); ``initial_cost`` at ``initial_gain``.
     success, status, message, nit : the optimiser's report (:func:`scipy.optimize.minimize`).
     problem : the :class:`~fdikit.design.game.setup.GameProblem`.
+
+    Made by :func:`game_filter` for a continuous model; ``report()`` gives the same numbers as a dict.
+
+    Examples
+    --------
+    >>> from fdikit.plants.white_speyer import white_speyer
+    >>> d = game_filter(white_speyer("stable-extra-zero"), ["f1", "f2"], M=0.05, Q=1e-3, options={"maxiter": 3})
+    >>> d.gain.shape, sorted(d.riccati), bool(d.cost <= d.initial_cost)
+    ((3, 2), ['f1', 'f2'], True)
+
+    References
+    ----------
+    Murray 2012, §3.2.3, (3.26)–(3.28), Theorem 3.1.
     """
 
     generator: ResidualGenerator
@@ -250,6 +263,10 @@ def game_filter(
     ...                 K=0.1, N={"f1": 5.0, "f2": 10.0})
     >>> d.generator.residuals, bool(d.cost < d.initial_cost)
     (('f1[0]', 'f2[0]'), True)
+
+    References
+    ----------
+    Murray 2012, §3.2.2–3.2.3, (3.26)–(3.28), §6.1.4, Remark 6.2; discrete: Murray 2012, §5.2.2, (5.39).
     """
     if model.is_discrete:
         given = [nm for nm, val in (("eps_stab", eps_stab), ("eps_ham", eps_ham), ("barrier", barrier))

@@ -100,6 +100,19 @@ class SingleFaultGameDesign:
     target : resolved target name.
     problem : the :class:`~fdikit.design.game.setup.GameProblem` (one target).
     solver : ``'care'`` (``V⁻¹ − ĤQĤ + γ(I−Ĥ)R(I−Ĥ) > 0``) or ``'hamiltonian'`` (indefinite).
+
+    Made by :func:`single_fault_game_filter` for a continuous model; ``report()`` gives the same numbers as a dict.
+
+    Examples
+    --------
+    >>> from fdikit.plants.white_speyer import white_speyer
+    >>> d = single_fault_game_filter(white_speyer("stable-extra-zero"), "f1", ["f2"], Q=1e-3, M=0.05)
+    >>> d.target, d.solver, d.gain.shape, d.generator.residuals
+    ('f1', 'care', (3, 2), ('f1[0]',))
+
+    References
+    ----------
+    Murray 2012, §3.3, (3.29)–(3.30).
     """
 
     generator: ResidualGenerator
@@ -207,6 +220,11 @@ def single_fault_game_filter(
     ...                              gamma=1e-6, V=1.0, Q=1e-4, M=0.01)
     >>> np.round(np.sort(d.poles.real), 4)
     array([-100.1401,   -4.1878,   -1.1925])
+
+    References
+    ----------
+    Murray 2012, §3.3, (3.29)–(3.32), Remark 6.8; Douglas et al. 1996, §9.2, (9.4), (9.15)–(9.17), (9.26);
+    discrete: Murray 2012, §5.3, (5.42)–(5.43).
     """
     if model.is_discrete:
         if np.any(weight("R", R, model.p)):
@@ -270,6 +288,20 @@ class GameBankDesign:
     ----------
     generator : the stacked generator (one block of residuals ``"<fault>[k]"`` per filter).
     filters : the single-fault designs by fault name.
+
+    The properties ``gains`` and ``poles`` give each filter's ``L`` (n x p) and eigenvalues of ``A − L C`` by fault
+    name.
+
+    Examples
+    --------
+    >>> from fdikit.plants.white_speyer import white_speyer
+    >>> bank = game_filter_bank(white_speyer("stable-extra-zero"), ["f1", "f2"], Q=1e-3, M=0.05)
+    >>> list(bank.filters), bank.gains["f1"].shape
+    (['f1', 'f2'], (3, 2))
+
+    References
+    ----------
+    Murray 2012, §6.1.1.
     """
 
     generator: ResidualGenerator
@@ -315,12 +347,37 @@ def game_filter_bank(
     value or a mapping fault → value (``M`` is sized to each ``F̂_i``).  A bank does not need mutual
     detectability (Murray 2012, Remark 2.4): each filter forms only one detection space.
 
+    Parameters
+    ----------
+    model : FaultModel
+        The plant, continuous.
+    targets : sequence of str or mapping name → (n, k) array
+        The faults, one filter each (fault names resolved by :func:`fdikit.linalg.resolve_faults`).
+    nuisance : sequence of str, mapping or ``'others'``
+        Faults every filter blocks besides the other targets: ``()`` (default) none.
+    gamma : float
+        Attenuation bound γ > 0 of every filter (default 1e-6).
+    V : float or (p, p) array
+        Murray's ``V = V̄/γ`` (default 1).
+    Q, M : float, array or mapping fault → value
+        Output weight (p x p) and complementary-fault weight (sized to each ``F̂_i``) of each filter (defaults 1e-4
+        and 0.01; scalars mean multiples of I).
+
+    Returns
+    -------
+    GameBankDesign
+        The stacked generator and the single-fault designs by fault name.
+
     Examples
     --------
     >>> from fdikit.plants.white_speyer import white_speyer
     >>> bank = game_filter_bank(white_speyer("stable-extra-zero"), ["f1", "f2"], Q=1e-3, M=0.05)
     >>> bank.generator.residuals
     ('f1[0]', 'f2[0]')
+
+    References
+    ----------
+    Murray 2012, §6.1.1, Remark 2.4; the filters: §3.3, (3.29)–(3.30).
     """
     require_continuous(model)
     prob = game_problem(model, targets, ())
