@@ -213,6 +213,20 @@ class HinfDesign:
     bound : ``(γ² + σ²_max(HD))^½``.
     family : the gain family (detection spaces ``W_i``, maps ``H_i``, projectors, ``L̂``).
     disturbances : names of the inputs that form ``ω``; ``B``, ``D`` their matrices.
+    model : the FaultModel the design was made for (keyword-only; set by :func:`hinf_detection_filter`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.plants.f16xl import f16xl_gust, F16XL_DRYDEN_GAIN
+    >>> m = f16xl_gust(gust_gain=F16XL_DRYDEN_GAIN)
+    >>> d = hinf_detection_filter(m, ["y_Az_sensor", "elevon_actuator"], gamma=1.5)
+    >>> d.generator.residuals, d.form, bool(np.allclose(d.report_gain, -d.gain))
+    (('y_Az_sensor[0]', 'y_Az_sensor[1]', 'elevon_actuator[0]'), 'corrected', True)
+
+    References
+    ----------
+    Douglas et al. 1996, App. C.3, Prop. C.7, (c.17)–(c.18); App. C.5.
     """
 
     generator: ResidualGenerator
@@ -314,10 +328,20 @@ def hinf_detection_filter(
         differential Riccati equation; ``polish`` refines the steady state by Newton's method.
     rtol : relative rank tolerance of the subspace computations.
 
+    Returns
+    -------
+    HinfDesign
+        Generator, observer gain, ``Y``, ``α_i``, the attained ``‖T_zω‖∞`` and its bound.
+
     Raises
     ------
+    ParameterError
+        Not a FaultModel; γ not a positive finite number; an unknown ``form``; ``horizon`` or ``steady_tol``
+        not positive; a ``disturbances`` name that is no ``d``/``w`` input; a bare signal name.
+    ModelError
+        A discrete model, or a name that is not a fault of the model.
     DesignError
-        γ ≤ 0; ``D Dᵀ`` singular; ``Â − B̂D₂₁ᵀV⁻¹C₂`` with imaginary-axis eigenvalues (Prop. C.7);
+        No ``d``/``w`` input; ``D Dᵀ`` singular; ``Â − B̂D₂₁ᵀV⁻¹C₂`` with imaginary-axis eigenvalues (Prop. C.7);
         no stabilising ARE solution to start from; the Riccati flow escapes or does not settle
         (γ too small); ``Y`` not positive definite; an unstable filter; the geometric conditions
         of :func:`detection_gain_family`.
@@ -330,6 +354,10 @@ def hinf_detection_filter(
     >>> d = hinf_detection_filter(m, ["y_Az_sensor", "elevon_actuator"], gamma=1.5)
     >>> bool(d.hinf_norm <= d.bound), bool(np.all(d.poles.real < 0))
     (True, True)
+
+    References
+    ----------
+    Douglas et al. 1996, App. C.3, Prop. C.7, (c.17)–(c.18); Thm. C.5, (c.14) (erratum above).
     """
     validate.instance("model", model, FaultModel)
     gamma = validate.number("gamma", gamma, finite=False)
@@ -400,6 +428,21 @@ class Enhancement:
     direction : unit ``q`` (k_i,); the enhanced scalar residual is ``qᵀ z_i``.
     ratio : ``λ_max`` of (c.25)/(c.26): fault-to-disturbance residual energy ratio along ``q``.
     generator : the scalar residual ``qᵀ z_i`` as a generator (named ``<fault>[q]``).
+    model : the FaultModel of the design (keyword-only; set by :func:`enhancement_direction`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.plants.f16xl import f16xl_gust, F16XL_DRYDEN_GAIN
+    >>> m = f16xl_gust(gust_gain=F16XL_DRYDEN_GAIN)
+    >>> d = hinf_detection_filter(m, ["y_Az_sensor", "elevon_actuator"], gamma=1.5)
+    >>> e = enhancement_direction(d, "y_Az_sensor")
+    >>> e.fault, e.generator.residuals, e.direction.shape
+    ('y_Az_sensor', ('y_Az_sensor[q]',), (2,))
+
+    References
+    ----------
+    Douglas et al. 1996, App. C.4, (c.19)–(c.26).
     """
 
     fault: str
@@ -434,6 +477,39 @@ def enhancement_direction(design: HinfDesign, fault: str) -> Enhancement:
     ``X_0ω``, ``X_0m`` solve ``ĀX + XĀᵀ + e_0e_0ᵀ = 0`` and ``q`` is the eigenvector of the
     largest λ of ``(C̄X_0mC̄ᵀ) q = λ (C̄X_0ωC̄ᵀ) q`` (c.26).  The sign of ``q`` is fixed so that
     its largest entry is positive.
+
+    Parameters
+    ----------
+    design : HinfDesign
+        The result of :func:`hinf_detection_filter`.
+    fault : str
+        One of the design's faults (its residual ``z_i`` is combined).
+
+    Returns
+    -------
+    Enhancement
+        The unit direction ``q``, the energy ratio ``λ_max`` and the scalar residual ``qᵀ z_i``.
+
+    Raises
+    ------
+    ParameterError
+        ``design`` not a HinfDesign, or ``fault`` not one of its faults.
+    DesignError
+        ``C̄X_0ωC̄ᵀ`` singular: (c.26) has no finite maximum.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.plants.f16xl import f16xl_gust, F16XL_DRYDEN_GAIN
+    >>> m = f16xl_gust(gust_gain=F16XL_DRYDEN_GAIN)
+    >>> d = hinf_detection_filter(m, ["y_Az_sensor", "elevon_actuator"], gamma=1.5)
+    >>> e = enhancement_direction(d, "y_Az_sensor")
+    >>> round(float(np.linalg.norm(e.direction)), 6), bool(e.ratio > 0)
+    (1.0, True)
+
+    References
+    ----------
+    Douglas et al. 1996, App. C.4, (c.19)–(c.26).
     """
     validate.instance("design", design, HinfDesign, "pass the result of hinf_detection_filter(...)")
     fam = design.family
