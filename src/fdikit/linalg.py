@@ -37,7 +37,6 @@ __all__ = [
     "intersect",
     "span_sum",
     "contains",
-    "is_stable",
     "sensor_fault_map",
     "actuator_fault_map",
     "sensor_fault_map_tv",
@@ -145,22 +144,6 @@ def contains(U: np.ndarray, x: np.ndarray, rtol: float = 1e-8) -> bool:
 
 
 # ---------------------------------------------------------------------- fault maps
-def is_stable(lam, discrete: bool, margin: float = 0.0) -> np.ndarray:
-    """Which eigenvalues ``lam`` are stable, with a stability ``margin`` (>= 0): ``|λ| < 1 − margin`` when
-    ``discrete``, ``Re λ < −margin`` otherwise (a boolean array of the shape of ``lam``).
-
-    Examples
-    --------
-    >>> from fdikit.linalg import is_stable
-    >>> is_stable([-1.0, 0.0, 1j - 0.5], discrete=False).tolist()
-    [True, False, True]
-    >>> is_stable([0.5, 0.95], discrete=True, margin=0.1).tolist()
-    [True, False]
-    """
-    lam = np.asarray(lam, dtype=complex)
-    return np.abs(lam) < 1 - margin if discrete else lam.real < -margin
-
-
 def sensor_fault_map(model: FaultModel, output: str, direction: str = "both", rtol: float = 1e-9) -> np.ndarray:
     """State-space fault map of an additive fault on the sensor of ``output``.
 

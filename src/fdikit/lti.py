@@ -18,7 +18,37 @@ import numpy as np
 from fdikit import validate
 from fdikit.errors import DataError
 
-__all__ = ["dlsim_blocked", "lifted_matrices"]
+__all__ = ["dlsim_blocked", "is_stable", "lifted_matrices"]
+
+
+def is_stable(lam, discrete: bool, margin: float = 0.0) -> np.ndarray:
+    """Which eigenvalues are stable, with a stability margin.
+
+    Parameters
+    ----------
+    lam : array_like of complex
+        Eigenvalues (poles) of a state matrix.
+    discrete : bool
+        ``True`` for a discrete-time matrix (stable: ``|λ| < 1 − margin``), ``False`` for a
+        continuous-time one (stable: ``Re λ < −margin``).
+    margin : float, default 0.0
+        Distance required inside the stability boundary (0: strict stability).
+
+    Returns
+    -------
+    numpy.ndarray of bool
+        One entry per eigenvalue, of the shape of ``lam``.
+
+    Examples
+    --------
+    >>> from fdikit.lti import is_stable
+    >>> is_stable([-1.0, 0.0, 1j - 0.5], discrete=False).tolist()
+    [True, False, True]
+    >>> is_stable([0.5, 0.95], discrete=True, margin=0.1).tolist()
+    [True, False]
+    """
+    lam = np.asarray(lam, dtype=complex)
+    return np.abs(lam) < 1 - margin if discrete else lam.real < -margin
 
 
 def lifted_matrices(A: np.ndarray, B: np.ndarray, M: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

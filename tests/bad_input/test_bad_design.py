@@ -185,7 +185,7 @@ CASES = [
     case("isolator-step-nan", lambda: SteeringFaultIsolator(5).step("x", 1.0), DataError, "residual", "number"),
     case("ltv-gamma-string", lambda: ltv_game_filter(_ltv(), "f1", ["f2"], [0.0, 1.0], gamma="small"),
          ParameterError, "gamma", "number"),
-    case("ltv-target-unknown", lambda: ltv_game_filter(_ltv(), "f9", ["f2"], [0.0, 1.0], gamma=1e-3), ModelError,
+    case("ltv-target-unknown", lambda: ltv_game_filter(_ltv(), "f9", ["f2"], [0.0, 1.0], gamma=1e-3), ParameterError,
          "f9"),
     case("ltv-grid-nan", lambda: ltv_game_filter(_ltv(), "f1", ["f2"], [0.0, np.nan], gamma=1e-3), ParameterError,
          "time grid t", "finite"),

@@ -10,20 +10,18 @@ import pytest
 from filterpy.kalman import KalmanFilter
 
 from fdikit.errors import DataError, ModelError, ParameterError
-from fdikit.multimodel.convex import (
-    convex_model_set,
-    dual_convex_filter,
+from fdikit.multimodel.convex import convex_model_set
+from fdikit.multimodel.convex_ekf import augmented_ekf, augmented_jacobians
+from fdikit.multimodel.convex_filter import dual_convex_filter, rls_weight_step, weight_regressors
+from fdikit.multimodel.kalman_steps import srcf_step
+from fdikit.multimodel.model_set import nearest_model
+from fdikit.multimodel.reconstruction import (
     estimated_model_vector,
     fault_size_from_weights,
     lv_parameter,
     lv_reciprocal_parameter,
-    project_to_simplex,
-    rls_weight_step,
-    weight_regressors,
 )
-from fdikit.multimodel.convex_ekf import augmented_ekf, augmented_jacobians
-from fdikit.multimodel.kalman_steps import srcf_step
-from fdikit.multimodel.model_set import nearest_model
+from fdikit.multimodel.simplex import project_to_simplex
 
 
 def _random_set(rng, N=3, n=3, m=2, p=2):
@@ -120,7 +118,7 @@ def test_weight_regressors_give_the_cost_2_27():
     assert np.isclose(np.sum((Phi @ mu - Gam) ** 2), J, rtol=1e-12)
     Phi2, Gam2 = weight_regressors(ms, xp, up, x, u, y, weighting="inverse")
     assert np.allclose(Phi2[:3] @ mu - Gam2[:3], -np.linalg.solve(ms.Q, ex))
-    with pytest.raises(ModelError, match="weighting"):
+    with pytest.raises(ParameterError, match="weighting"):
         weight_regressors(ms, xp, up, x, u, y, weighting="Q^-1/4")
 
 
@@ -213,7 +211,7 @@ def test_lv_maps_3_54_to_3_57():
     inv_m3 = 1 / lv_reciprocal_parameter(mu, 1.8, 0.2)
     assert np.allclose(inv_m3, 1 / 1.8 + mu * (1 / 0.2 - 1 / 1.8), atol=1e-12)  # A^+ + μ A^{m3} entries
     assert np.allclose(lv_parameter(mu, 1.0, 0.0), 1 - mu)  # (3.56)–(3.57)
-    with pytest.raises(ModelError, match="positive"):
+    with pytest.raises(ParameterError, match="positive"):
         lv_reciprocal_parameter(0.5, 1.8, 0.0)
 
 
@@ -228,7 +226,7 @@ def test_fault_size_and_nearest_model_reconstruction():
     large = a[:, None] + b[:, None] * grid
     est = estimated_model_vector(np.column_stack([a, a + b]), np.array([[0.7, 0.3], [0.26, 0.74]]))
     assert np.allclose(grid[nearest_model(large, est)], [0.3, 0.75])
-    with pytest.raises(ModelError, match="indices"):
+    with pytest.raises(ParameterError, match="indices"):
         fault_size_from_weights(mu, [6])
 
 
@@ -300,7 +298,7 @@ def test_affine_projection_is_the_equality_projection_2_38():
 def test_innovation_regressors_are_the_whitened_prediction_error():
     """Corrected weight step: ‖Φμ − Γ‖² is the whitened one-step prediction error of the blended model at any μ
     when C, D are common (exact), and to first order in μ − μ̄ when C varies."""
-    from fdikit.multimodel.convex import innovation_regressors
+    from fdikit.multimodel.convex_filter import innovation_regressors
     from fdikit.multimodel.kalman_steps import psd_sqrt
 
     rng = np.random.default_rng(5)

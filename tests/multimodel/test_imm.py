@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from filterpy.kalman import IMMEstimator, KalmanFilter
 
-from fdikit.errors import DataError, ModelError
+from fdikit.errors import DataError, ModelError, ParameterError
 from fdikit.gaussian import LinearGaussianModel
 from fdikit.multimodel.imm import IMMFilter
 from fdikit.trace import Trace
@@ -187,7 +187,7 @@ def test_nan_measurement_is_prediction_only_and_online_equals_batch():
 def test_bad_input_raises_clear_errors():
     s = _system()
     md = LinearGaussianModel(**s)
-    with pytest.raises(ModelError, match="rows summing to 1"):
+    with pytest.raises(ParameterError, match="rows summing to 1"):
         IMMFilter([md, md], [[0.9, 0.2], [0.1, 0.9]])
     with pytest.raises(ModelError, match="share the state"):
         IMMFilter([md, LinearGaussianModel(A=np.eye(2), C=np.eye(2), Q=np.eye(2), R=np.eye(2))], np.eye(2))

@@ -12,7 +12,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from fdikit.errors import ModelError, ParameterError
+from fdikit.errors import ParameterError
 from fdikit.lpv import LPVModel
 from fdikit.plants.varrier_lateral import (
     RHO_STAR,
@@ -33,7 +33,7 @@ def test_parameters_are_the_table_of_section_5_1():
     assert (RHO_STAR, T_D) == (0.048, 0.02)  # §5.3: rho* = 1/20.83 = 0.048; s = 3 samples = 60 ms
     with pytest.raises(dataclasses.FrozenInstanceError):
         p.m = 1.0  # type: ignore[misc]
-    with pytest.raises(ModelError, match="c_V"):
+    with pytest.raises(ParameterError, match="c_V"):
         VarrierParameters(c_V=-57117.0)
 
 

@@ -6,14 +6,15 @@ thesis chooses ``W = I``; Simon & Chia show that ``W = P⁻¹``, the inverse err
 unconstrained estimate, gives the minimum-variance constrained estimate.  For the dual CMF's RLS weight
 step that is ``W = T_kᵀ T_k`` (the information matrix), and it matters when the weight regressors are
 strongly correlated: with ``W = I`` an error in the well-determined sum ``1ᵀμ̂`` is spread evenly over
-the weights instead of along the poorly determined directions (see :func:`fdikit.multimodel.convex.dual_convex_filter`).
+the weights instead of along the poorly determined directions (see
+:func:`fdikit.multimodel.convex_filter.dual_convex_filter`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from fdikit.errors import DataError, ModelError
+from fdikit.errors import DataError, ParameterError
 
 __all__ = ["project_to_simplex", "project_to_simplex_weighted", "project_to_affine", "constrain_weights"]
 
@@ -41,7 +42,7 @@ def project_to_simplex(mu, ordering: str = "michelot") -> np.ndarray:
 
     Raises
     ------
-    ModelError
+    ParameterError
         On an unknown ``ordering``.
     DataError
         If ``mu`` is empty or not finite.
@@ -56,7 +57,7 @@ def project_to_simplex(mu, ordering: str = "michelot") -> np.ndarray:
     Hallouzi 2008, §2.3.2, (2.37)–(2.38) and the inequality step that follows them.
     """
     if ordering not in ("michelot", "thesis"):
-        raise ModelError(f"ordering must be 'michelot' or 'thesis', got {ordering!r}")
+        raise ParameterError(f"ordering must be 'michelot' or 'thesis', got {ordering!r}")
     y = _weights(mu)
     free = np.ones(y.size, dtype=bool)
     if ordering == "thesis":
@@ -98,7 +99,7 @@ def project_to_simplex_weighted(mu, W, ridge: float = 1e-9) -> np.ndarray:
 
     Raises
     ------
-    ModelError
+    ParameterError
         If ``W`` is not a finite N x N matrix, or the active-set loop does not converge (``W`` not PSD).
     DataError
         If ``mu`` is empty or not finite.
@@ -136,7 +137,7 @@ def project_to_simplex_weighted(mu, W, ridge: float = 1e-9) -> np.ndarray:
         if alpha < 1.0:
             block = int(np.argmin(ratios))
             m[block], free[block] = 0.0, False
-    raise ModelError("the weighted simplex projection did not converge; check that W is positive semidefinite")
+    raise ParameterError("the weighted simplex projection did not converge; check that W is positive semidefinite")
 
 
 def project_to_affine(mu, W=None, ridge: float = 1e-9) -> np.ndarray:
@@ -193,7 +194,7 @@ def _metric(W, N: int, ridge: float) -> np.ndarray:
     """Symmetrised ``W`` plus ``ridge · tr(W)/N · I`` (so a singular information matrix still has an inverse)."""
     W = np.asarray(W, dtype=float)
     if W.shape != (N, N) or not np.all(np.isfinite(W)):
-        raise ModelError(f"the projection metric W must be a finite {N} x {N} matrix, got shape {W.shape}")
+        raise ParameterError(f"the projection metric W must be a finite {N} x {N} matrix, got shape {W.shape}")
     W = 0.5 * (W + W.T)
     return W + ridge * max(np.trace(W) / N, np.finfo(float).tiny) * np.eye(N)
 
@@ -230,7 +231,7 @@ def constrain_weights(mu, constrain, W=None, ordering: str = "michelot") -> np.n
 
     Raises
     ------
-    ModelError
+    ParameterError
         On an unknown ``constrain`` (or as the projections).
 
     Examples
@@ -250,4 +251,4 @@ def constrain_weights(mu, constrain, W=None, ordering: str = "michelot") -> np.n
         return project_to_affine(mu, W)
     if constrain == "box":
         return np.clip(_weights(mu), 0.0, 1.0)
-    raise ModelError(f"constrain must be True/'simplex', 'affine', 'box' or False, got {constrain!r}")
+    raise ParameterError(f"constrain must be True/'simplex', 'affine', 'box' or False, got {constrain!r}")

@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from fdikit import validate
-from fdikit.errors import ModelError, ParameterError
+from fdikit.errors import ParameterError
 from fdikit.model import FaultModel
 
 __all__ = [
@@ -198,7 +198,7 @@ def msd_parameter_grid(k1_values=None, m3_values=None, fault_values=None) -> np.
 
     Raises
     ------
-    ModelError
+    ParameterError
         If one of the grids is empty.
 
     References
@@ -216,7 +216,7 @@ def msd_parameter_grid(k1_values=None, m3_values=None, fault_values=None) -> np.
     m3_values = np.linspace(0.2, 1.8, 13) if m3_values is None else np.asarray(m3_values, float).ravel()
     faults = np.linspace(0.0, 1.0, 11) if fault_values is None else np.asarray(fault_values, float).ravel()
     if k1_values.size == 0 or m3_values.size == 0 or faults.size == 0:
-        raise ModelError("msd_parameter_grid needs at least one value for k1, m3 and the fault levels")
+        raise ParameterError("msd_parameter_grid needs at least one value for k1, m3 and the fault levels")
     pairs = [(f, 1.0) for f in faults] + [(1.0, f) for f in faults if f != 1.0]
     if 1.0 not in faults:
         pairs.append((1.0, 1.0))
@@ -245,7 +245,7 @@ def msd_model_vectors(parameters, dt: float | None = MSD_SAMPLE_TIME) -> np.ndar
 
     Raises
     ------
-    ModelError
+    ParameterError
         If ``parameters`` does not have 4 columns.
     ParameterError
         If a parameter is not finite or outside its range (see :func:`msd_matrices`).
@@ -261,7 +261,7 @@ def msd_model_vectors(parameters, dt: float | None = MSD_SAMPLE_TIME) -> np.ndar
     """
     parameters = np.atleast_2d(np.asarray(parameters, float))
     if parameters.shape[1] != 4:
-        raise ModelError(f"parameters must have 4 columns (k1, m3, f1, f2), got shape {parameters.shape}")
+        raise ParameterError(f"parameters must have 4 columns (k1, m3, f1, f2), got shape {parameters.shape}")
     columns = []
     for k1, m3, f1, f2 in parameters:
         A, B, C = msd_matrices(k1, m3, f1, f2)
@@ -291,7 +291,7 @@ def msd_parameters_to_weights(k1: float, m3: float, f1: float, f2: float) -> np.
 
     Raises
     ------
-    ModelError
+    ParameterError
         If ``m3 <= 0``.
 
     References
@@ -305,7 +305,7 @@ def msd_parameters_to_weights(k1: float, m3: float, f1: float, f2: float) -> np.
     """
     (k1lo, k1hi), (m3lo, m3hi) = MSD_RANGES["k1"], MSD_RANGES["m3"]
     if m3 <= 0:
-        raise ModelError(f"m3 must be positive, got {m3}")
+        raise ParameterError(f"m3 must be positive, got {m3}")
     return np.array([
         (k1 - k1hi) / (k1lo - k1hi),
         (1.0 / m3 - 1.0 / m3hi) / (1.0 / m3lo - 1.0 / m3hi),
@@ -332,7 +332,7 @@ def msd_weights_to_parameters(weights) -> tuple[float, float, float, float]:
 
     Raises
     ------
-    ModelError
+    ParameterError
         If ``weights`` does not hold exactly 4 values.
 
     References
@@ -346,7 +346,7 @@ def msd_weights_to_parameters(weights) -> tuple[float, float, float, float]:
     """
     mu = np.asarray(weights, float).ravel()
     if mu.shape != (4,):
-        raise ModelError(f"expected 4 weights (μ_k1, μ_m3, μ_f1, μ_f2), got shape {mu.shape}")
+        raise ParameterError(f"expected 4 weights (μ_k1, μ_m3, μ_f1, μ_f2), got shape {mu.shape}")
     (k1lo, k1hi), (m3lo, m3hi) = MSD_RANGES["k1"], MSD_RANGES["m3"]
     k1 = k1hi + mu[0] * (k1lo - k1hi)
     m3 = m3hi * m3lo / (m3lo + mu[1] * (m3hi - m3lo))

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from fdikit import validate
-from fdikit.errors import ModelError, ParameterError
+from fdikit.errors import ParameterError
 
 __all__ = [
     "TRACKING_MODES",
@@ -95,7 +95,7 @@ def tracking_B(model: str) -> np.ndarray:
 
     Raises
     ------
-    ModelError
+    ParameterError
         If ``model`` is not one of the three modes.
 
     References
@@ -110,7 +110,7 @@ def tracking_B(model: str) -> np.ndarray:
     left = np.sqrt(2.0) * np.array([[-0.25], [-0.5], [0.25], [0.5]])
     table = {"straight": 0.0 * left, "left_turn": left, "right_turn": -left}
     if model not in table:
-        raise ModelError(f"unknown tracking model {model!r}; choose one of {TRACKING_MODES}")
+        raise ParameterError(f"unknown tracking model {model!r}; choose one of {TRACKING_MODES}")
     return table[model]
 
 

@@ -400,7 +400,7 @@ def test_bad_inputs_raise_clear_errors():
         ltv_game_filter(m, "f1", ["f2"], [0.0, 1.0], gamma=0.0)
     with pytest.raises(DesignError, match="both as target and as nuisance"):
         ltv_game_filter(m, "f1", ["f1"], [0.0, 1.0], gamma=1e-3)
-    with pytest.raises(ModelError, match="no fault named 'f3'"):
+    with pytest.raises(ParameterError, match="no fault named 'f3'"):
         ltv_feasibility(m, ["f1", "f3"], [], lambda s: np.zeros((3, 2)), [0.0, 1.0], gamma=1.0)
     with pytest.raises(ParameterError, match="weight Q must be symmetric"):
         ltv_game_filter(m, "f1", ["f2"], [0.0, 1.0], gamma=1e-3, Q=[[1.0, 2.0], [0.0, 1.0]])

@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 
 from fdikit import FaultModel
 from fdikit.design.observers.beard_jones import beard_jones, restricted_diagonal
-from fdikit.errors import DesignError, ModelError
+from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.linalg import resolve_faults
 
 W = np.logspace(-2, 3, 40)
@@ -104,7 +104,7 @@ def test_infeasible_specifications_raise_with_reasons():
         beard_jones(model, faults, {"f0": [-1.0], "f1": [-1.0]}, [-4, -5])
     with pytest.raises(DesignError, match="conjugate"):
         beard_jones(model, faults, {"f0": [-1.0], "f1": [-3]}, [-4 + 1j, -5])
-    with pytest.raises(ModelError, match="unknown fault"):
+    with pytest.raises(ParameterError, match="unknown fault"):
         beard_jones(model, faults, {"f0": [-1.0], "f1": [-3], "f9": [-2]}, [-4, -5])
     # not output separable: two faults with parallel output images
     same = {"a": faults["f0"], "b": 2 * faults["f0"] + 1e-3 * np.linalg.svd(model.C)[2][-1][:, None]}

@@ -121,7 +121,7 @@ def test_family_rejects_bad_specifications():
     with pytest.raises(DesignError, match="dependent columns"):
         detection_gain_family(model, {"f": np.hstack([f, 2 * f])})
     fam = detection_gain_family(model, {"f": f})
-    with pytest.raises(ModelError, match="shape"):
+    with pytest.raises(ParameterError, match="shape"):
         fam.gain({"f": np.zeros((2, 2))})
     with pytest.raises(ModelError, match="continuous-time"):
         detection_gain_family(model.discretize(0.1), {"f": f})
@@ -211,7 +211,7 @@ def test_bad_input_is_rejected(plant):
         hinf_detection_filter(f16xl_gust(pitch_rate_noise=0.0), FAULTS, gamma=2.0)
     with pytest.raises(DesignError, match="singular"):  # wind alone: D Dᵀ = 0
         hinf_detection_filter(plant, FAULTS, gamma=2.0, disturbances=["wind"])
-    with pytest.raises(ModelError, match="not a disturbance or noise input"):
+    with pytest.raises(ParameterError, match="not a disturbance or noise input"):
         hinf_detection_filter(plant, FAULTS, gamma=2.0, disturbances=["gust"])
     with pytest.raises(ParameterError, match="form"):
         hinf_detection_filter(plant, FAULTS, gamma=2.0, form="exact")

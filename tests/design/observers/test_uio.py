@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from fdikit import DesignError, FaultModel, ModelError
+from fdikit import DesignError, FaultModel, ModelError, ParameterError
 from fdikit.design.observers.full_order import observer_generator
 from fdikit.design.observers.uio import uio, uio_bank, unknown_input_matrix
 from fdikit.faults import Bias, Drift, FaultScenario
@@ -312,7 +312,7 @@ def test_bad_names_and_other_infeasible_specifications():
         uio(m, "nope", nuisance="others")
     with pytest.raises(ModelError, match=r"no faults input named 'nope'"):
         uio(m, "u1_actuator", nuisance=["nope"])
-    with pytest.raises(ModelError, match=r"also listed as a nuisance"):
+    with pytest.raises(ParameterError, match=r"also listed as a nuisance"):
         uio(m, "u1_actuator", nuisance=["u1_actuator"])
     # a target along a nuisance direction cannot be seen by any decoupled residual
     twin = m.add_faults(["twin"], m.Bf[:, [1]], m.Df[:, [1]])

@@ -20,7 +20,7 @@ from fdikit.design.parity.polynomial import (
     minimal_degree,
     parity_filter,
 )
-from fdikit.errors import DesignError, ModelError
+from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.faults import Bias, FaultScenario, ScaleFactor
 from fdikit.lti import dlsim_blocked
 from fdikit.plants.single_track import single_track, single_track_lpv
@@ -59,7 +59,7 @@ def test_bar_gives_product_coefficients():
         for j, Hj in enumerate(Hc):
             direct[i + j] += (Ni @ Hj)[0]
     np.testing.assert_allclose(np.hstack(Nc) @ Hb, direct.reshape(1, -1), rtol=1e-13, atol=1e-13)
-    with pytest.raises(ModelError, match="non-negative integer"):
+    with pytest.raises(ParameterError, match="non-negative integer"):
         bar(Hc, -1)
 
 

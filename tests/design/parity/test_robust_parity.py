@@ -37,7 +37,7 @@ from fdikit.design.parity.robust import (
     theorem1_batch,
 )
 from fdikit.design.parity.state_space import parity_matrix
-from fdikit.errors import DesignError, ModelError
+from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.lpv import lpv_stacked_matrices
 from fdikit.plants.varrier_lateral import varrier_lateral_lpv, varrier_uncertainty
 
@@ -252,7 +252,7 @@ def test_vertex_repair_keeps_eigenvectors_and_positive_eigenvalues():
         np.testing.assert_allclose(F @ Q[:, 0], new * Q[:, 0], atol=1e-12)
     F, count = repair_vertex(np.eye(3))
     assert count == 0 and np.array_equal(F, np.eye(3))
-    with pytest.raises(ModelError, match="repair"):
+    with pytest.raises(ParameterError, match="repair"):
         repair_vertex(M, "clip")
 
 
@@ -293,7 +293,7 @@ def test_polytopic_lmi_against_the_per_vertex_closed_form(design):
         np.testing.assert_allclose(Wi, ref, rtol=1e-4, atol=1e-6 * np.abs(ref).max())
     with pytest.raises(DesignError, match="not positive definite"):
         polytopic_lmi(design.vertices, c)  # the raw prefix-sum vertices 1, 2, 3, 5 are indefinite (Remark 6)
-    with pytest.raises(ModelError, match="objective"):
+    with pytest.raises(ParameterError, match="objective"):
         polytopic_lmi(V, c, objective="max")
 
 
@@ -317,9 +317,9 @@ def test_design_report_counts_and_adjugate_variant(design):
 def test_bad_criteria_input_is_refused():
     with pytest.raises(DesignError, match="no target fault"):
         robust_criteria(LPV, UNC, 0.048, 3, nuisance=["lateral_acceleration_sensor"])
-    with pytest.raises(ModelError, match="no fault named"):
+    with pytest.raises(ParameterError, match="no fault named"):
         robust_criteria(LPV, UNC, 0.048, 3, nuisance=["yaw_rate_sensor"])
-    with pytest.raises(ModelError, match="fault_model"):
+    with pytest.raises(ParameterError, match="fault_model"):
         robust_criteria(LPV, UNC, 0.048, 3, fault_model="ramp")
-    with pytest.raises(ModelError, match="rho_min < rho_max"):
+    with pytest.raises(ParameterError, match="rho_min < rho_max"):
         robust_lpv_parity(LPV, UNC, 3, kappa=0.1, rho_min=0.2, rho_max=0.1)

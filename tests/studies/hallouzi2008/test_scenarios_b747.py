@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from fdikit.errors import ModelError
+from fdikit.errors import ParameterError
 from fdikit.plants.b747 import B747_NOISE
 from fdikit.studies.hallouzi2008.b747 import (
     INTERVALS,
@@ -103,11 +103,11 @@ def test_state_rmse_within_thesis_bound_until_the_v_sensor_fault_not_in_it():
 
 
 def test_bad_input_raises():
-    with pytest.raises(ModelError, match="unknown filters"):
+    with pytest.raises(ParameterError, match="unknown filters"):
         b747_monte_carlo(runs=1, filters=("kalman",))
-    with pytest.raises(ModelError, match="runs must be at least 1"):
+    with pytest.raises(ParameterError, match="runs must be at least 1"):
         b747_monte_carlo(runs=0)
-    with pytest.raises(ModelError, match="input_std must be 6"):
+    with pytest.raises(ParameterError, match="input_std must be 6"):
         b747_trace(0, input_std=[0.1, 0.1])
 
 

@@ -4,7 +4,7 @@ degree of observability of model pairs."""
 import numpy as np
 import pytest
 
-from fdikit.errors import ModelError
+from fdikit.errors import ParameterError
 from fdikit.studies.hallouzi2008.example_3_1 import PAIRS, example_3_1, example_3_1_models
 
 # Table 3.1 as printed: rows = model sets, columns {1,2}, {1,3}, {2,3}, {1,4}, {2,4}, {3,4}
@@ -57,5 +57,5 @@ def test_separation_ratio_is_the_printed_1_5(table):
 
 
 def test_bad_input():
-    with pytest.raises(ModelError, match="b_scale"):
+    with pytest.raises(ParameterError, match="b_scale"):
         example_3_1(model_sets=1, b_scale=0.0)

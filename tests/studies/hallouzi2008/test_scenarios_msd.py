@@ -5,7 +5,7 @@ import pytest
 import scipy.linalg
 import scipy.optimize
 
-from fdikit.errors import ModelError
+from fdikit.errors import ParameterError
 from fdikit.metrics import vaf
 from fdikit.multimodel.model_set import vectorize
 from fdikit.plants.msd import msd_matrices, msd_model_vectors, msd_parameter_grid
@@ -116,13 +116,13 @@ def test_ekf_state_vaf_table_3_3(ekf):
 
 
 def test_bad_input_raises(sim):
-    with pytest.raises(ModelError, match="filter must be"):
+    with pytest.raises(ParameterError, match="filter must be"):
         run_msd_filter(sim, msd_od_model_set(DT), "imm")
-    with pytest.raises(ModelError, match="discretised at"):
+    with pytest.raises(ParameterError, match="discretised at"):
         run_msd_filter(sim, msd_od_model_set(2.5e-3))
-    with pytest.raises(ModelError, match="f1_size"):
+    with pytest.raises(ParameterError, match="f1_size"):
         simulate_msd(f1_size=1.5)
-    with pytest.raises(ModelError, match="too coarse"):
+    with pytest.raises(ParameterError, match="too coarse"):
         simulate_msd(dt=0.1)
 
 

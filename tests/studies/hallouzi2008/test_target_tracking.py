@@ -7,7 +7,7 @@ measured on this seed (values in the comments).
 import numpy as np
 import pytest
 
-from fdikit.errors import ModelError, ParameterError
+from fdikit.errors import ParameterError
 from fdikit.plants.target_tracking import PI_TRACKING, R_TRACKING, tracking_A, tracking_B
 from fdikit.studies.hallouzi2008.target_tracking import (
     maneuver_profile,
@@ -32,7 +32,7 @@ def test_plant_matches_2_65_to_2_68():
     assert np.allclose(PI_TRACKING.sum(axis=1), 1.0) and PI_TRACKING[0, 0] == 0.98
     assert ms.varying == (False, True, False, False)
     assert np.allclose(np.linalg.matrix_power(tracking_A(), 3)[0, 1], 3.0)
-    with pytest.raises(ModelError, match="unknown tracking model"):
+    with pytest.raises(ParameterError, match="unknown tracking model"):
         tracking_B("loop")
 
 
@@ -80,7 +80,7 @@ def test_imm_chatters_in_the_half_turn_and_wins_elsewhere(mc):
 def test_printed_dual_cmf_weight_step_fails_on_this_benchmark():
     """Erratum behind the corrected dual CMF: Table 2.2 as printed weights the Kalman correction by Q⁻¹ and
     follows the position rows' noise (velocity RMSE 4.0 m/s in straight flight, 8 runs; corrected form 0.70)."""
-    from fdikit.multimodel.convex import dual_convex_filter
+    from fdikit.multimodel.convex_filter import dual_convex_filter
 
     ms = tracking_convex_set()
     worse = []

@@ -14,7 +14,7 @@ import pytest
 import scipy.linalg
 import scipy.signal
 
-from fdikit.errors import DataError, ModelError
+from fdikit.errors import DataError, ParameterError
 from fdikit.estimate.steering import fault_map_coefficients, isolate_steering_faults, lateral_fault_map
 from fdikit.faults import NO_FAULT, Bias, FaultScenario, ScaleFactor
 from fdikit.lti import dlsim_blocked
@@ -122,7 +122,7 @@ def test_case_catalogue_schedules(s6):
     assert f_m[-1] == 0.6 and f_a[-1] == pytest.approx(0.12 * DEG)
     np.testing.assert_array_equal(true_steering_faults(s6)[1], f_m)
     assert vanderploeg_case("S5").meta["source"].endswith("Figs. 4-12, 4-13")
-    with pytest.raises(ModelError, match="unknown case"):
+    with pytest.raises(ParameterError, match="unknown case"):
         vanderploeg_case("S9")
 
 
@@ -269,7 +269,7 @@ def test_table_4_2_and_bad_input():
     assert design_bank_angle(280.0) == pytest.approx(2.00)
     assert design_bank_angle(630.0, 90) == pytest.approx(1.72)
     assert design_bank_angle(1e4) == pytest.approx(1.43)
-    with pytest.raises(ModelError, match="70, 90 and 120"):
+    with pytest.raises(ParameterError, match="70, 90 and 120"):
         design_bank_angle(300.0, 100)
     with pytest.raises(DataError, match="positive"):
         lateral_run(10.0, speed_kmh=-70.0)
@@ -279,5 +279,5 @@ def test_table_4_2_and_bad_input():
         lateral_run(0.0)
     with pytest.raises(DataError, match="pairs"):
         lateral_run(10.0, additive_deg=[0.1])
-    with pytest.raises(ModelError, match="unknown vehicle parameters"):
+    with pytest.raises(ParameterError, match="unknown vehicle parameters"):
         perturbed_parameters(Cf=1.1)

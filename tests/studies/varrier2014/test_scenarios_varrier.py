@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from fdikit.design.parity.state_space import lpv_parity_residuals
-from fdikit.errors import DataError, ModelError
+from fdikit.errors import DataError, ParameterError
 from fdikit.plants.varrier_lateral import rho_from_speed, varrier_lateral_lpv
 from fdikit.studies.varrier2014.scenarios import (
     fault_window_masks,
@@ -78,7 +78,7 @@ def test_window_masks_normalisation_and_score():
         normalise_residual(np.zeros(len(tr)), faulty)
     with pytest.raises(DataError, match="no faulty sample"):
         fault_window_masks(varrier_trace(duration=10.0), 3)
-    with pytest.raises(ModelError, match="fault_window"):
+    with pytest.raises(ParameterError, match="fault_window"):
         varrier_trace(fault_window=(158.0, 150.0))
 
 

@@ -49,7 +49,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg
 
-from fdikit import linalg, validate
+from fdikit import linalg, lti, validate
 from fdikit.design.observers.full_order import observer_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.linalg import resolve_faults
@@ -268,8 +268,8 @@ def _check_sets(model, dims, poles, complement_poles):
             raise DesignError(f"set {name!r} has {lam.size} eigenvalues but needs {wanted[name]} "
                               f"(detection-space dimensions {dims}, n = {n})")
         _self_conjugate(name, lam, scale)
-        if not np.all(linalg.is_stable(lam, discrete)):
-            raise DesignError(f"set {name!r} has unstable eigenvalues {lam[~linalg.is_stable(lam, discrete)].tolist()}")
+        if not np.all(lti.is_stable(lam, discrete)):
+            raise DesignError(f"set {name!r} has unstable eigenvalues {lam[~lti.is_stable(lam, discrete)].tolist()}")
     everything = np.concatenate(list(sets.values()))
     for i, z in enumerate(everything):
         if np.any(np.abs(everything[i + 1 :] - z) <= 1e-9 * scale):

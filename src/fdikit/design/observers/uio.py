@@ -57,7 +57,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg
 
-from fdikit import linalg, validate
+from fdikit import linalg, lti, validate
 from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import joined_form
@@ -412,8 +412,8 @@ def uio(
     At = Z.T @ A1 @ Z
     fixed = scipy.linalg.eigvals(At[no:, no:]) if no < n else np.zeros(0, complex)
     margin = 1e3 * max(n, 1) * _EPS * max(1.0, np.linalg.norm(A, 2))
-    if fixed.size and not np.all(linalg.is_stable(fixed, discrete, margin)):
-        bad = fixed[~linalg.is_stable(fixed, discrete, margin)]
+    if fixed.size and not np.all(lti.is_stable(fixed, discrete, margin)):
+        bad = fixed[~lti.is_stable(fixed, discrete, margin)]
         raise DesignError(
             f"(C, T A) is not detectable: its unobservable modes {_fmt(bad)} — the invariant zeros of (A, E, C) "
             f"with E the directions of {list(decoupled)} — are not stable "
@@ -430,8 +430,8 @@ def uio(
             raise DesignError(
                 f"need {no} UIO poles (n = {n} minus {n - no} fixed modes {_fmt(fixed)}), got {poles.size}"
             )
-        if not np.all(linalg.is_stable(poles, discrete)):
-            raise DesignError(f"requested UIO poles {_fmt(poles[~linalg.is_stable(poles, discrete)])} are not stable")
+        if not np.all(lti.is_stable(poles, discrete)):
+            raise DesignError(f"requested UIO poles {_fmt(poles[~lti.is_stable(poles, discrete)])} are not stable")
         W = linalg.orth(Co)  # compress dependent outputs; W Wᵀ Co = Co
         try:
             Lr = np.asarray(control.place(Ao.T, (W.T @ Co).T, poles)).T
@@ -440,8 +440,8 @@ def uio(
         K1 = Zo @ Lr @ W.T
     N = A1 - K1 @ C
     achieved = scipy.linalg.eigvals(N)
-    if not np.all(linalg.is_stable(achieved, discrete)):
-        bad = achieved[~linalg.is_stable(achieved, discrete)]
+    if not np.all(lti.is_stable(achieved, discrete)):
+        bad = achieved[~lti.is_stable(achieved, discrete)]
         raise DesignError(f"the placed UIO is not stable: poles {_fmt(bad)}")
     K = K1 + N @ H
     notes = []

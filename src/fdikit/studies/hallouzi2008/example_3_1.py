@@ -25,7 +25,7 @@ import numpy as np
 import scipy.stats
 
 from fdikit.errors import ParameterError
-from fdikit.multimodel.model_set import pair_observability
+from fdikit.multimodel.observability import pair_observability
 
 __all__ = ["PAIRS", "Example31Result", "example_3_1_models", "example_3_1"]
 

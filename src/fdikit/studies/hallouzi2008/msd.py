@@ -32,15 +32,13 @@ import numpy as np
 
 from fdikit.errors import ParameterError
 from fdikit.metrics import vaf
-from fdikit.multimodel.convex import convex_model_set, dual_convex_filter, fault_size_from_weights
+from fdikit.multimodel.convex import convex_model_set
 from fdikit.multimodel.convex_ekf import augmented_ekf
-from fdikit.multimodel.model_set import (
-    first_order_discretize,
-    minimum_mismatch_points,
-    od_model_set,
-    pair_observability,
-    unvectorize,
-)
+from fdikit.multimodel.convex_filter import dual_convex_filter
+from fdikit.multimodel.model_set import first_order_discretize, unvectorize
+from fdikit.multimodel.observability import minimum_mismatch_points, pair_observability
+from fdikit.multimodel.od_design import od_model_set
+from fdikit.multimodel.reconstruction import fault_size_from_weights
 from fdikit.plants.msd import MSD_SAMPLE_TIME, msd_matrices, msd_model_vectors, msd_parameter_grid
 
 __all__ = [
@@ -263,7 +261,7 @@ def msd_od_model_set(dt: float = MSD_SAMPLE_TIME, grid_levels: int = 5, fault_va
 
     The pivoting criterion of (3.19)/(3.22) ties on this grid: the grid is symmetric (equal residual norms
     up to rounding) and the 6th model is taken beyond the numerical rank 5, where every residual is
-    numerically zero.  Ties are broken by the documented rule of :func:`~fdikit.multimodel.model_set.pivoted_qr`
+    numerically zero.  Ties are broken by the documented rule of :func:`~fdikit.multimodel.od_design.pivoted_qr`
     (tolerance ``1e-10`` of the largest column norm) with the secondary key: models whose fault parameters
     both lie at a limit (``f ∈ {0, 1}``) first, then the grid order.  That key keeps the structure the
     fault reconstruction of Fig. 3.9 needs — ``f = 1 − Σ_{f^(i)=0} μ̂^(i)`` equals the blended ``Σ μ̂^(i) f^(i)``

@@ -28,16 +28,12 @@ import numpy as np
 
 from fdikit.errors import ParameterError
 from fdikit.metrics import vaf
-from fdikit.multimodel.convex import (
-    convex_model_set,
-    estimated_model_vector,
-    limit_value_convex_set,
-    lv_parameter,
-    lv_reciprocal_parameter,
-)
+from fdikit.multimodel.convex import convex_model_set, limit_value_convex_set
 from fdikit.multimodel.convex_ekf import augmented_ekf
 from fdikit.multimodel.cp_design import CPModelSet, cp_model_set
-from fdikit.multimodel.model_set import LimitValueModelSet, limit_value_model_set, nearest_model, unvectorize
+from fdikit.multimodel.lv_design import LimitValueModelSet, limit_value_model_set
+from fdikit.multimodel.model_set import nearest_model, unvectorize
+from fdikit.multimodel.reconstruction import estimated_model_vector, lv_parameter, lv_reciprocal_parameter
 from fdikit.plants.msd import MSD_RANGES, msd_matrices, msd_model_vectors, msd_parameter_grid
 from fdikit.studies.hallouzi2008.msd import MSD_STATES, MSDSimulation, run_msd_filter
 
