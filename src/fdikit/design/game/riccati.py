@@ -56,6 +56,19 @@ class RiccatiSolution:
         spectrum from the imaginary axis; 0 means no stabilizing solution).
     closed_loop_poles : eigenvalues of ``A + R X`` (all in the open left half-plane).
     residual : ``‖X A + Aᵀ X + X R X + Q‖ / (‖Q‖ + 2‖A‖‖X‖ + ‖R‖‖X‖²)``.
+
+    The property ``stabilizing`` says whether ``A + R X`` is Hurwitz.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> sol = solve_game_are(np.array([[-1.0]]), np.array([[0.5]]), np.array([[1.0]]))
+    >>> sol.X.shape, sol.stabilizing, bool(sol.residual < 1e-8)
+    ((1, 1), True, True)
+
+    References
+    ----------
+    Murray 2012, §3.2.3, (3.26), Theorem 3.1.
     """
 
     X: np.ndarray
@@ -70,7 +83,28 @@ class RiccatiSolution:
 
 
 def hamiltonian_margin(A: np.ndarray, R: np.ndarray, Q: np.ndarray) -> float:
-    """``min |Re λ|`` of the Hamiltonian ``[[A, R], [−Q, −Aᵀ]]`` (Murray 2012, (3.36))."""
+    """``min |Re λ|`` of the Hamiltonian ``[[A, R], [−Q, −Aᵀ]]`` (Murray 2012, (3.36)).
+
+    Parameters
+    ----------
+    A, R, Q : (n, n) arrays
+        The coefficients of ``X A + Aᵀ X + X R X + Q = 0`` (``R``, ``Q`` symmetric).
+
+    Returns
+    -------
+    float
+        The distance of the Hamiltonian spectrum from the imaginary axis (0: no stabilizing solution).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> round(hamiltonian_margin(np.array([[-1.0]]), np.array([[0.5]]), np.array([[1.0]])), 6)   # √(1 − 0.5)
+    0.707107
+
+    References
+    ----------
+    Murray 2012, §3.4.1, (3.36), Remark 3.2.
+    """
     H = np.block([[A, R], [-Q, -A.T]])
     return float(np.min(np.abs(scipy.linalg.eigvals(H).real)))
 
@@ -120,6 +154,10 @@ def solve_game_are(
     >>> sol = solve_game_are(np.array([[-1.0]]), np.array([[0.5]]), np.array([[1.0]]))
     >>> round(float(sol.X[0, 0]), 6), sol.stabilizing       # 0.5 x² − 2x + 1 = 0, x = 2 − √2
     (0.585786, True)
+
+    References
+    ----------
+    Murray 2012, §3.2.3, (3.26), Remark 3.2; §3.4.1, (3.35)–(3.36).
     """
     A = validate.as_square("A", A)
     n = A.shape[0]
@@ -265,11 +303,50 @@ def game_riccati(
     Hamiltonian has no imaginary-axis eigenvalue, ``Π ≥ 0``, ``A − LC + RΠ`` is Hurwitz and
     ``Ker Π`` is the unobservable subspace of ``(ĤC, A − LC)``.  Returned ``X`` is ``Π``.
 
+    Parameters
+    ----------
+    problem : GameProblem
+        The partitioned faults (:func:`~fdikit.design.game.setup.game_problem`), continuous model.
+    L : (n, p) array
+        The filter gain (observer sign: ``A − L C``).
+    target : str
+        The target ``i`` whose equation is solved.
+    gamma : float
+        Attenuation bound γ > 0 (default 1e-6).
+    V : float or (p, p) array
+        Murray's ``V = V̄/γ`` (default 1).
+    Q, M : float, array or mapping target → value
+        Output weight (p x p, default 1e-4) and complementary-fault weight (sized to ``F̂_i``, default 0.01).
+
+    Returns
+    -------
+    RiccatiSolution
+        ``X = Π_i`` (n x n), the Hamiltonian margin, the poles of ``A − LC + RΠ`` and the relative residual.
+
     Raises
     ------
+    ParameterError
+        A gain of the wrong shape, or ``target`` not a target of ``problem``.
     DesignError
         If ``A − LC`` is not Hurwitz or the Hamiltonian has imaginary-axis eigenvalues (the
-        attenuation bound γ is not met by this gain: Remark 3.2).
+        attenuation bound γ is not met by this gain: Remark 3.2), or the model is discrete.
+
+    Examples
+    --------
+    >>> from fdikit.design.game.setup import game_problem
+    >>> from fdikit.design.game.single_fault import game_filter_bank
+    >>> from fdikit.plants.white_speyer import white_speyer
+    >>> model = white_speyer("stable-extra-zero")
+    >>> prob = game_problem(model, ["f1", "f2"])
+    >>> bank = game_filter_bank(model, ["f1", "f2"], Q=1e-3, M=0.05)
+    >>> L = (bank.gains["f1"] + bank.gains["f2"]) / 2          # a stable shared gain
+    >>> sol = game_riccati(prob, L, "f1", Q=1e-3, M=0.05)
+    >>> sol.X.shape, sol.stabilizing, bool(np.linalg.eigvalsh(sol.X).min() > -1e-12)
+    ((3, 3), True, True)
+
+    References
+    ----------
+    Murray 2012, §3.2.3, (3.28), Theorem 3.1; §3.4.1, (3.36).
     """
     require_continuous(problem.model)
     L = checked_gain(problem, L)
@@ -319,10 +396,48 @@ def game_cost(
     whose zero is the stationarity condition (3.25) ``L = (Σ Π_iΔ_iΠ_i)⁻¹ Σ Π_iΔ_i Cᵀ V⁻¹``.
     Weights are one value for every target or a mapping target → value.
 
+    Parameters
+    ----------
+    problem : GameProblem
+        The partitioned faults (:func:`~fdikit.design.game.setup.game_problem`), continuous model.
+    L : (n, p) array
+        The filter gain (observer sign: ``A − L C``).
+    gamma : float
+        Attenuation bound γ > 0 (default 1e-6).
+    V : float or (p, p) array
+        Murray's ``V = V̄/γ`` (default 1).
+    Q, M, K, N : float, array or mapping target → value
+        Riccati weights ``Q_i`` (p x p), ``M_i`` (sized to ``F̂_i``) and cost weights ``K_i`` (sized to ``F̂_i``,
+        penalises complementary-fault transmission), ``N_i`` (sized to ``F_i``, rewards target transmission).
+
+    Returns
+    -------
+    J : float
+        The cost ``Σ_i tr(W_i Π_i(L))``.
+    grad : (n, p) array
+        ``∂J/∂L``.
+
     Raises
     ------
     DesignError
         If a Riccati equation has no stabilizing solution at ``L``.
+
+    Examples
+    --------
+    >>> from fdikit.design.game.setup import game_problem
+    >>> from fdikit.design.game.single_fault import game_filter_bank
+    >>> from fdikit.plants.white_speyer import white_speyer
+    >>> model = white_speyer("stable-extra-zero")
+    >>> prob = game_problem(model, ["f1", "f2"])
+    >>> bank = game_filter_bank(model, ["f1", "f2"], Q=1e-3, M=0.05)
+    >>> L = (bank.gains["f1"] + bank.gains["f2"]) / 2          # a stable shared gain
+    >>> J, grad = game_cost(prob, L, Q=1e-3, M=0.05, K=0.1, N=5.0)
+    >>> f"{J:.3e}", grad.shape
+    ('1.577e-04', (3, 2))
+
+    References
+    ----------
+    Murray 2012, §3.2.2, (3.25), and §3.2.3, (3.27)–(3.28).
     """
     require_continuous(problem.model)
     L = checked_gain(problem, L)
