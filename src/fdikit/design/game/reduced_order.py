@@ -73,6 +73,20 @@ class GohFilterDesign:
     separation : defect of (4.85), ``max ‖S̄ⱼ(ΣS̄)⁻¹S̄ₖ − δⱼₖS̄ⱼ‖ / ‖S̄ⱼ‖`` (0 for one target).
     structure_residual : ``‖A₁₂ − L₁C₂‖ / ‖A‖`` ((4.70); round-off when the design is consistent).
     problem : the target/nuisance partition.
+
+    Made by :func:`goh_filter` / :func:`goh_detector`; ``targets`` gives the target names, ``blocks()`` the
+    partitioned transformed plant.
+
+    Examples
+    --------
+    >>> from fdikit.plants.white_speyer import white_speyer
+    >>> d = goh_detector(white_speyer("stable-extra-zero"), "f1", ["f2"], V=1.0, Q=0.5)
+    >>> d.order, d.targets, d.gain.shape, sorted(d.blocks())
+    (2, ('f1',), (2, 2), ['A11', 'A12', 'A21', 'A22', 'C1', 'C2'])
+
+    References
+    ----------
+    Murray 2012, §4.3.2, (4.60)–(4.75); Douglas et al. 1996, §9.5, (9.61)–(9.63).
     """
 
     generator: ResidualGenerator
@@ -144,6 +158,11 @@ def goh_filter(
         Goh Riccati equation of standard (LQ) type.
     rtol : rank tolerance of the subspace computations.
 
+    Returns
+    -------
+    GohFilterDesign
+        The reduced-order generator (order ``n₁``), its gain ``L₁`` and the design report.
+
     Raises
     ------
     DesignError
@@ -162,6 +181,10 @@ def goh_filter(
     >>> d = goh_filter(m, faults, V=1.0, Q=0.5)
     >>> d.order, d.separation < 1e-9
     (4, True)
+
+    References
+    ----------
+    Murray 2012, §4.2.4, Theorem 4.4, and §4.3, (4.60)–(4.75), Prop. 4.6; Douglas et al. 1996, §9.5, (9.63).
     """
     if model.is_discrete:
         raise DesignError(
@@ -260,6 +283,18 @@ def goh_detector(
     Q : PATH's ``Q₁`` (1 in §9.6).
     rtol : rank tolerance.
 
+    Returns
+    -------
+    GohFilterDesign
+        The reduced-order detector; ``static_gain`` is PATH's ``K`` (9.62) when ``C₂`` has full column rank.
+
+    Raises
+    ------
+    ParameterError
+        More than one target (use :func:`goh_filter`).
+    DesignError
+        As :func:`goh_filter`.
+
     Examples
     --------
     The air-mass sensor filter of PATH §9.6 (engine-speed and accelerometer faults as nuisance):
@@ -269,6 +304,10 @@ def goh_detector(
     >>> d = goh_detector(m, "air_mass_sensor", path_longitudinal_7_fault_maps(), V=0.8, Q=1.0)
     >>> d.order, d.generator.residuals
     (3, ('air_mass_sensor[0]', 'air_mass_sensor[1]', 'air_mass_sensor[2]'))
+
+    References
+    ----------
+    Douglas et al. 1996, §9.4, Theorem 9.4; §9.5, (9.61)–(9.68), (9.77), Theorem 9.5; §9.6.2.
     """
     prob_targets = targets if not isinstance(targets, str) else [targets]
     if len(prob_targets) != 1:
