@@ -44,8 +44,31 @@ __all__ = [
 def minimal_horizon(n: int, p: int, residuals: int = 1) -> int:
     """Smallest ``s`` with ``q = (s+1)p − n >= residuals`` (cf. Varrier et al. 2014, (13): ``s = ⌈n/m⌉``).
 
-    >>> minimal_horizon(2, 2)
-    1
+    Parameters
+    ----------
+    n, p : int
+        Number of states and of outputs.
+    residuals : int
+        Parity-space dimension ``q`` wanted (default 1).
+
+    Returns
+    -------
+    int
+        The horizon ``s >= 0``.
+
+    Raises
+    ------
+    ParameterError
+        ``n < 0``, ``p < 1`` or ``residuals < 1``.
+
+    Examples
+    --------
+    >>> minimal_horizon(2, 2), minimal_horizon(2, 2, residuals=3)
+    (1, 2)
+
+    References
+    ----------
+    Varrier et al. 2014, §3.3, (13).
     """
     if n < 0 or p < 1 or residuals < 1:
         raise ParameterError(f"need n >= 0, p >= 1 and residuals >= 1, got n={n}, p={p}, residuals={residuals}")
@@ -56,10 +79,34 @@ def minimal_horizon(n: int, p: int, residuals: int = 1) -> int:
 def regular_rows(H_os: np.ndarray, rtol: float = 1e-9) -> tuple[int, ...]:
     """The first ``n`` linearly independent rows of ``H_os``, in order (Remark 2: ``reg(𝒪)``).
 
+    Parameters
+    ----------
+    H_os : ((s+1)p, n) array_like
+        Stacked observability matrix.
+    rtol : float
+        A row is independent when it raises the smallest singular value above ``rtol ‖H_os‖₂`` (default 1e-9).
+
+    Returns
+    -------
+    tuple of int
+        The ``n`` row indices forming ``H_os1``.
+
     Raises
     ------
+    ParameterError
+        ``H_os`` is not 2-D.
     DesignError
         If ``H_os`` has rank < n (the pair (A, C) is not observable over the horizon).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> regular_rows(np.array([[1.0, 0.0], [2.0, 0.0], [0.0, 1.0]]))
+    (0, 2)
+
+    References
+    ----------
+    Varrier et al. 2014, §3.2, Remark 2, (10).
     """
     H = np.asarray(H_os)
     if H.ndim != 2:
@@ -93,13 +140,25 @@ def parity_matrix(H_os: np.ndarray, rows: Sequence[int] | None = None, cond_max:
 
     Returns
     -------
-    (..., q, (s+1)p) array; the columns of the ``H_os2`` rows hold ``I_q``.
+    (..., q, (s+1)p) array
+        The parity basis; the columns of the ``H_os2`` rows hold ``I_q``.
+
+    Raises
+    ------
+    ParameterError
+        ``rows`` that are not ``n`` distinct row indices.
+    DesignError
+        ``H_os1`` singular or with condition number above ``cond_max``; ``H_os`` of rank < n.
 
     Examples
     --------
     >>> import numpy as np
     >>> parity_matrix(np.array([[2.0], [1.0], [0.5]])).tolist()
     [[-0.5, 1.0, 0.0], [-0.25, 0.0, 1.0]]
+
+    References
+    ----------
+    Varrier et al. 2014, §3.2, (10)–(12).
     """
     H = np.asarray(H_os)
     N, n = H.shape[-2], H.shape[-1]
@@ -130,9 +189,25 @@ class ParityDesign:
 
     Attributes
     ----------
-    generator : FIR :class:`ResidualGenerator`, ``r(k) = Wᵀ(Y_s(k) − H_us U_s(k))`` over ``[k−s, k]``.
-    P : (q, (s+1)p) parity basis; W2 : (q, k) free parameter; W : ((s+1)p, k) parity matrix ``Pᵀ W₂``.
-    stacked : the stacked matrices; rows : the rows of ``H_os1``; s : horizon.
+    generator : FIR ResidualGenerator, ``r(k) = Wᵀ(Y_s(k) − H_us U_s(k))`` over ``[k−s, k]``.
+    P : (q, (s+1)p) parity basis.
+    W2 : (q, k) free parameter.
+    W : ((s+1)p, k) parity matrix ``Pᵀ W₂``.
+    stacked : the stacked matrices (:class:`~fdikit.lpv.StackedMatrices`).
+    rows : the rows of ``H_os1``.
+    s : horizon.
+    model : the FaultModel of the design (keyword-only; set by :func:`parity_design`).
+
+    Examples
+    --------
+    >>> from fdikit import FaultModel
+    >>> d = parity_design(FaultModel([[0.9]], [[1.0], [2.0]], Bu=[[1.0]], dt=0.1), 0)
+    >>> d.q, d.rows, d.P.tolist(), d.W.shape
+    (1, (0,), [[-2.0, 1.0]], (2, 1))
+
+    References
+    ----------
+    Varrier et al. 2014, §3.1–3.2, (7)–(12).
     """
 
     generator: ResidualGenerator
@@ -194,6 +269,20 @@ def parity_design(model: FaultModel, s: int | None = None, *, W2=None, rows: Seq
     rows, names, isolates
         Rows of ``H_os1``; residual names (default ``parity_0, …``); fault tied to each residual.
 
+    Returns
+    -------
+    ParityDesign
+        The FIR generator and ``P``, ``W₂``, ``W``, the stacked matrices and the rows of ``H_os1``.
+
+    Raises
+    ------
+    ParameterError
+        ``model`` not a FaultModel; a bad horizon, ``rows`` or ``W2`` shape.
+    ModelError
+        A continuous model.
+    DesignError
+        No parity space at horizon ``s``; ``H_os`` of rank < n or ``H_os1`` ill-conditioned; ``W2 = 0``.
+
     Examples
     --------
     >>> import numpy as np
@@ -202,6 +291,10 @@ def parity_design(model: FaultModel, s: int | None = None, *, W2=None, rows: Seq
     >>> d = parity_design(m, 0)
     >>> d.q, bool(np.allclose(d.P @ d.stacked.H_os, 0))
     (1, True)
+
+    References
+    ----------
+    Varrier et al. 2014, §3.1–3.2, (7)–(12).
     """
     if not isinstance(model, FaultModel):
         raise ParameterError(f"parity_design needs a FaultModel, got {type(model).__name__}")
@@ -269,6 +362,31 @@ def lpv_parity_residuals(
     -------
     Residuals
         The first ``s`` samples (incomplete window) are NaN and marked invalid.
+
+    Raises
+    ------
+    ParameterError
+        A bad horizon, ``mode``, ``rows`` or ``W2`` (or a ``W2`` function returning the wrong shape).
+    DataError
+        ``rho`` without one value per sample; NaN/inf in ``rho``, controls or outputs; a trace of at most
+        ``s`` samples or without the model's signals.
+    DesignError
+        ``H_os`` of rank < n, or ``H_os1`` ill-conditioned somewhere on the trace.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.plants import varrier_lateral_lpv
+    >>> from fdikit.simulate import simulate
+    >>> lpv = varrier_lateral_lpv()
+    >>> tr = simulate(lpv.at(0.05), duration=2.0, u=lambda t: [0.02 * np.sin(t)], x0=[0.01, 0.05])
+    >>> r = lpv_parity_residuals(lpv, tr, np.full(len(tr), 0.05), 3)
+    >>> r.r.shape, int(r.valid.sum()), bool(np.abs(r.r[3:]).max() < 1e-9)
+    ((101, 6), 98, True)
+
+    References
+    ----------
+    Varrier et al. 2014, (9), (12), (16); §4.6.1 (frozen ρ).
     """
     s = check_horizon(s)
     u = trace.columns("u", lpv.controls)
