@@ -366,7 +366,9 @@ def lpv_parity_residuals(
     Raises
     ------
     ParameterError
-        A bad horizon, ``mode``, ``rows`` or ``W2`` (or a ``W2`` function returning the wrong shape).
+        A bad horizon, ``rows`` or ``W2`` (or a ``W2`` function returning the wrong shape).
+    ModelError
+        An unknown ``mode`` (raised by :func:`fdikit.lpv.lpv_stacked_matrices`).
     DataError
         ``rho`` without one value per sample; NaN/inf in ``rho``, controls or outputs; a trace of at most
         ``s`` samples or without the model's signals.
