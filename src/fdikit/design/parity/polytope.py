@@ -58,7 +58,28 @@ def lmi_block(Ginv_scaled: np.ndarray, w: np.ndarray, g: float) -> np.ndarray:
 
 # ---------------------------------------------------------------------------------------------- polytope
 def adjugate(M: np.ndarray) -> np.ndarray:
-    """Adjugate (transposed cofactor matrix) of square matrices, batch axes allowed, real or complex."""
+    """Adjugate (transposed cofactor matrix) of square matrices, batch axes allowed, real or complex.
+
+    Parameters
+    ----------
+    M : (..., q, q) array_like
+        Square matrices.
+
+    Returns
+    -------
+    (..., q, q) array
+        ``adj M`` (``M adj M = det M · I``); ones for ``q = 1``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> np.round(adjugate(np.array([[1.0, 2.0], [3.0, 4.0]])), 6).tolist()
+    [[4.0, -2.0], [-3.0, 1.0]]
+
+    References
+    ----------
+    Varrier et al. 2014, §4.5, (32)–(33).
+    """
     M = np.asarray(M)
     q = M.shape[-1]
     out = np.empty_like(M)
@@ -80,10 +101,41 @@ def polynomial_coefficients(fun: Callable[[np.ndarray], np.ndarray], rho_min: fl
     degree is the last coefficient above 100 × the round-off floor (the largest of the upper
     half of the spectrum); it depends on the interval's scale, so count ρ-degrees on [0, 1].
 
+    Parameters
+    ----------
+    fun : callable
+        Maps a 1-D complex array of ρ to an array whose first axis runs over those ρ.
+    rho_min, rho_max : float
+        The scheduling interval (``t = 0`` and ``t = 1``).
+    points : int
+        Number of points on the circle (default 64; degrees below ``points / 2`` are resolved).
+    rtol : float
+        Largest accepted tail of the spectrum relative to its peak (default 1e-8).
+
+    Returns
+    -------
+    coefficients : (degree + 1, ...) array
+        ``M_0 … M_degree`` (real parts).
+    degree : int
+        The polynomial degree in ``t``.
+
     Raises
     ------
+    ParameterError
+        ``rho_min``, ``rho_max`` not finite with ``rho_min < rho_max``.
     DesignError
         If the coefficients do not die out (``fun`` is not a polynomial of degree < points/2).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> M, degree = polynomial_coefficients(lambda r: (1 + 2 * r + r**2)[:, None, None], 0.0, 1.0)
+    >>> degree, np.round(M.ravel(), 6).tolist()
+    (2, [1.0, 2.0, 1.0])
+
+    References
+    ----------
+    Varrier et al. 2014, §4.5, (32)–(36).
     """
     if not (np.isfinite(rho_min) and np.isfinite(rho_max) and rho_max > rho_min):
         raise ParameterError(f"need finite rho_min < rho_max, got [{rho_min}, {rho_max}]")
@@ -102,19 +154,85 @@ def polynomial_coefficients(fun: Callable[[np.ndarray], np.ndarray], rho_min: fl
 
 
 def box_vertices(N: int, rho_max: float) -> np.ndarray:
-    """The ``2^N`` corners of the box ``θ_j = ρ^j ∈ [0, ρ_max^j]`` (classical polytope, §4.6.2)."""
+    """The ``2^N`` corners of the box ``θ_j = ρ^j ∈ [0, ρ_max^j]`` (classical polytope, §4.6.2).
+
+    Parameters
+    ----------
+    N : int
+        Number of parameters ``ρ, ρ², …, ρ^N``.
+    rho_max : float
+        Upper end of the scheduling range.
+
+    Returns
+    -------
+    (2^N, N) array
+        The corners, in binary order.
+
+    Examples
+    --------
+    >>> box_vertices(2, 0.5).tolist()
+    [[0.0, 0.0], [0.0, 0.25], [0.5, 0.0], [0.5, 0.25]]
+
+    References
+    ----------
+    Varrier et al. 2014, §4.6.2.
+    """
     return np.array([[b * rho_max ** (j + 1) for j, b in enumerate(bits)] for bits in product((0, 1), repeat=N)],
                     dtype=float).reshape(-1, N)
 
 
 def is_admissible(vertex: np.ndarray, rho_max: float) -> bool:
-    """Property 1, (46): ``ν_{j+1} ≤ ρ_max ν_j`` for all j (coordinates ν_j ∈ {0, ρ_max^j})."""
+    """Property 1, (46): ``ν_{j+1} ≤ ρ_max ν_j`` for all j (coordinates ν_j ∈ {0, ρ_max^j}).
+
+    Parameters
+    ----------
+    vertex : (N,) array_like
+        A box corner (:func:`box_vertices`).
+    rho_max : float
+        Upper end of the scheduling range.
+
+    Returns
+    -------
+    bool
+        Whether the corner is one of the Property-1 vertices.
+
+    Examples
+    --------
+    >>> is_admissible([0.5, 0.25], 0.5), is_admissible([0.0, 0.25], 0.5)
+    (True, False)
+
+    References
+    ----------
+    Varrier et al. 2014, §4.6.2, Property 1, (46).
+    """
     v = np.asarray(vertex, dtype=float)
     return bool(np.all(v[1:] <= rho_max * v[:-1] * (1 + 1e-12) + 1e-300))
 
 
 def property1_vertices(N: int, rho_max: float) -> np.ndarray:
-    """The ``N+1`` admissible vertices ``ω_j = (ρ_max, …, ρ_max^j, 0, …, 0)``, j = 0..N (Property 1)."""
+    """The ``N+1`` admissible vertices ``ω_j = (ρ_max, …, ρ_max^j, 0, …, 0)``, j = 0..N (Property 1).
+
+    Parameters
+    ----------
+    N : int
+        Number of parameters ``ρ, ρ², …, ρ^N``.
+    rho_max : float
+        Upper end of the scheduling range.
+
+    Returns
+    -------
+    (N + 1, N) array
+        Row ``j`` is ``ω_j``.
+
+    Examples
+    --------
+    >>> property1_vertices(2, 0.5).tolist()
+    [[0.0, 0.0], [0.5, 0.0], [0.5, 0.25]]
+
+    References
+    ----------
+    Varrier et al. 2014, §4.6.2, Property 1, (46).
+    """
     return np.array([[rho_max ** (i + 1) if i < j else 0.0 for i in range(N)] for j in range(N + 1)])
 
 
@@ -124,8 +242,28 @@ def scheduling_weights(rho, N: int, rho_min: float, rho_max: float) -> np.ndarra
     ``α̃₀ = 1 − t``, ``α̃_j = t^j − t^{j+1}`` (0 < j < N), ``α̃_N = t^N`` with ``t`` clipped to [0, 1];
     ``Σ_j α̃_j ω_j = (ρ', ρ'², …)`` in the scaled variable.
 
+    Parameters
+    ----------
+    rho : float or array_like
+        Scheduling values (any shape).
+    N : int
+        Polynomial degree (number of vertices minus one).
+    rho_min, rho_max : float
+        The scheduling interval.
+
+    Returns
+    -------
+    (..., N + 1) array
+        The weights ``α̃_0 … α̃_N`` per value of ``rho``.
+
+    Examples
+    --------
     >>> scheduling_weights(0.5, 2, 0.0, 1.0).tolist()
     [0.5, 0.25, 0.25]
+
+    References
+    ----------
+    Varrier et al. 2014, §4.5, Remark 5; §4.6.2, Property 1 (the weights are derived here, not printed).
     """
     t = np.clip((np.asarray(rho, dtype=float) - rho_min) / (rho_max - rho_min), 0.0, 1.0)
     powers = t[..., None] ** np.arange(N + 2)
@@ -139,7 +277,38 @@ def repair_vertex(M: np.ndarray, mode: str = "inverse", factor: float = 10.0) ->
 
     ``mode="paper"``: by ``factor × max positive eigenvalue``; ``"inverse"``: by
     ``min positive eigenvalue / factor`` (large in the inverse, Remark 7).  Eigenvectors and
-    positive eigenvalues are kept.  Returns the matrix and the number of replaced eigenvalues.
+    positive eigenvalues are kept.
+
+    Parameters
+    ----------
+    M : (q, q) array_like
+        Vertex matrix (symmetrised).
+    mode : str
+        ``'inverse'`` (default) or ``'paper'``.
+    factor : float
+        The replacement factor (default 10).
+
+    Returns
+    -------
+    matrix : (q, q) array
+        The repaired (positive definite) matrix.
+    replaced : int
+        The number of replaced eigenvalues (0: ``M`` was positive definite and is returned symmetrised).
+
+    Raises
+    ------
+    ParameterError
+        An unknown ``mode`` (only checked when a repair is needed).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> repair_vertex(np.diag([2.0, -1.0]))[0].tolist(), repair_vertex(np.diag([2.0, -1.0]), "paper")[0].tolist()
+    ([[2.0, 0.0], [0.0, 0.2]], [[2.0, 0.0], [0.0, 20.0]])
+
+    References
+    ----------
+    Varrier et al. 2014, §4.5, Remarks 6–7, (41)–(42).
     """
     M = (np.asarray(M, dtype=float) + np.asarray(M, dtype=float).T) / 2
     d, V = np.linalg.eigh(M)
@@ -160,7 +329,30 @@ def repair_vertex(M: np.ndarray, mode: str = "inverse", factor: float = 10.0) ->
 @dataclass(frozen=True)
 class PolytopicLmi:
     """Vertex solutions ``W`` (r, q); ``gamma`` (r,) the attained bounds ``W_iᵀΓ̃_i⁻¹W_i`` (common: their
-    maximum), checked against the solver's γ'; ``min_eigs`` of the vertex LMI blocks at ``γ'(1 + 1e-8)``."""
+    maximum), checked against the solver's γ'; ``min_eigs`` of the vertex LMI blocks at ``γ'(1 + 1e-8)``.
+
+    Attributes
+    ----------
+    W : (r, q) array
+        One parity vector per vertex, ``cᵀ W_i = 1``.
+    gamma : (r,) array
+        Attained bounds (objective ``'common'``: all equal to their maximum).
+    min_eigs : (r,) array
+        Smallest eigenvalue of each vertex LMI block (≥ 0).
+    status : str
+        The solver status (``'optimal'``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> res = polytopic_lmi(np.array([np.eye(2), 2 * np.eye(2)]), np.array([1.0, 1.0]))
+    >>> np.round(res.gamma, 6).tolist(), res.status
+    ([0.5, 0.5], 'optimal')
+
+    References
+    ----------
+    Varrier et al. 2014, §4.5, (37)–(40).
+    """
 
     W: np.ndarray
     gamma: np.ndarray
@@ -178,6 +370,40 @@ def polytopic_lmi(vertices: np.ndarray, c: np.ndarray, *, objective: str = "comm
     ``Γ̃_i = L_i L_iᵀ`` — the same LMI with an identity (1,1) block (posed directly, Clarabel's γ'
     was 3e-4 off the bound its W attains).  The solution is checked: vertices PD, attained
     bounds ``W_iᵀΓ̃_i⁻¹W_i`` ≤ solver γ' (1 + 1e-5), block eigenvalues ≥ 0, ``cᵀW_i = 1``.
+
+    Parameters
+    ----------
+    vertices : (r, q, q) array_like
+        Vertex matrices ``Γ̃_i`` (positive definite; see :func:`repair_vertex`).
+    c : (q,) array_like
+        Normalisation vector of ``cᵀ W_i = 1``.
+    objective : str
+        ``'common'`` (default) or ``'sum'``.
+    solver : str
+        cvxpy solver name (default ``'CLARABEL'``, with tight tolerances).
+
+    Returns
+    -------
+    PolytopicLmi
+        The vertex solutions, attained bounds, block eigenvalues and solver status.
+
+    Raises
+    ------
+    ParameterError
+        An unknown ``objective``.
+    DesignError
+        A vertex that is not positive definite, no solution, or a solution that fails the checks.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> res = polytopic_lmi(np.array([np.eye(2), 2 * np.eye(2)]), np.array([1.0, 1.0]))
+    >>> np.round(res.W[0], 6).tolist(), bool(np.allclose(res.W @ [1.0, 1.0], 1))
+    ([0.5, 0.5], True)
+
+    References
+    ----------
+    Varrier et al. 2014, §4.5, (37)–(40).
     """
     import cvxpy as cp
 
