@@ -80,6 +80,18 @@ class GohTransformation:
     B_tilde : ``B̃`` (n x k), transformed nuisance directions; ``C B̃`` has full column rank.
     B_bar : ``B̄`` (n x m), every direction met; ``Im B̄ = Ŵ*`` (4.18).
     iterations : ``β̂``, the number of Goh transformations (0 when ``C F̂`` has full column rank).
+
+    The property ``invariant_subspace`` is an orthonormal basis of ``Ŵ* = Im B̄``.
+
+    Examples
+    --------
+    >>> g = goh_transformation([[0, 1], [0, 0]], [[1, 0]], [[0], [1]])
+    >>> g.iterations, g.invariant_subspace.shape
+    (1, (2, 2))
+
+    References
+    ----------
+    Murray 2012, §4.1.2, Algorithm 4.1.
     """
 
     B_hat: np.ndarray
@@ -124,8 +136,15 @@ def goh_transformation(A, C, F, rtol: float | None = None) -> GohTransformation:
     F : n x k nuisance direction ``F̂`` (k may be 0).
     rtol : rank tolerance relative to ``‖C‖ ‖B̃‖``.
 
+    Returns
+    -------
+    GohTransformation
+        ``B̂``, ``B̃``, ``B̄`` and the number of steps.
+
     Raises
     ------
+    ModelError
+        ``A``, ``C``, ``F`` of inconsistent sizes or with non-finite entries.
     DesignError
         If ``F`` is rank deficient (not monic) or a direction never reaches the output (it lies in
         the unobservable subspace of (C, A)), so the iteration does not stop within n steps.
@@ -137,6 +156,10 @@ def goh_transformation(A, C, F, rtol: float | None = None) -> GohTransformation:
     >>> g = goh_transformation([[0, 1], [0, 0]], [[1, 0]], [[0], [1]])
     >>> g.iterations, g.B_bar.shape, g.B_tilde.ravel().tolist()
     (1, (2, 2), [1.0, 0.0])
+
+    References
+    ----------
+    Murray 2012, §4.1.2, Algorithm 4.1, Steps 1–8.
     """
     A = _as2d("A", A)
     n = A.shape[0]
@@ -183,6 +206,31 @@ def oblique_projector(C: np.ndarray, B_tilde: np.ndarray, V: np.ndarray) -> np.n
 
     For ``V = v I`` it is the orthogonal projector ``Ĥ``; with ``C F̂`` of full rank it is PATH's
     ``I − C₂ K`` of (9.62)–(9.63).
+
+    Parameters
+    ----------
+    C : (p, n) array
+        Output matrix.
+    B_tilde : (n, k) array
+        ``B̃`` of :func:`goh_transformation` (``C B̃`` of full column rank; k = 0 gives ``I``).
+    V : (p, p) array
+        Positive definite noise weight ``V = V̄/γ``.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``H̄`` (p x p), idempotent, kernel ``Im C B̃``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> np.round(oblique_projector(np.eye(2), np.array([[1.0], [1.0]]), np.diag([1.0, 2.0])), 6)
+    array([[ 0.333333, -0.333333],
+           [-0.666667,  0.666667]])
+
+    References
+    ----------
+    Murray 2012, §4.2.1, (4.31); Douglas et al. 1996, §9.5, (9.62)–(9.63).
     """
     C, V = np.asarray(C, dtype=float), np.asarray(V, dtype=float)
     p = C.shape[0]
@@ -197,6 +245,36 @@ def goh_riccati_rhs(S, A, C, goh: GohTransformation, V, Q, H) -> np.ndarray:
     """Right-hand side of ``−Ṡ = …`` of the Goh Riccati equation (Murray (4.33) ≡ PATH (9.44)).
 
     ``S Ã + Ãᵀ S + S B̂ Ξ B̂ᵀ S + Cᵀ (Ĥ Q Ĥ − H̄ᵀ V⁻¹ H̄) C`` (module docstring); zero at a steady state.
+
+    Parameters
+    ----------
+    S : (n, n) array
+        The point at which the right-hand side is evaluated.
+    A, C : (n, n) and (p, n) arrays
+        Plant matrices (continuous time).
+    goh : GohTransformation
+        Algorithm 4.1 applied to ``F̂`` (:func:`goh_transformation`).
+    V, Q, H : (p, p) arrays
+        Noise weight ``V = V̄/γ``, output weight and the orthogonal projector ``Ĥ``.
+
+    Returns
+    -------
+    numpy.ndarray
+        The (n, n) right-hand side.
+
+    Examples
+    --------
+    The steady state of :func:`goh_riccati` makes it vanish:
+
+    >>> from fdikit.plants.white_speyer import white_speyer
+    >>> m = white_speyer("unstable-zero")
+    >>> sol = goh_riccati(m.A, m.C, m.Bf[:, [1]], V=1.0, Q=0.002)
+    >>> bool(np.abs(goh_riccati_rhs(sol.S, m.A, m.C, sol.goh, sol.V, sol.Q, sol.projector)).max() < 1e-8)
+    True
+
+    References
+    ----------
+    Murray 2012, §4.2.1, (4.33); Douglas et al. 1996, §9.3.2, (9.44).
     """
     A, C, S = (np.asarray(M, dtype=float) for M in (A, C, S))
     V, Q, H = (np.asarray(M, dtype=float) for M in (V, Q, H))
@@ -226,6 +304,20 @@ class GohRiccatiSolution:
     kernel_zeros : invariant zeros of ``(C, A, F̂)`` with ``Re ≥ 0`` whose directions are in ``Ker S``
         (PATH Theorem 9.4).
     residual : ``‖goh_riccati_rhs(S)‖ / (‖Cᵀ(ĤQĤ − H̄ᵀV⁻¹H̄)C‖ + 2‖Ã‖‖S‖ + ‖B̂ΞB̂ᵀ‖‖S‖²)``.
+
+    The property ``kernel`` is an orthonormal basis of ``Ker S`` (``Γ₂ᵀ``).
+
+    Examples
+    --------
+    >>> from fdikit.plants.white_speyer import white_speyer
+    >>> m = white_speyer("unstable-zero")
+    >>> sol = goh_riccati(m.A, m.C, m.Bf[:, [1]], V=1.0, Q=0.002)
+    >>> sol.S_reduced.shape, sol.kernel.shape
+    ((1, 1), (3, 2))
+
+    References
+    ----------
+    Douglas et al. 1996, §9.3.2, (9.44), (9.48), §9.5, (9.57), (9.77); Murray 2012, §4.2.1, (4.33), Theorem 4.2.
     """
 
     S: np.ndarray
@@ -327,6 +419,10 @@ def goh_riccati(A, C, F_hat, *, V=1.0, Q=1e-4, projector=None, rtol: float | Non
     >>> sol = goh_riccati(m.A, m.C, m.Bf[:, [1]], V=1.0, Q=0.002)
     >>> sol.order, np.round(sol.kernel_zeros.real, 6).tolist()
     (1, [3.0])
+
+    References
+    ----------
+    Douglas et al. 1996, §9.3.2, (9.44), §9.4, Theorem 9.4, §9.5, (9.77); Murray 2012, §4.2, (4.33), §6.2.2.
     """
     A, C, F, Vw, Qw, Vi, goh, H, Hb = _prepare(A, C, F_hat, V, Q, projector, rtol)
     n, W = A.shape[0], goh.invariant_subspace
@@ -385,6 +481,52 @@ def goh_riccati_transient(A, C, F_hat, t: Sequence[float], *, V=1.0, Q=1e-4, S0=
     direction ν of ``(C, A, F̂)`` is an exactly uncoupled mode of (9.77) on which ``S = 0`` is an
     (unstable) equilibrium: from ``S(0) = 0`` it stays in ``Ker S(t)`` for all t, whereas from any
     ``S(0) > 0`` on it (e.g. (4.50)) ``S(t)`` converges to the stabilizing solution of :func:`goh_riccati`.
+
+    Parameters
+    ----------
+    A, C : (n, n) and (p, n) arrays
+        Plant matrices (continuous time).
+    F_hat : (n, k) array
+        ``F̂``, the complementary fault direction.
+    t : sequence of float
+        Nondecreasing output times ≥ 0 [s] (the equation starts at 0).
+    V, Q : float or (p, p) array
+        Noise weight ``V = V̄/γ`` (positive definite) and output weight, as in :func:`goh_riccati`.
+    S0 : (n, n) array, optional
+        Initial value (default 0, PATH (9.41)).
+    projector : (p, p) array, optional
+        ``Ĥ``; default the orthogonal projector annihilating ``C Ŵ*``.
+    rtol : float, optional
+        Rank tolerance of the subspace computations.
+    tol : float
+        Relative tolerance of the integration (default 1e-10).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``S(t)``, shape (len(t), n, n).
+
+    Raises
+    ------
+    ParameterError
+        ``t`` not a nondecreasing 1-D sequence of times ≥ 0 (or a bad weight).
+    DesignError
+        Algorithm 4.1 fails, or the integration fails.
+
+    Examples
+    --------
+    From ``S(0) = 0`` to the steady state of :func:`goh_riccati`:
+
+    >>> from fdikit.plants.white_speyer import white_speyer
+    >>> m = white_speyer("stable-extra-zero")
+    >>> S = goh_riccati_transient(m.A, m.C, m.Bf[:, [1]], [0.0, 5.0], V=1.0, Q=0.002, tol=1e-6)
+    >>> Sinf = goh_riccati(m.A, m.C, m.Bf[:, [1]], V=1.0, Q=0.002).S
+    >>> S.shape, bool(np.abs(S[-1] - Sinf).max() < 1e-6 * np.abs(Sinf).max())
+    ((2, 3, 3), True)
+
+    References
+    ----------
+    Douglas et al. 1996, §9.3.2, (9.41), Prop. 9.2, and §9.5, (9.77)–(9.78); Murray 2012, §4.2.1, (4.50).
     """
     A, C, F, Vw, Qw, Vi, goh, H, Hb = _prepare(A, C, F_hat, V, Q, projector, rtol)
     n, W = A.shape[0], goh.invariant_subspace
