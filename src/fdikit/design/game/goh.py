@@ -526,7 +526,7 @@ def goh_riccati_transient(A, C, F_hat, t: Sequence[float], *, V=1.0, Q=1e-4, S0=
 
     References
     ----------
-    Douglas et al. 1996, §9.3.2, (9.41), Prop. 9.2, and §9.5, (9.77)–(9.78); Murray 2012, §4.2.1, (4.50).
+    Douglas et al. 1996, §9.3.2, (9.41), Prop. 9.2, and §9.5, (9.77)–(9.78); Murray 2012, §4.2.3, (4.50).
     """
     A, C, F, Vw, Qw, Vi, goh, H, Hb = _prepare(A, C, F_hat, V, Q, projector, rtol)
     n, W = A.shape[0], goh.invariant_subspace
