@@ -73,6 +73,29 @@ def time_varying_bar(rows: Sequence[Sequence[np.ndarray]]) -> np.ndarray:
 
     With the same coefficients in every row this is the bar matrix of Lemma 2-1.2; with the
     coefficients of the model at instant ``τ_i`` it is the LPV ``H̄_k`` of Lemma 3-3.2.
+
+    Parameters
+    ----------
+    rows : sequence of sequences of (r, c) arrays, the coefficients of each block row.
+
+    Returns
+    -------
+    (len(rows) r, w c) array, ``w`` the widest block row's extent.
+
+    Raises
+    ------
+    ParameterError
+        No block row, or an empty first row.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> time_varying_bar([[np.eye(1), 2 * np.eye(1)], [3 * np.eye(1)]]).tolist()
+    [[1.0, 2.0], [0.0, 3.0]]
+
+    References
+    ----------
+    van der Ploeg 2018, Lemma 2-1.2, Lemma 3-3.2.
     """
     rows = [list(r) for r in rows]
     if not rows or not rows[0]:
@@ -91,11 +114,30 @@ def bar(coefficients: Sequence[np.ndarray], degree: int) -> np.ndarray:
 
     ``N̄ · bar(C, d_N)`` is the coefficient row of ``N(q) C(q)`` for ``N`` of degree ``d_N``.
 
+    Parameters
+    ----------
+    coefficients : sequence of (r, c) arrays, ``C_0 … C_d`` (ascending powers of ``q``).
+    degree : int, the parity degree ``d_N >= 0``.
+
+    Returns
+    -------
+    ((d_N + 1) r, (d_N + d + 1) c) array
+
+    Raises
+    ------
+    ParameterError
+        ``degree`` not a non-negative integer, or no coefficients.
+
     Examples
     --------
+    >>> import numpy as np
     >>> bar([np.array([[1.0]]), np.array([[2.0]])], 1)
     array([[1., 2., 0.],
            [0., 1., 2.]])
+
+    References
+    ----------
+    van der Ploeg 2018, Lemma 2-1.2.
     """
     if int(degree) != degree or degree < 0:
         raise ParameterError(f"the parity degree must be a non-negative integer, got {degree!r}")
@@ -103,19 +145,76 @@ def bar(coefficients: Sequence[np.ndarray], degree: int) -> np.ndarray:
 
 
 def bar_matrices(dae: DAEModel, degree: int, fault: str | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(H̄, L̄, F̄)`` of Lemma 2-1.2 for parity degree ``d_N``; ``F̄`` for one fault column."""
+    """``(H̄, L̄, F̄)`` of Lemma 2-1.2 for parity degree ``d_N``; ``F̄`` for one fault column.
+
+    Parameters
+    ----------
+    dae : DAEModel
+    degree : int, the parity degree ``d_N``.
+    fault : str or None, the fault column of ``F`` (default: the DAE's only fault).
+
+    Returns
+    -------
+    tuple of three arrays, the bar matrices of ``H``, ``L`` and of the fault column of ``F``.
+
+    Examples
+    --------
+    >>> from fdikit import FaultModel; from fdikit.dae import dae_form
+    >>> dae = dae_form(FaultModel(A=[[0.5, 0], [0, 0.6]], C=[[1, 0], [0, 1]], dt=0.1).with_sensor_faults(["y0", "y1"]))
+    >>> [M.shape for M in bar_matrices(dae, 1, "y0_sensor")]
+    [(8, 6), (8, 4), (8, 2)]
+
+    References
+    ----------
+    van der Ploeg 2018, Lemma 2-1.2, (2.8).
+    """
     j = dae.fault_index(fault)
     return bar(dae.H, degree), bar(dae.L, degree), bar([F[:, [j]] for F in dae.F], degree)
 
 
 def normal_rank(coefficients: Sequence[np.ndarray], rtol: float | None = None) -> int:
-    """Normal rank of ``Σ C_i qⁱ``: the largest rank at three fixed generic complex points."""
+    """Normal rank of ``Σ C_i qⁱ``: the largest rank at three fixed generic complex points.
+
+    Parameters
+    ----------
+    coefficients : sequence of arrays, ``C_0 … C_d`` (ascending powers of ``q``).
+    rtol : float or None, relative rank tolerance (default :func:`fdikit.linalg.rank`'s).
+
+    Returns
+    -------
+    int
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> normal_rank([np.array([[1.0, 0.0]]), np.array([[0.0, 1.0]])])
+    1
+
+    References
+    ----------
+    van der Ploeg 2018, Assumption 2-1.1, (2.5).
+    """
     return max(linalg.rank(sum(c * lam**i for i, c in enumerate(coefficients)), rtol) for lam in _RANK_POINTS)
 
 
 @dataclass(frozen=True)
 class RankTest:
-    """Outcome of a rank condition ``rank_with > rank_without``; true in a boolean context when it holds."""
+    """Outcome of a rank condition ``rank_with > rank_without``; true in a boolean context when it holds.
+
+    Attributes
+    ----------
+    holds : bool, whether ``rank_with > rank_without``.
+    rank_with, rank_without : int, the (normal) ranks with and without the fault column.
+
+    Examples
+    --------
+    >>> bool(RankTest(True, 3, 2)), bool(RankTest(False, 2, 2))
+    (True, False)
+
+    References
+    ----------
+    van der Ploeg 2018, Assumption 2-1.1, (2.5); Fact 3-3.3, (3.15).
+    """
 
     holds: bool
     rank_with: int
@@ -134,7 +233,28 @@ def _hstack_poly(*polys: Sequence[np.ndarray]) -> list[np.ndarray]:
 
 
 def detectability(dae: DAEModel, fault: str | None = None) -> RankTest:
-    """Condition (2.5) (Assumption 2-1.1, [21] Fact 4.4): ``Rank [H(q) F(q)] > Rank H(q)`` (normal ranks)."""
+    """Condition (2.5) (Assumption 2-1.1, [21] Fact 4.4): ``Rank [H(q) F(q)] > Rank H(q)`` (normal ranks).
+
+    Parameters
+    ----------
+    dae : DAEModel
+    fault : str or None, the fault column of ``F`` (default: the DAE's only fault).
+
+    Returns
+    -------
+    RankTest
+
+    Examples
+    --------
+    >>> from fdikit import FaultModel; from fdikit.dae import dae_form
+    >>> dae = dae_form(FaultModel(A=[[0.5, 0], [0, 0.6]], C=[[1, 0], [0, 1]], dt=0.1).with_sensor_faults(["y0", "y1"]))
+    >>> detectability(dae, "y0_sensor")
+    RankTest(holds=True, rank_with=3, rank_without=2)
+
+    References
+    ----------
+    van der Ploeg 2018, Assumption 2-1.1, (2.5).
+    """
     j = dae.fault_index(fault)
     F = [c[:, [j]] for c in dae.F]
     r_with, r_without = normal_rank(_hstack_poly(dae.H, F)), normal_rank(dae.H)
@@ -146,6 +266,26 @@ def isolability(dae: DAEModel, fault: str, nuisance: str) -> RankTest:
 
     For an additive and a multiplicative fault on the same signal both columns are ``F``, so
     the condition fails: they are "dynamically inseparable" by any LTI parity filter.
+
+    Parameters
+    ----------
+    dae : DAEModel
+    fault, nuisance : str, fault columns of ``F``: the one to isolate and the one to decouple.
+
+    Returns
+    -------
+    RankTest
+
+    Examples
+    --------
+    >>> from fdikit import FaultModel; from fdikit.dae import dae_form
+    >>> dae = dae_form(FaultModel(A=[[0.5, 0], [0, 0.6]], C=[[1, 0], [0, 1]], dt=0.1).with_sensor_faults(["y0", "y1"]))
+    >>> bool(isolability(dae, "y0_sensor", "y1_sensor"))
+    True
+
+    References
+    ----------
+    van der Ploeg 2018, §2-3.
     """
     Fa = [c[:, [dae.fault_index(fault)]] for c in dae.F]
     Fn = [c[:, [dae.fault_index(nuisance)]] for c in dae.F]
@@ -155,7 +295,28 @@ def isolability(dae: DAEModel, fault: str, nuisance: str) -> RankTest:
 
 
 def left_null_space(dae: DAEModel, degree: int) -> np.ndarray:
-    """Orthonormal rows spanning ``{N̄ : N̄ H̄ = 0}`` for parity degree ``d_N`` (Lemma 2-1.2)."""
+    """Orthonormal rows spanning ``{N̄ : N̄ H̄ = 0}`` for parity degree ``d_N`` (Lemma 2-1.2).
+
+    Parameters
+    ----------
+    dae : DAEModel
+    degree : int, the parity degree ``d_N``.
+
+    Returns
+    -------
+    (k, (d_N + 1) n_r) array, ``k`` the dimension of the left null space of ``H̄``.
+
+    Examples
+    --------
+    >>> from fdikit import FaultModel; from fdikit.dae import dae_form
+    >>> dae = dae_form(FaultModel(A=[[0.5, 0], [0, 0.6]], C=[[1, 0], [0, 1]], dt=0.1).with_sensor_faults(["y0", "y1"]))
+    >>> left_null_space(dae, 1).shape
+    (2, 8)
+
+    References
+    ----------
+    van der Ploeg 2018, Lemma 2-1.2, (2.8a).
+    """
     return linalg.null(bar(dae.H, degree).T).T
 
 
@@ -165,12 +326,33 @@ def minimal_degree(dae: DAEModel, fault: str | None = None, max_degree: int | No
     ``max_degree`` defaults to ``n_x · d_H`` (the degree of a minimal polynomial basis of the
     left null space of ``H(q)`` cannot exceed it).
 
+    Parameters
+    ----------
+    dae : DAEModel
+    fault : str or None, the fault column of ``F`` (default: the DAE's only fault).
+    max_degree : int or None, the largest degree tried.
+
+    Returns
+    -------
+    int, the minimal ``d_N``.
+
     Raises
     ------
     DesignError
         If no degree up to ``max_degree`` works: the fault is not detectable (2.5).
     ParameterError
         If ``dae`` is not a :class:`DAEModel`.
+
+    Examples
+    --------
+    >>> from fdikit import FaultModel; from fdikit.dae import dae_form
+    >>> dae = dae_form(FaultModel(A=[[0.5, 0], [0, 0.6]], C=[[1, 0], [0, 1]], dt=0.1).with_sensor_faults(["y0", "y1"]))
+    >>> minimal_degree(dae, "y0_sensor")
+    1
+
+    References
+    ----------
+    van der Ploeg 2018, Lemma 2-1.2, Assumption 2-1.1.
     """
     if not isinstance(dae, DAEModel):
         raise ParameterError(f"dae must be a DAEModel (build one with dae_form(model)), got {type(dae).__name__}")
@@ -240,6 +422,19 @@ class PolynomialParityDesign:
     NF : coefficients of ``N(q) F(q)`` (``qⁱ``).
     denominator : ``d̄ = [d_0 … d_n]`` (monic); poles : its roots.
     decoupling : ``‖N̄ H̄‖ / (‖N̄‖ ‖H̄‖)`` (0 for exact decoupling, round-off in practice).
+    model : the discrete FaultModel it was made from, or None (keyword-only; set by :func:`parity_filter`).
+
+    Examples
+    --------
+    >>> from fdikit import FaultModel; from fdikit.dae import dae_form
+    >>> dae = dae_form(FaultModel(A=[[0.5, 0], [0, 0.6]], C=[[1, 0], [0, 1]], dt=0.1).with_sensor_faults(["y0", "y1"]))
+    >>> d = parity_filter(dae, "y0_sensor")
+    >>> d.degree, d.generator.residuals, round(d.dc_gain, 9), bool(d.decoupling < 1e-12)
+    (1, ('r_y0_sensor',), 1.0, True)
+
+    References
+    ----------
+    van der Ploeg 2018, Lemma 2-1.2, (2.6)–(2.9).
     """
 
     generator: ResidualGenerator
@@ -312,9 +507,36 @@ class PolynomialParityDesign:
 def target_fault(dae: DAEModel, targets: str | Sequence[str] | None, who: str = "the parity filter") -> str:
     """The one fault of ``dae`` a parity filter detects.
 
-    ``targets``: a fault name (a column of ``F``), a one-element sequence of it, or ``None`` when the
-    DAE has exactly one fault.  A bare signal name (an output or control) raises
-    :class:`ParameterError` giving the fault name (``'<output>_sensor'``, ``'<control>_actuator'``).
+    Parameters
+    ----------
+    dae : DAEModel
+    targets : str, sequence of str or None
+        A fault name (a column of ``F``), a one-element sequence of it, or ``None`` when the DAE has
+        exactly one fault.
+    who : str, the caller named in error messages.
+
+    Returns
+    -------
+    str, the fault name.
+
+    Raises
+    ------
+    ParameterError
+        More than one target, or a bare signal name (an output or control; the message gives the
+        fault name ``'<output>_sensor'`` / ``'<control>_actuator'``).
+    DesignError
+        A name that is not a fault of the DAE, or ``None`` when it has several faults (raised by ``dae.fault_index``).
+
+    Examples
+    --------
+    >>> from fdikit import FaultModel; from fdikit.dae import dae_form
+    >>> dae = dae_form(FaultModel(A=[[0.5, 0], [0, 0.6]], C=[[1, 0], [0, 1]], dt=0.1).with_sensor_faults(["y0", "y1"]))
+    >>> target_fault(dae, ["y1_sensor"])
+    'y1_sensor'
+
+    References
+    ----------
+    van der Ploeg 2018, §2-1, (2.1) (the fault columns of ``F(q)``).
     """
     if targets is None:
         return dae.faults[dae.fault_index(None)]
@@ -366,8 +588,10 @@ def parity_filter(
 
     Raises
     ------
+    ParameterError
+        ``model`` neither a DAEModel nor a FaultModel; several targets or a bare signal name.
     DesignError
-        Undetectable fault, unstable or complex poles, too few poles, or a fault whose
+        Undetectable or unknown fault, unstable or complex poles, too few poles, or a fault whose
         residual response vanishes at DC (the normalisation (2.8b) is then impossible).
 
     Examples
@@ -378,6 +602,10 @@ def parity_filter(
     (2, 1, 3)
     >>> round(design.dc_gain, 12), round(float(design.fault_zeros[0].real), 5)
     (1.0, -0.97294)
+
+    References
+    ----------
+    van der Ploeg 2018, Lemma 2-1.2, (2.6)–(2.9); Sec. 4-3-1.
     """
     dae = dae_form(model) if isinstance(model, FaultModel) else model
     if not isinstance(dae, DAEModel):
