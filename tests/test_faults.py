@@ -11,6 +11,7 @@ import pytest
 import scipy.stats
 
 from fdikit import FaultModel, ParameterError
+from fdikit.fault_spec import parse_fault
 from fdikit.faults import (
     NO_FAULT,
     Bias,
@@ -21,7 +22,6 @@ from fdikit.faults import (
     Noise,
     ScaleFactor,
     Stuck,
-    parse_fault,
 )
 from fdikit.simulate import simulate, time_grid
 

@@ -19,6 +19,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from fdikit.errors import ParameterError
+from fdikit.fault_spec import format_fault, parse_fault
 from fdikit.faults import (
     Bias,
     Drift,
@@ -27,8 +28,6 @@ from fdikit.faults import (
     Noise,
     ScaleFactor,
     Stuck,
-    format_fault,
-    parse_fault,
 )
 
 FINITE = st.floats(allow_nan=False, allow_infinity=False)

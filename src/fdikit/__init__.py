@@ -4,8 +4,8 @@ The layers, from data to decisions (``docs/ARCHITECTURE.md``):
 
 * model layer — :mod:`fdikit.model` (:class:`FaultModel`, LTI with named signals), :mod:`fdikit.lpv`,
   :mod:`fdikit.ltv`, :mod:`fdikit.dae`, :mod:`fdikit.gaussian`; :mod:`fdikit.plants` (benchmark plants);
-* signals — :mod:`fdikit.faults`, :mod:`fdikit.simulate`, :mod:`fdikit.trace` (+ :mod:`fdikit.trace_io`),
-  :mod:`fdikit.gaps`;
+* signals — :mod:`fdikit.faults` (+ :mod:`fdikit.fault_spec`), :mod:`fdikit.simulate`, :mod:`fdikit.trace`
+  (+ :mod:`fdikit.trace_io`), :mod:`fdikit.gaps`;
 * residual generation — :mod:`fdikit.design` (observers, game, parity families), :mod:`fdikit.residuals`;
 * decisions — :mod:`fdikit.decision` (evaluators), :mod:`fdikit.multimodel` (banks of estimators),
   :mod:`fdikit.estimate` (fault sizes), :mod:`fdikit.diagnosis`, :mod:`fdikit.metrics`, :mod:`fdikit.compare`;

@@ -116,7 +116,8 @@ def simulate(
     out: Path = typer.Option(Path("out/trace.parquet"), help="Parquet file to write."),
 ) -> None:
     """Simulate a named plant under faults and save the trace as Parquet."""
-    from fdikit.faults import FaultScenario, parse_fault
+    from fdikit.fault_spec import parse_fault
+    from fdikit.faults import FaultScenario
     from fdikit.plants import get_plant
     from fdikit.resume import check_nonnegative, check_output_file, check_positive, check_seed
     from fdikit.simulate import simulate as run

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from harness import case, check, ids
 
-import fdikit.faults as faults
 from fdikit.errors import DataError, ParameterError
+from fdikit.fault_spec import format_fault, parse_fault
 from fdikit.faults import (
     Bias,
     Drift,
@@ -21,7 +21,6 @@ from fdikit.faults import (
     Noise,
     ScaleFactor,
     Stuck,
-    parse_fault,
 )
 
 OUT, CTL = ("yaw_rate", "speed", "steer"), ("steer", "throttle")
@@ -120,9 +119,9 @@ CASES = [
     case("spec-too-many-values", lambda: parse_fault("bias:y:1/2"), ParameterError, "bias:y:1/2", "one value"),
     case("spec-no-target", lambda: parse_fault("bias::1"), ParameterError, "bias::1", "target"),
     # ---- the spec writer
-    case("format-not-a-fault", lambda: faults.format_fault("bias:y:1"), ParameterError, "Fault", "str"),
-    case("format-target-with-colon", lambda: faults.format_fault(Bias("a:b", 1.0)), ParameterError, "a:b", "target"),
-    case("format-target-with-space", lambda: faults.format_fault(Bias("a b", 1.0)), ParameterError, "a b", "target"),
+    case("format-not-a-fault", lambda: format_fault("bias:y:1"), ParameterError, "Fault", "str"),
+    case("format-target-with-colon", lambda: format_fault(Bias("a:b", 1.0)), ParameterError, "a:b", "target"),
+    case("format-target-with-space", lambda: format_fault(Bias("a b", 1.0)), ParameterError, "a b", "target"),
 ]
 
 
