@@ -74,13 +74,54 @@ Family = Callable[[float], FaultModel]
 
 
 def lpv_bar_matrices(window: Sequence[DAEModel], fault: str | None = None) -> tuple[np.ndarray, ...]:
-    """``(H̄_k, L̄_k, F̄_k)`` of Lemma 3-3.2 from the DAE models at the instants ``τ_0 … τ_{d_N}`` (oldest first)."""
+    """``(H̄_k, L̄_k, F̄_k)`` of Lemma 3-3.2 from the DAE models at the instants ``τ_0 … τ_{d_N}`` (oldest first).
+
+    Parameters
+    ----------
+    window : sequence of DAEModel, one per instant (``d_N + 1`` of them).
+    fault : str or None, the fault column of ``F`` (default: the only fault).
+
+    Returns
+    -------
+    tuple of three arrays, the time-indexed bar matrices of ``H``, ``L`` and of the fault column of ``F``.
+
+    Examples
+    --------
+    >>> from fdikit.dae import dae_form; from fdikit.plants.single_track import single_track_lpv
+    >>> window = [dae_form(single_track_lpv()(v)) for v in (19.0, 19.5, 20.0)]
+    >>> [M.shape for M in lpv_bar_matrices(window)]
+    [(21, 24), (21, 12), (21, 3)]
+
+    References
+    ----------
+    van der Ploeg 2018, Lemma 3-3.2.
+    """
     j = window[0].fault_index(fault)
     return (_bar([m.H for m in window]), _bar([m.L for m in window]), _bar([[F[:, [j]] for F in m.F] for m in window]))
 
 
 def lpv_rank_test(window: Sequence[DAEModel], fault: str | None = None) -> RankTest:
-    """Fact 3-3.3 / (3.15): ``Rank [H̄_k F̄_k] > Rank H̄_k`` for one window of parameter values."""
+    """Fact 3-3.3 / (3.15): ``Rank [H̄_k F̄_k] > Rank H̄_k`` for one window of parameter values.
+
+    Parameters
+    ----------
+    window, fault : as in :func:`lpv_bar_matrices`.
+
+    Returns
+    -------
+    RankTest
+
+    Examples
+    --------
+    >>> from fdikit.dae import dae_form; from fdikit.plants.single_track import single_track_lpv
+    >>> window = [dae_form(single_track_lpv()(v)) for v in (19.0, 19.5, 20.0)]
+    >>> lpv_rank_test(window)
+    RankTest(holds=True, rank_with=21, rank_without=20)
+
+    References
+    ----------
+    van der Ploeg 2018, Fact 3-3.3, (3.15).
+    """
     Hb, _, Fb = lpv_bar_matrices(window, fault)
     r_with, r_without = rank(np.hstack([Hb, Fb])), rank(Hb)
     return RankTest(r_with > r_without, r_with, r_without)
@@ -91,6 +132,32 @@ def lpv_parity_row(H_bar: np.ndarray, F_column: np.ndarray, gamma: float | None 
 
     ``gamma`` a positive number: the closed form (3.17) ``½ F̄_jᵀ (I + γ H̄ H̄ᵀ)⁻¹``.
     ``gamma=None``: its limit ``½ (P F̄_j)ᵀ``, ``P = I − H̄ H̄⁺`` (SVD, relative rank tolerance).
+
+    Parameters
+    ----------
+    H_bar : (m, n) or (K, m, n) array, ``H̄_k`` (or a stack of them).
+    F_column : (m,) or (K, m) array, the column ``F̄_{k,j}``.
+    gamma : float or None, the Lagrange multiplier (None: the exact limit).
+
+    Returns
+    -------
+    (m,) or (K, m) array, the unnormalised row(s) ``N̄_k``.
+
+    Raises
+    ------
+    DesignError
+        ``gamma`` not a positive finite number.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> H, f = np.array([[1.0], [0.0]]), np.array([1.0, 1.0])
+    >>> lpv_parity_row(H, f).round(6).tolist(), lpv_parity_row(H, f, gamma=1.0).round(6).tolist()
+    ([0.0, 0.5], [0.25, 0.5])
+
+    References
+    ----------
+    van der Ploeg 2018, Thm 3-3.4, (3.17).
     """
     H = np.asarray(H_bar, dtype=float)
     f = np.asarray(F_column, dtype=float)
@@ -124,6 +191,18 @@ class ScheduledResidualGenerator:
     controls, outputs, residuals, isolates, dt : as :class:`~fdikit.residuals.ResidualGenerator`.
     schedule : name of the trace column holding ``ρ``.
     reference : the LTI :class:`PolynomialParityDesign` at the design point.
+    fast_path : whether the family's ``dae_matrices`` is used (see :meth:`dae`).
+
+    Examples
+    --------
+    >>> from fdikit.plants.single_track import single_track_lpv
+    >>> gen = scheduled_parity_filter(single_track_lpv(), 70 / 3.6)
+    >>> gen.fault, gen.schedule, gen.fast_path
+    ('steering_actuator', 'speed', True)
+
+    References
+    ----------
+    van der Ploeg 2018, Thm 3-3.4, Cor. 3-3.5; Sec. 4-3-4.
     """
 
     family: Family
@@ -355,6 +434,22 @@ class ScheduledStepper:
     invalid), and every ``w`` whose window holds an invalid sample is replaced by 0 so the
     ``d(q)`` filter runs on.  ``last_valid`` is False on invalid and on recovering samples,
     ``last_recovering`` True on the latter.
+
+    Parameters
+    ----------
+    generator : ScheduledResidualGenerator, the filter to step.
+    recovery_tol : float in (0, 1], the recovery tolerance (see ``recovery_length``; default 0.1).
+
+    Examples
+    --------
+    >>> from fdikit.plants.single_track import single_track_lpv
+    >>> st = scheduled_parity_filter(single_track_lpv(), 70 / 3.6).online()
+    >>> float(st.step([0.0], [0.0, 0.0, 0.0], 19.0)), st.step([float("nan")], [0.0, 0.0, 0.0], 19.0), st.invalid
+    (0.0, nan, 1)
+
+    References
+    ----------
+    van der Ploeg 2018, Cor. 3-3.5.
     """
 
     def __init__(self, generator: ScheduledResidualGenerator, *, recovery_tol: float = 0.1) -> None:
@@ -463,8 +558,16 @@ def scheduled_parity_filter(
     name : str, optional
         Residual name (default ``r_<fault>``).
 
+    Returns
+    -------
+    ScheduledResidualGenerator, the scheduled filter (its own ``generator``; ``reference``: the LTI design).
+
     Raises
     ------
+    ParameterError
+        ``family`` not callable; several targets or a bare signal name.
+    ModelError
+        ``family(reference)`` not a discrete FaultModel.
     DesignError
         If the fault is not detectable at ``reference``, ``column`` is out of range or
         degenerate there, or there are fewer than ``d_N + d_L + 1`` poles.
@@ -475,6 +578,10 @@ def scheduled_parity_filter(
     >>> gen = scheduled_parity_filter(single_track_lpv(), 70 / 3.6)
     >>> gen.degree, gen.window, gen.residuals
     (2, 3, ('r_steering_actuator',))
+
+    References
+    ----------
+    van der Ploeg 2018, Thm 3-3.4, (3.17), (4.18)–(4.19); Sec. 4-3-4.
     """
     if not callable(family):
         raise ParameterError(
