@@ -114,7 +114,8 @@ def _game():
 
 
 def _dgtfdf():
-    from fdikit.design.game.discrete import dgtfdf, discrete_game_setup
+    from fdikit.design.game.discrete import dgtfdf
+    from fdikit.design.game.discrete_setup import discrete_game_setup
 
     m = white_speyer().discretize(0.01)
     st = discrete_game_setup(m, ["f1"], ["f2"], gamma=1e-2, Vbar=1e-2 / 0.01, Q=1e-3, M=5.0, P0=1e-2, steps=50)
@@ -122,7 +123,8 @@ def _dgtfdf():
 
 
 def _dgtmfdf():
-    from fdikit.design.game.discrete import dgtmfdf, discrete_game_setup
+    from fdikit.design.game.discrete import dgtmfdf
+    from fdikit.design.game.discrete_setup import discrete_game_setup
 
     rng = np.random.default_rng(0)
     A = rng.standard_normal((3, 3))

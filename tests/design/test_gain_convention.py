@@ -26,7 +26,8 @@ import numpy as np
 import pytest
 
 from fdikit import FaultModel
-from fdikit.design.game.discrete import dgtfdf, dgtmfdf, discrete_game_setup
+from fdikit.design.game.discrete import dgtfdf, dgtmfdf
+from fdikit.design.game.discrete_setup import discrete_game_setup
 from fdikit.design.game.multi_fault import game_filter
 from fdikit.design.game.reduced_order import goh_detector, goh_filter
 from fdikit.design.game.single_fault import game_filter_bank, single_fault_game_filter

@@ -9,11 +9,8 @@ import pytest
 import scipy.linalg
 
 from fdikit import FaultModel
-from fdikit.design.game.discrete import (
-    DiscreteGtfdfDesign,
-    DiscreteGtmfdfDesign,
-    dgtfdf,
-    dgtmfdf,
+from fdikit.design.game.discrete import DiscreteGtfdfDesign, DiscreteGtmfdfDesign, dgtfdf, dgtmfdf
+from fdikit.design.game.discrete_setup import (
     discrete_game_generator,
     discrete_game_riccati,
     discrete_game_setup,

@@ -9,6 +9,8 @@ discrete and time-varying filters, and the γ → 0 limit (Goh transformation, r
   (steady state; a discrete model runs Murray 2012, Ch. 5).
 * :mod:`fdikit.design.game.multi_fault` — Multiple-fault game-theoretic detection filter (GTMFDF): one gain for all
   targets (steady state; a discrete model runs Murray 2012, Ch. 5).
+* :mod:`fdikit.design.game.discrete_setup` — Building blocks of the discrete game-theoretic detection filters
+  (Murray 2012, Ch. 5): setup, DARI propagation, secondary cost, gain formula (5.41), residual generator.
 * :mod:`fdikit.design.game.discrete` — Discrete-time game-theoretic detection filters: DGTFDF and DGTMFDF (Murray
   2012, Ch. 5).
 * :mod:`fdikit.design.game.time_varying` — Finite-horizon, time-varying game-theoretic detection filters (Murray
@@ -36,10 +38,12 @@ __getattr__, __dir__, __all__ = lazy.attach(
         "multi_fault": [
             "GameDesign", "game_filter",
         ],
+        "discrete_setup": [
+            "DiscreteGameSetup", "GameRiccatiSolution", "discrete_game_generator", "discrete_game_riccati",
+            "discrete_game_setup", "gain_update", "secondary_cost",
+        ],
         "discrete": [
-            "DiscreteGameSetup", "DiscreteGtfdfDesign", "DiscreteGtmfdfDesign", "GameRiccatiSolution", "dgtfdf",
-            "dgtmfdf", "discrete_game_generator", "discrete_game_riccati", "discrete_game_setup", "gain_update",
-            "secondary_cost",
+            "DiscreteGtfdfDesign", "DiscreteGtmfdfDesign", "dgtfdf", "dgtmfdf",
         ],
         "time_varying": [
             "LTVDetectionFilter", "LTVFeasibility", "LTVGameDesign", "ltv_detection_filter", "ltv_feasibility",

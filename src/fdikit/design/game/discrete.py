@@ -1,31 +1,18 @@
 """Discrete-time game-theoretic detection filters: DGTFDF and DGTMFDF (Murray 2012, Ch. 5).
 
-Observer (5.3) on a *discrete* model (``Φ = model.A``); the residual uses the a-priori estimate
-(the text's (2.19c) prints x̂, (2.20c) and (5.3c) say x̄)::
-
-    x̄(k+1) = Φ x̂(k) + Bu u(k),   x̂(k) = x̄(k) + L (y − C x̄ − Du u),   r = y − C x̄ − Du u,   r̄_i = Ĥ_i r
-
-i.e. the predictor ``x̄(k+1) = Φ x̄ + Bu u + ΦL (y − C x̄ − Du u)`` (``observer_generator`` with gain ``ΦL``).
+Both run the observer (5.3) on a *discrete* model (``Φ = model.A``) with the projected residuals ``r̄_i = Ĥ_i r``
+of :func:`~fdikit.design.game.discrete_setup.discrete_game_generator`; the setup, the DARI propagation, the
+secondary cost and the gain formula (5.41) are in :mod:`fdikit.design.game.discrete_setup`.
 
 **Gain convention.**  Murray's ``L`` is the *filtered-form* gain of the a-posteriori update; the designs
-keep it as ``filter_gain`` (and :func:`discrete_game_riccati`, :func:`secondary_cost`, :func:`gain_update`,
-:func:`discrete_game_generator` and ``dgtmfdf(L0=…)`` take it in that form, as the text writes every
-equation).  Their ``gain`` is fdikit's observer (predictor) gain ``ΦL``: the generator's state matrix is
+keep it as ``filter_gain`` (and ``dgtmfdf(L0=…)`` takes it in that form, as the text writes every equation).
+Their ``gain`` is fdikit's observer (predictor) gain ``ΦL``: the generator's state matrix is
 ``Φ − (ΦL) C = Φ(I − LC)``, the sign and form of python-control's ``dlqe`` and of every other design.
 
-Target ``i`` (``F̂_i``, ``Ĥ_i`` from :func:`~fdikit.design.game.setup.game_problem`) meets its
-disturbance-attenuation problem (5.8) when the DARI (5.23) ≡ (5.29) ≡ (5.30) has ``Π_i ≥ 0``.  With
-equality and ``P = Π⁻¹`` ((5.29) and (5.44b) rewritten in ``P``; for ``L = Λ⁻¹CᵀV⁻¹`` it is (5.42))::
-
-    P(k+1) = Φ [(I − LC)(P⁻¹ − CᵀĤQĤC)⁻¹(I − LC)ᵀ + L V Lᵀ] Φᵀ + F̂MF̂ᵀ/γ,     P(k0) = P0/γ
-
-with ``V = V̄/γ`` and ``Π_0 = γP0⁻¹`` (5.9).  It needs ``Γ = P⁻¹ − CᵀĤQĤC > 0`` at every step
-(Proposition 5.2), checked as ``λ_max(RPRᵀ) < 1`` with ``R = Q^½ĤC``; ``Γ⁻¹ = P + PRᵀ(I − RPRᵀ)⁻¹RP``
-avoids inverting ``P``.  Φ and ``I − LC`` must be invertible (Ch. 5 assumption).
-
 * **DGTFDF** (one target, (5.42)–(5.43)): ``Σ = Θ − Cᵀ(ĤQĤ − V⁻¹)C``, ``Θ̃ = [ΦΣ⁻¹Φᵀ + F̂MF̂ᵀ/γ]⁻¹``,
-  ``L = Σ⁻¹CᵀV⁻¹`` (erratum: (5.42b) prints Λ for Σ).  The recursion above reproduces it exactly at
-  this gain, which minimises ``P(k+1)`` given ``P(k)``.
+  ``L = Σ⁻¹CᵀV⁻¹`` (erratum: (5.42b) prints Λ for Σ).  The DARI recursion of
+  :func:`~fdikit.design.game.discrete_setup.discrete_game_riccati` reproduces it exactly at this gain, which
+  minimises ``P(k+1)`` given ``P(k)``.
 * **DGTMFDF** (targets sharing one gain, (5.31)–(5.41)): minimise ``J̄ = Σ_i Σ_{k0}^{k1−1} tr(W_iΠ_i(k))``,
   ``W_i = F̂_iK_iF̂_iᵀ/γ − F_iN_iF_iᵀ`` (5.39).  fdikit keeps **one constant gain** over the horizon
   (the text's L may vary with k), so the filter is LTI.  Gradient: (5.34) summed over k, multiplier
@@ -38,319 +25,34 @@ avoids inverting ``P``.  Φ and ``I − LC`` must be invertible (Ch. 5 assumptio
   pole to the unit circle (measured on the F-16XL); accepted gains keep ``ρ(Φ(I − LC)) ≤ max_radius``
   (the stability constraint of the text's ``fmincon`` runs, Remarks 6.1–6.2), and the optimum then
   sits on that bound.  Remark 5.1: no steady-state theory exists; everything is finite-horizon.
-
-Other errata applied: (5.2a) prints ``Φ x(k)`` for the state ``x_i``, read ``Φ x_i(k)``; (5.23), (5.26), (5.27)
-need ``F̂_iᵀ`` where the
-text prints ``F̂_iΓ̂_iΦL``; (3.32)/(5.9) start from ``P0/γ``, not ``γP0``.
 """
 
 from __future__ import annotations
 
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
 import scipy.optimize
 
-from fdikit import linalg, validate
-from fdikit.design.game.setup import GameProblem, game_problem, per_target, weight
-from fdikit.design.observers.full_order import observer_generator
+from fdikit import validate
+from fdikit.design.game.discrete_setup import (
+    GUARD,
+    DiscreteGameSetup,
+    GameRiccatiSolution,
+    discrete_game_generator,
+    discrete_game_riccati,
+    gain_update,
+    infeasible,
+    secondary_cost,
+)
 from fdikit.errors import DesignError, ParameterError
-from fdikit.model import FaultModel
 from fdikit.protocols import FieldReport
 from fdikit.residuals import ResidualGenerator
 
-__all__ = [
-    "DiscreteGameSetup", "discrete_game_setup", "GameRiccatiSolution", "discrete_game_riccati", "secondary_cost",
-    "gain_update", "discrete_game_generator", "DiscreteGtfdfDesign", "dgtfdf", "DiscreteGtmfdfDesign", "dgtmfdf",
-]
-
-_GUARD = 1.0 - 1e-10  # λ_max(RPRᵀ) at or above this: Γ = P⁻¹ − RᵀR is not positive definite
-
-
-@dataclass(frozen=True, eq=False)
-class DiscreteGameSetup:
-    """Partition, weights and horizon of a discrete game filter (Murray 2012, (5.8), (5.9), (5.39)).
-
-    Attributes
-    ----------
-    problem : targets, ``F̂_i``, ``Ĥ_i``.  gamma : γ (small = strong blocking).  V : ``V̄/γ``.
-    P_init : ``P(k0) = P0/γ = Π_0⁻¹``.  steps : horizon ``k1 − k0``.
-    Q, M, K, N : per-target weights (p x p; k̂_i; k̂_i; k_i square).
-    """
-
-    problem: GameProblem
-    gamma: float
-    V: np.ndarray
-    P_init: np.ndarray
-    steps: int
-    Q: dict[str, np.ndarray]
-    M: dict[str, np.ndarray]
-    K: dict[str, np.ndarray]
-    N: dict[str, np.ndarray]
-
-    @property
-    def model(self) -> FaultModel:
-        return self.problem.model
-
-    @property
-    def names(self) -> tuple[str, ...]:
-        return self.problem.names
-
-    def nuisance_covariance(self, name: str) -> np.ndarray:
-        """``F̂_i M_i F̂_iᵀ / γ``."""
-        F = self.problem.complementary[name]
-        return F @ self.M[name] @ F.T / self.gamma
-
-    def cost_weight(self, name: str) -> np.ndarray:
-        """``W_i = F̂_iK_iF̂_iᵀ/γ − F_iN_iF_iᵀ`` of the example cost (5.39)."""
-        F, Fh = self.problem.targets[name], self.problem.complementary[name]
-        return Fh @ self.K[name] @ Fh.T / self.gamma - F @ self.N[name] @ F.T
-
-    def output_weight_root(self, name: str) -> np.ndarray:
-        """``R_i = Q_i^½ Ĥ_i C``, so that ``CᵀĤ_iQ_iĤ_iC = R_iᵀR_i``."""
-        w, U = np.linalg.eigh(self.Q[name])
-        return (U * np.sqrt(np.clip(w, 0.0, None))) @ U.T @ self.problem.projectors[name] @ self.model.C
-
-
-def _weights(kind: str, value, dims: Mapping[str, int]) -> dict[str, np.ndarray]:
-    """:func:`~fdikit.design.game.setup.per_target`, each checked as a ``dims[target]``-square :func:`weight`."""
-    return {nm: weight(f"{kind}[{nm}]", v, dims[nm]) for nm, v in per_target(kind, value, list(dims)).items()}
-
-
-def _positive(name: str, W: np.ndarray) -> np.ndarray:
-    if W.size and np.linalg.eigvalsh(W).min() <= 0:
-        raise ParameterError(f"weight {name} must be positive definite")
-    return W
-
-
-def discrete_game_setup(
-    model: FaultModel,
-    targets: Mapping[str, np.ndarray] | Sequence[str],
-    nuisance: Mapping[str, np.ndarray] | Sequence[str] = (),
-    *,
-    gamma: float,
-    Vbar,
-    Q,
-    M,
-    K=0.0,
-    N=0.0,
-    P0=1.0,
-    steps: int = 500,
-    rtol: float | None = None,
-) -> DiscreteGameSetup:
-    """Partition the faults of a discrete model and fix the weights (Murray 2012, (5.8), (5.9), (5.39)).
-
-    Parameters
-    ----------
-    model : discrete FaultModel (sample a continuous plant with ``model.discretize(dt)``).
-    targets, nuisance : as in :func:`~fdikit.design.game.setup.game_problem`.
-    gamma : attenuation bound γ > 0.  Vbar : measurement-noise weight ``V̄ > 0``; ``V = V̄/γ``.
-    Q, M, K, N : output weight ``Q_i ≥ 0`` (p x p), complementary-fault weight ``M_i > 0`` and
-        secondary-cost weights ``K_i`` (on ``F̂_i``), ``N_i`` (on ``F_i``): scalar, matrix or a
-        mapping target → value.  Sampling a continuous design at Δt: ``Q_d = Q_cΔt``,
-        ``M_d = M_c/Δt`` (fault columns ZOH-sampled, ≈ ``F_cΔt``), ``V_d = V_c/Δt``.
-    P0 : initial-error weight, ``P(k0) = P0/γ`` (``Π_0 = γP0⁻¹``).  ``Q·P0/γ`` must stay below 1
-        along ``ĤC`` or the DARI fails at k0 — the initial error reaches the a-priori residual.
-    steps : horizon ``k1 − k0`` in samples.
-
-    Raises
-    ------
-    DesignError
-        Continuous model, γ ≤ 0, singular Φ, ``V̄``, ``P0`` or ``M_i`` not positive definite, a weight
-        of the wrong size.
-    """
-    if not model.is_discrete:
-        raise DesignError("the discrete game filter needs a discrete model; sample the plant with model.discretize(dt)")
-    validate.instance("model", model, FaultModel)
-    gamma = validate.number("gamma", gamma, finite=False)
-    if not (np.isfinite(gamma) and gamma > 0):
-        raise ParameterError(f"gamma must be a positive finite attenuation bound, got {gamma}")
-    if isinstance(steps, bool) or not isinstance(steps, int | np.integer | float) or int(steps) != steps or steps < 1:
-        raise ParameterError(f"steps must be a positive integer horizon, got {steps}")
-    s = np.linalg.svd(model.A, compute_uv=False)
-    if s[-1] <= 1e-12 * max(s[0], 1.0):
-        raise DesignError(f"Φ = model.A is singular (σ_min = {s[-1]:.3g}); Murray 2012 Ch. 5 assumes an invertible "
-                          "state-transition matrix (a sampled continuous plant always has one)")
-    prob = game_problem(model, targets, nuisance, rtol)
-    kh = {t: prob.complementary[t].shape[1] for t in prob.names}
-    return DiscreteGameSetup(
-        prob, float(gamma), _positive("Vbar", weight("Vbar", Vbar, model.p)) / gamma,
-        _positive("P0", weight("P0", P0, model.n)) / gamma, int(steps),
-        _weights("Q", Q, {t: model.p for t in prob.names}),
-        {t: _positive(f"M[{t}]", Mi) for t, Mi in _weights("M", M, kh).items()},
-        _weights("K", K, kh), _weights("N", N, {t: prob.targets[t].shape[1] for t in prob.names}),
-    )
-
-
-# ---------------------------------------------------------------------- the DARI propagation
-@dataclass(frozen=True, eq=False)
-class GameRiccatiSolution:
-    """Forward solution of the DGTMFDF Riccati equations for a given gain.
-
-    Attributes
-    ----------
-    covariances : ``P_i(k)`` by target, shape (steps + 1, n, n), ``P_i(k0) = P0/γ``.
-    levels : ``λ_max(Q_i^½Ĥ_iCP_i(k)CᵀĤ_iQ_i^½)``, k = k0 … k1 − 1; below 1 ⇔ ``Γ_i(k) > 0``.
-    gamma_inverses : ``Γ_i(k)⁻¹``, shape (steps, n, n).
-    """
-
-    covariances: dict[str, np.ndarray]
-    levels: dict[str, np.ndarray]
-    gamma_inverses: dict[str, np.ndarray]
-
-    def information(self, name: str, k: int = -1) -> np.ndarray:
-        """``Π_i(k) = P_i(k)⁻¹``."""
-        Pi = np.linalg.inv(self.covariances[name][k])
-        return (Pi + Pi.T) / 2
-
-
-def _check_gain(L: np.ndarray, C: np.ndarray, floor: float = 1e-10) -> float:
-    smin = float(np.linalg.svd(np.eye(L.shape[0]) - L @ C, compute_uv=False)[-1])
-    if smin <= floor:
-        raise DesignError(f"I − LC is singular (σ_min = {smin:.3g}); Murray 2012 Ch. 5 needs an invertible I − LC — "
-                          "choose a gain whose a-posteriori update does not cancel a state direction")
-    return smin
-
-
-def _infeasible(setup: DiscreteGameSetup, name: str, k: int, P: np.ndarray, level: float) -> DesignError:
-    R = setup.output_weight_root(name)
-    lam = float(np.linalg.eigvalsh(np.linalg.inv(P) - R.T @ R).min())
-    return DesignError(
-        f"target {name!r}: the game Riccati recursion loses P⁻¹ − CᵀĤQĤC > 0 at step k = {k} (smallest eigenvalue "
-        f"{lam:.3g}; λ_max(Q^½ĤCPCᵀĤQ^½) = {level:.4g} ≥ 1): the attenuation bound γ = {setup.gamma:g} is not met "
-        "with this gain — lower Q or P0, raise γ or M, or change the gain"
-    )
-
-
-def discrete_game_riccati(setup: DiscreteGameSetup, L) -> GameRiccatiSolution:
-    """Propagate the DARI with equality (Murray 2012, (5.17), (5.29)–(5.30)) for a given gain, all targets at once.
-
-    ``L`` (Murray's filtered form, a design's ``filter_gain``) is n x p (constant) or a (steps, n, p)
-    sequence.  Raises :class:`DesignError` naming the target, the step and the smallest eigenvalue of
-    ``P⁻¹ − CᵀĤQĤC`` when positivity is lost, or when ``I − L(k)C`` is singular.
-
-    Examples
-    --------
-    >>> from fdikit.plants.white_speyer import white_speyer
-    >>> m = white_speyer().discretize(0.01)
-    >>> st = discrete_game_setup(m, ["f1"], ["f2"], gamma=1e-2, Vbar=1e-2 / 0.01, Q=1e-3, M=5.0, P0=1e-2, steps=50)
-    >>> bool(discrete_game_riccati(st, dgtfdf(st).filter_gain).levels["f1"].max() < 1)
-    True
-    """
-    m, steps, names = setup.model, setup.steps, setup.names
-    n = m.n
-    L = np.asarray(L, dtype=float)
-    if L.shape not in ((n, m.p), (steps, n, m.p)):
-        raise DesignError(f"gain has shape {L.shape}; give n x p = {n} x {m.p} or a ({steps}, {n}, {m.p}) sequence")
-    Ls = L if L.ndim == 3 else L[None]
-    for Lk in Ls:
-        _check_gain(Lk, m.C)
-    R = np.stack([setup.output_weight_root(t) for t in names])  # (s, p, n)
-    Rt = np.swapaxes(R, 1, 2)
-    Nc = np.stack([setup.nuisance_covariance(t) for t in names])
-    P = np.empty((steps + 1, len(names), n, n))
-    Ginv = np.empty((steps, len(names), n, n))
-    P[0] = setup.P_init
-    eye_p = np.eye(m.p)
-    for k in range(steps):
-        if k < len(Ls):
-            Lk = Ls[k]
-            Phat = m.A @ (np.eye(n) - Lk @ m.C)
-            G = m.A @ Lk @ setup.V @ Lk.T @ m.A.T + Nc  # G_i of (5.17)
-        RP = R @ P[k]
-        S = eye_p - RP @ Rt
-        try:
-            np.linalg.cholesky(S * (1 + 1e-10) - 1e-10 * eye_p)  # ⇔ λ_max(RPRᵀ) < _GUARD
-        except np.linalg.LinAlgError:
-            lv = 1.0 - np.linalg.eigvalsh(S).min(axis=-1)
-            i = int(np.argmax(lv))
-            raise _infeasible(setup, names[i], k, P[k, i], float(lv[i])) from None
-        Ginv[k] = P[k] + np.swapaxes(RP, 1, 2) @ np.linalg.solve(S, RP)
-        Pn = Phat @ Ginv[k] @ Phat.T + G
-        P[k + 1] = (Pn + np.swapaxes(Pn, 1, 2)) / 2
-    RPR = R[None] @ P[:-1] @ Rt[None]
-    lev = np.linalg.eigvalsh((RPR + np.swapaxes(RPR, -1, -2)) / 2).max(axis=-1)
-    return GameRiccatiSolution({t: P[:, i] for i, t in enumerate(names)}, {t: lev[:, i] for i, t in enumerate(names)},
-                               {t: Ginv[:, i] for i, t in enumerate(names)})
-
-
-# ---------------------------------------------------------------------- secondary optimisation
-def _adjoint(setup: DiscreteGameSetup, L: np.ndarray, sol: GameRiccatiSolution):
-    """Cost, exact gradient and the two (5.41) sums for a constant gain (one backward sweep)."""
-    m, names = setup.model, setup.names
-    Phi, C, V = m.A, m.C, setup.V
-    CV = C.T @ np.linalg.inv(V)
-    Phat = Phi @ (np.eye(m.n) - L @ C)
-    Ginv = np.stack([sol.gamma_inverses[t] for t in names], axis=1)  # (steps, s, n, n)
-    Pis = np.linalg.inv(np.stack([sol.covariances[t] for t in names], axis=1))
-    Pis = (Pis + np.swapaxes(Pis, -1, -2)) / 2
-    W = np.stack([setup.cost_weight(t) for t in names])
-    RtR = np.stack([(R := setup.output_weight_root(t)).T @ R for t in names])
-    cost = float(np.einsum("sij,ksji->", W, Pis[:-1]))
-    Y = Ginv @ Phat.T  # Γ⁻¹Φ̂ᵀ
-    X = np.empty_like(Ginv)
-    lam = np.zeros_like(W)  # ∂J̄/∂Π(k+1) = −Δ(k+1); zero at k1 (5.36)
-    for k in range(setup.steps - 1, -1, -1):
-        X[k] = Pis[k + 1] @ lam @ Pis[k + 1]
-        lam = W + Y[k] @ X[k] @ np.swapaxes(Y[k], -1, -2)  # (5.35), (5.37), (5.40)
-    grad = 2 * Phi.T @ np.einsum("ksij,ksjl->il", X, Phat @ Ginv @ C.T - Phi @ L @ V)  # (5.34)
-    T = Phat.T @ X @ Phat @ Ginv  # −Γ_iΛ_i of (5.41)
-    lhs = np.einsum("ksij,ksjl->il", T, Pis[:-1] - RtR + CV @ C)
-    return cost, grad, lhs, np.einsum("ksij,jl->il", T, CV)
-
-
-def _constant_gain(setup: DiscreteGameSetup, L) -> np.ndarray:
-    L = np.asarray(L, dtype=float)
-    if L.shape != (setup.model.n, setup.model.p):
-        raise DesignError(f"the secondary optimisation uses one constant gain: L must be n x p = "
-                          f"{setup.model.n} x {setup.model.p}, got shape {L.shape}")
-    return L
-
-
-def secondary_cost(setup: DiscreteGameSetup, L) -> tuple[float, np.ndarray]:
-    """``J̄(L) = Σ_i Σ_{k=k0}^{k1−1} tr(W_iΠ_i(k))`` and its exact gradient (Murray 2012, (5.31)–(5.40)).
-
-    ``L`` is constant over the horizon; the gradient is (5.34) summed over k with the backward
-    multiplier (5.35) from ``Δ(k1) = 0`` (5.36).  :class:`DesignError` when the DARI is infeasible.
-    """
-    L = _constant_gain(setup, L)
-    cost, grad, _, _ = _adjoint(setup, L, discrete_game_riccati(setup, L))
-    return cost, grad
-
-
-def gain_update(setup: DiscreteGameSetup, L) -> np.ndarray:
-    """The gain formula (5.41), summed over targets and the horizon, with ``Γ_i, Λ_i`` evaluated at ``L``.
-
-    ``L⁺ = [Σ Γ_iΛ_i(Γ_i + CᵀV⁻¹C)]⁻¹ [Σ Γ_iΛ_iCᵀV⁻¹]``.  Its residual ``Σ Γ_iΛ_i[(Γ_i + CᵀV⁻¹C)L − CᵀV⁻¹]``
-    equals ``(I − LC)ᵀ·½∇J̄·V⁻¹(I − CL)``, so a fixed point is stationary only while ``I − LC`` is invertible.
-    """
-    L = _constant_gain(setup, L)
-    _, _, lhs, rhs = _adjoint(setup, L, discrete_game_riccati(setup, L))
-    try:
-        return np.linalg.solve(lhs, rhs)
-    except np.linalg.LinAlgError as exc:
-        raise DesignError("Σ Γ_iΛ_i(Γ_i + CᵀV⁻¹C) of (5.41) is singular: the null spaces overlap across targets "
-                          "(Murray 2012, Remark 5.3); raise the weights N_i or K_i") from exc
-
-
-# ---------------------------------------------------------------------- generators and designs
-def discrete_game_generator(setup: DiscreteGameSetup, L, targets: Sequence[str] | None = None) -> ResidualGenerator:
-    """Residual generator of the observer (5.3) with projected residuals ``Q_iᵀ r`` (Murray 2012, (5.3), (5.6)).
-
-    ``x̄(k+1) = Φ(I − LC) x̄ + (Bu − ΦL Du) u + ΦL y``, ``r = y − C x̄ − Du u``; ``Q_i`` is an orthonormal
-    basis of ``Im Ĥ_i`` and the residuals are named ``<target>[j]``, each isolating its target.
-    """
-    m = setup.model
-    names, blocks, isolates = [], [], []
-    for t in targets if targets is not None else setup.names:
-        Qi = linalg.orth(setup.problem.projectors[t])
-        blocks.append(Qi)
-        names += [f"{t}[{j}]" for j in range(Qi.shape[1])]
-        isolates += [t] * Qi.shape[1]
-    return observer_generator(m, m.A @ np.asarray(L, dtype=float), names, np.hstack(blocks), isolates)
+__all__ = ["DiscreteGtfdfDesign", "dgtfdf", "DiscreteGtmfdfDesign", "dgtmfdf"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -427,8 +129,8 @@ def dgtfdf(setup: DiscreteGameSetup, targets: str | Sequence[str] | None = None,
     for k in range(setup.steps):
         RP = R @ P[k]
         levels[k] = float(np.linalg.eigvalsh(RP @ R.T).max())
-        if levels[k] >= _GUARD:
-            raise _infeasible(setup, target, k, P[k], levels[k])
+        if levels[k] >= GUARD:
+            raise infeasible(setup, target, k, P[k], levels[k])
         Ginv = P[k] + RP.T @ np.linalg.solve(np.eye(m.p) - RP @ R.T, RP)
         GC = Ginv @ C.T
         gains[k] = np.linalg.solve(V + C @ GC, GC.T).T

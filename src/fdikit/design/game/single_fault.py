@@ -25,7 +25,8 @@ import numpy as np
 import scipy.linalg
 
 from fdikit import linalg
-from fdikit.design.game.discrete import DiscreteGameSetup, DiscreteGtfdfDesign, dgtfdf, discrete_game_setup
+from fdikit.design.game.discrete import DiscreteGtfdfDesign, dgtfdf
+from fdikit.design.game.discrete_setup import DiscreteGameSetup, discrete_game_setup
 from fdikit.design.game.riccati import checked_gamma, require_continuous, solve_game_are
 from fdikit.design.game.setup import GameProblem, game_problem, per_target, weight
 from fdikit.design.observers.full_order import observer_generator
