@@ -299,7 +299,7 @@ def test_missing_signal_in_trace():
 
 
 def test_generator_validation():
-    with pytest.raises(ModelError, match=r"B has shape \(2, 2\), need \(2, 3\)"):
+    with pytest.raises(ModelError, match=r"B has 2 columns but must have 3 \(shape \(2, 2\)\)"):
         ResidualGenerator(A=np.eye(2), B=np.zeros((2, 2)), C=np.zeros((1, 2)), D=np.zeros((1, 3)),
                           controls=["u"], outputs=["a", "b"], residuals=["r"], dt=0.1)
     with pytest.raises(ModelError, match="non-finite"):

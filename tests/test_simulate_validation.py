@@ -151,7 +151,7 @@ def test_the_block_solver_would_leak_inf_backwards_so_inf_never_reaches_it():
     m = plant().discretize(DT)
     v = np.zeros((161, 6))  # u1, u2, gust, w1..w3
     v[100:, 0] = np.inf
-    with pytest.raises(DataError, match=r"v \(the input sequence\) has a non-finite entry at index \(100, 0\)"):
+    with pytest.raises(DataError, match=r"v \(the input sequence\) has a non-finite entry at row 100, column 0"):
         dlsim_blocked(m.A, m.B, m.C, m.D, v)
     with pytest.raises(ParameterError, match="size must be a finite number"):
         Bias("u1", np.inf, onset=5.0)

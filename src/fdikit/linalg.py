@@ -53,10 +53,7 @@ _EPS = np.finfo(float).eps
 
 def _mat(name: str, M) -> np.ndarray:
     """``M`` as a finite real or complex 2-D array (a vector is one row); ParameterError otherwise."""
-    M = np.atleast_2d(validate.as_array(name, M, complex_ok=True))
-    if M.ndim != 2:
-        raise ParameterError(f"{name} must be a 2-D matrix, got an array with {M.ndim} dimensions (shape {M.shape})")
-    return M
+    return validate.as_matrix(name, M, promote=True, complex_ok=True)
 
 
 def _rtol(rtol):

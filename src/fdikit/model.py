@@ -64,25 +64,11 @@ def _matrix(name: str, value, rows: int | None, cols: int | None) -> np.ndarray:
         out = np.zeros((rows, cols))
     else:
         out = validate.as_array(name, value, error=ModelError, finite=False)
-        if out.ndim == 0:
-            out = out.reshape(1, 1)
         if out.ndim == 1 and cols == 1:
             out = out.reshape(-1, 1)
         if out.size == 0:
             out = np.zeros((rows if rows is not None else 0, cols if cols is not None else 0))
-        if out.ndim != 2:
-            raise ModelError(f"{name} must be a 2-D matrix, got an array with {out.ndim} dimensions")
-        if rows is not None and out.shape[0] != rows:
-            raise ModelError(f"{name} has {out.shape[0]} rows but must have {rows}")
-        if cols is not None and out.shape[1] != cols:
-            raise ModelError(f"{name} has {out.shape[1]} columns but must have {cols}")
-    bad = np.argwhere(~np.isfinite(out))
-    if bad.size:
-        i, j = bad[0]
-        raise ModelError(
-            f"{name} has a non-finite entry at row {i}, column {j} ({out[i, j]!r}); "
-            "every matrix entry must be a finite number"
-        )
+        out = validate.as_matrix(name, out, (rows, cols), error=ModelError)
     out.setflags(write=False)
     return out
 

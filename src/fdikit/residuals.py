@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg
 
+from fdikit import validate
 from fdikit.errors import DataError, ModelError, ParameterError
 from fdikit.gaps import GapRule, Recovery, gap_options
 from fdikit.lti import dlsim_blocked
@@ -140,11 +141,9 @@ class Residuals:
 
 
 def _mat(name, value, shape):
-    arr = np.atleast_2d(np.asarray(value, dtype=float)) if np.size(value) else np.zeros(shape)
-    if arr.shape != shape:
-        raise ModelError(f"residual generator {name} has shape {arr.shape}, need {shape}")
-    if not np.all(np.isfinite(arr)):
-        raise ModelError(f"residual generator {name} has non-finite entries")
+    """A read-only filter matrix of ``shape`` (:func:`fdikit.validate.as_matrix`; empty means zeros)."""
+    arr = (validate.as_matrix(f"residual generator {name}", value, shape, error=ModelError, promote=True)
+           if np.size(value) else np.zeros(shape))
     arr.setflags(write=False)
     return arr
 

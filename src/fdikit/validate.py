@@ -72,7 +72,7 @@ def as_array(name: str, value, *, error: type[Exception] = ParameterError, finit
         bad = np.argwhere(~np.isfinite(out))
         if bad.size:
             where = tuple(int(i) for i in bad[0])
-            at = f" at index {where}" if out.ndim else ""
+            at = f" at row {where[0]}, column {where[1]}" if out.ndim == 2 else f" at index {where}" if out.ndim else ""
             raise error(f"{name} has a non-finite entry{at} ({out[where]!r}); every entry must be a finite number")
     return out
 
@@ -85,13 +85,19 @@ def as_matrix(
     error: type[Exception] = ParameterError,
     finite: bool = True,
     scalar_ok: bool = False,
+    promote: bool = False,
+    complex_ok: bool = False,
 ) -> np.ndarray:
     """``value`` as a 2-D float matrix of ``shape`` (``None`` entries are free).
 
-    A scalar becomes 1 x 1 (or, with ``scalar_ok`` and a square ``shape``, ``value · I``).
+    A scalar becomes 1 x 1 (or, with ``scalar_ok`` and a square ``shape``, ``value · I``); with
+    ``promote`` a vector becomes one row (``np.atleast_2d``); with ``complex_ok`` complex entries
+    give a complex matrix.
     """
-    out = as_array(name, value, error=error, finite=finite)
+    out = as_array(name, value, error=error, finite=finite, complex_ok=complex_ok)
     rows, cols = shape if shape is not None else (None, None)
+    if promote and out.ndim == 1:
+        out = out.reshape(1, -1)
     if out.ndim == 0:
         if scalar_ok and rows is not None and rows == cols:
             out = float(out) * np.eye(rows)
@@ -101,9 +107,10 @@ def as_matrix(
         raise error(f"{name} must be a 2-D matrix, got an array with {out.ndim} dimensions (shape {out.shape})")
     want = f"{'n' if rows is None else rows} x {'m' if cols is None else cols}"
     if rows is not None and out.shape[0] != rows:
-        raise error(f"{name} has {out.shape[0]} rows but must have {rows}; pass a {want} matrix")
+        raise error(f"{name} has {out.shape[0]} rows but must have {rows} (shape {out.shape}); pass a {want} matrix")
     if cols is not None and out.shape[1] != cols:
-        raise error(f"{name} has {out.shape[1]} columns but must have {cols}; pass a {want} matrix")
+        raise error(f"{name} has {out.shape[1]} columns but must have {cols} (shape {out.shape}); pass a {want} "
+                    "matrix")
     return out
 
 
@@ -164,7 +171,13 @@ def as_covariance(
     A scalar means ``value · I``.  Symmetry and the eigenvalue test use a tolerance relative
     to the largest entry (1e-12).  Returns the symmetric part.
     """
-    out = as_matrix(name, value, (n, n), error=error, scalar_ok=scalar_ok)
+    raw = as_array(name, value, error=error)
+    if scalar_ok and raw.size == 1 and raw.ndim <= 2:
+        raw = raw.reshape(())
+    if raw.shape != (n, n) and not (raw.ndim == 0 and (scalar_ok or n == 1)):
+        raise error(f"{name} must be a {n}x{n} covariance matrix{' (a scalar means σ² I)' if scalar_ok else ''}; "
+                    f"use np.diag(variances) for independent components; got shape {raw.shape}")
+    out = as_matrix(name, raw, (n, n), error=error, scalar_ok=scalar_ok)
     scale = max(1.0, float(np.abs(out).max(initial=0.0)))
     if not np.allclose(out, out.T, rtol=0.0, atol=1e-12 * scale):
         raise error(f"{name} must be symmetric; pass (M + M.T) / 2 or a diagonal matrix")

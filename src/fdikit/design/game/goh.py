@@ -53,7 +53,7 @@ import numpy as np
 import scipy.linalg
 from scipy.integrate import solve_ivp
 
-from fdikit import linalg
+from fdikit import linalg, validate
 from fdikit.design.game.setup import weight
 from fdikit.errors import DesignError, ModelError, ParameterError
 
@@ -105,15 +105,6 @@ class GohTransformation:
         return linalg.orth(self.B_bar) if self.B_bar.shape[1] else self.B_bar
 
 
-def _as2d(name: str, M, rows: int | None = None) -> np.ndarray:
-    M = np.atleast_2d(np.asarray(M, dtype=float))
-    if rows is not None and M.shape[0] != rows:
-        raise ModelError(f"{name} has {M.shape[0]} rows, need {rows}")
-    if not np.all(np.isfinite(M)):
-        raise ModelError(f"{name} has non-finite entries")
-    return M
-
-
 def _rank_tol(C: np.ndarray, B: np.ndarray, rtol: float | None) -> float:
     """Absolute threshold for ``C B`` singular values, relative to ‖C‖‖B‖ (not to ‖C B‖)."""
     r = rtol if rtol is not None else 1e3 * max(C.shape + B.shape) * _EPS
@@ -161,9 +152,9 @@ def goh_transformation(A, C, F, rtol: float | None = None) -> GohTransformation:
     ----------
     Murray 2012, §4.1.2, Algorithm 4.1, Steps 1–8.
     """
-    A = _as2d("A", A)
+    A = validate.as_square("A", A, error=ModelError)
     n = A.shape[0]
-    C = _as2d("C", C)
+    C = validate.as_matrix("C", C, error=ModelError, promote=True)
     if C.shape[1] != n:
         raise ModelError(f"C has {C.shape[1]} columns but A is {n} x {n}")
     F = np.asarray(F, dtype=float).reshape(n, -1)
@@ -376,14 +367,14 @@ def _weights(C: np.ndarray, V, Q) -> tuple[np.ndarray, np.ndarray]:
 
 def _prepare(A, C, F_hat, V, Q, projector, rtol):
     """Common data of the Goh Riccati equation: checked matrices, weights, Goh transformation, Ĥ and H̄."""
-    A = _as2d("A", A)
+    A = validate.as_square("A", A, error=ModelError)
     n = A.shape[0]
-    C = _as2d("C", C)
+    C = validate.as_matrix("C", C, (None, n), error=ModelError, promote=True)
     F = np.asarray(F_hat, dtype=float).reshape(n, -1)
     Vw, Qw = _weights(C, V, Q)
     goh = goh_transformation(A, C, F, rtol)
-    H = _orthogonal_projector(C, goh.invariant_subspace) if projector is None else _as2d(
-        "projector", projector, C.shape[0])
+    H = _orthogonal_projector(C, goh.invariant_subspace) if projector is None else validate.as_matrix(
+        "projector", projector, (C.shape[0], C.shape[0]))
     return A, C, F, Vw, Qw, np.linalg.inv(Vw), goh, H, oblique_projector(C, goh.B_tilde, Vw)
 
 
@@ -546,7 +537,7 @@ def goh_riccati_transient(A, C, F_hat, t: Sequence[float], *, V=1.0, Q=1e-4, S0=
     t = np.asarray(t, dtype=float)
     if t.ndim != 1 or np.any(t < 0) or np.any(np.diff(t) < 0):
         raise ParameterError("t must be a nondecreasing 1-D sequence of times ≥ 0 (the equation starts at t0 = 0)")
-    Sb0 = np.zeros((n1, n1)) if S0 is None else G1 @ _as2d("S0", S0, n) @ G1.T
+    Sb0 = np.zeros((n1, n1)) if S0 is None else G1 @ validate.as_matrix("S0", S0, (n, n)) @ G1.T
     sol = solve_ivp(rhs, (0.0, float(t[-1]) if t.size else 0.0), Sb0.ravel(), method="Radau", t_eval=t,
                     rtol=tol, atol=tol * max(np.abs(q).max(), _EPS))
     if not sol.success:

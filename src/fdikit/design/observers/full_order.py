@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg
 
-from fdikit import linalg, validate
+from fdikit import lti, validate
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import joined_form
@@ -186,7 +186,7 @@ def observer_generator(
 
 
 def _check_stable(model: FaultModel, poles: np.ndarray, what: str) -> None:
-    bad = ~linalg.is_stable(poles, model.is_discrete)
+    bad = ~lti.is_stable(poles, model.is_discrete)
     if np.any(bad):
         modes = unobservable_modes(model.A, model.C)
         raise DesignError(
@@ -263,21 +263,6 @@ def _poles(poles, n: int) -> np.ndarray:
     return out
 
 
-def _cov(name: str, value, k: int) -> np.ndarray:
-    arr = np.atleast_2d(validate.as_array(name, value))
-    if arr.shape == (1, 1) and k != 1:
-        arr = arr[0, 0] * np.eye(k)
-    if arr.shape != (k, k):
-        raise ParameterError(
-            f"{name} must be a {k}x{k} covariance matrix (use np.diag(variances)), got shape {arr.shape}"
-        )
-    if not np.allclose(arr, arr.T, atol=1e-12 * max(1.0, np.abs(arr).max())):
-        raise ParameterError(f"{name} must be symmetric")
-    if np.linalg.eigvalsh(arr).min() < -1e-12 * max(1.0, np.abs(arr).max()):
-        raise ParameterError(f"{name} must be positive semidefinite")
-    return arr
-
-
 def kalman(model: FaultModel, Q, R) -> ObserverDesign:
     """Steady-state Kalman filter residual generator (the innovation).
 
@@ -327,11 +312,11 @@ def kalman(model: FaultModel, Q, R) -> ObserverDesign:
     n, p = model.n, model.p
     if model.noise:
         G, H = model.Bw, model.Dw
-        Q = _cov("Q", Q, len(model.noise))
+        Q = validate.as_covariance("Q", Q, len(model.noise))
     else:
         G, H = np.eye(n), np.zeros((p, n))
-        Q = _cov("Q", Q, n)
-    R = _cov("R", R, p)
+        Q = validate.as_covariance("Q", Q, n)
+    R = validate.as_covariance("R", R, p)
     Qx, Rbar, S = G @ Q @ G.T, R + H @ Q @ H.T, G @ Q @ H.T
     A, C = model.A, model.C
     try:
