@@ -67,6 +67,27 @@ class RobustCriteria:
     """``Γ₁ = P G Gᵀ Pᵀ``, ``Γ₂ = P H_F H_Fᵀ Pᵀ`` (Varrier et al. 2014, (18)–(20)); batch axes allowed.
 
     ``fault_direction`` is ``P H_fs 𝟙``, the image of a constant fault (per target fault).
+
+    Attributes
+    ----------
+    gamma1, gamma2 : (..., q, q) arrays, ``Γ₁`` and ``Γ₂``.
+    P : (..., q, (s+1)p) array, the parity basis at each ρ.
+    G : (..., (s+1)p, k) array, the uncertainty and unknown-input map (18), weighted.
+    H_fs : (..., (s+1)p, (s+1)n_f) array, the nominal fault map of the target faults.
+    fault_direction : (..., q, n_f) array, ``P H_fs 𝟙`` per target fault (summed when there is one).
+    rows : tuple of int, the rows of ``H_os1``.
+
+    Examples
+    --------
+    >>> from fdikit.plants import varrier_lateral_lpv, varrier_uncertainty
+    >>> lpv, unc = varrier_lateral_lpv(), [varrier_uncertainty()]
+    >>> cr = robust_criteria(lpv, unc, 0.048, 3)
+    >>> cr.gamma1.shape, cr.P.shape, cr.rows
+    ((6, 6), (6, 8), (0, 1))
+
+    References
+    ----------
+    Varrier et al. 2014, §4.2, (16)–(20).
     """
 
     gamma1: np.ndarray
@@ -85,6 +106,11 @@ def robust_criteria(lpv: LPVModel, uncertainties: Sequence[Uncertainty], rho, s:
 
     Parameters
     ----------
+    lpv : LPVModel, with disturbance (unknown-input) and fault groups.
+    uncertainties : sequence of :class:`~fdikit.lpv.Uncertainty`, the δ-blocks of (14).
+    rho : float or array, scheduling value(s) (batch axes allowed; ``mode="exact"``: windows of s+1).
+    s : int, the horizon.
+    mode : ``"frozen"`` (default) or ``"exact"`` stacking (see :func:`fdikit.lpv.lpv_stacked_matrices`).
     fault_model : ``"sequence"`` (the paper: ``H_F = H_fs``, the fault an arbitrary sequence over
         the window) or ``"constant"`` (``H_F = H_fs (𝟙 ⊗ I)``, a fault constant over the window,
         an fdikit option; Γ₂ then has rank ≤ #faults).
@@ -93,6 +119,29 @@ def robust_criteria(lpv: LPVModel, uncertainties: Sequence[Uncertainty], rho, s:
         faults of the model not listed are the targets.  (The paper's sentence after (4) swaps f₁
         and f₂; the construction is followed.)
     rows : rows of ``H_os1``; default :func:`regular_rows` at the mean of ``Re ρ``.
+
+    Returns
+    -------
+    RobustCriteria
+
+    Raises
+    ------
+    ParameterError
+        Bad ``weights`` keys, ``nuisance='others'`` or unknown nuisance names, an unknown ``fault_model``.
+    DesignError
+        No target fault left; ``H_os`` of rank < n or ``H_os1`` ill-conditioned.
+
+    Examples
+    --------
+    >>> from fdikit.plants import varrier_lateral_lpv, varrier_uncertainty
+    >>> lpv, unc = varrier_lateral_lpv(), [varrier_uncertainty()]
+    >>> cr = robust_criteria(lpv, unc, [0.04, 0.05], 3)
+    >>> cr.gamma1.shape, cr.gamma2.shape
+    ((2, 6, 6), (2, 6, 6))
+
+    References
+    ----------
+    Varrier et al. 2014, §2.4, (4); §4.1–4.2, (14), (18)–(20).
     """
     w = {"os": 1.0, "us": 1.0, "ds": 1.0, "ds_tilde": 1.0} | dict(weights or {})
     if set(w) != {"os", "us", "ds", "ds_tilde"}:
@@ -139,7 +188,25 @@ def robust_criteria(lpv: LPVModel, uncertainties: Sequence[Uncertainty], rho, s:
 # ---------------------------------------------------------------------------------------------- Theorem 1
 @dataclass(frozen=True)
 class EigenDesign:
-    """Theorem 1: ``W2`` (unit norm) attains ``J = lambda_min``; ``eigenvalues`` are the finite λ(Γ₁, Γ₂)."""
+    """Theorem 1: ``W2`` (unit norm) attains ``J = lambda_min``; ``eigenvalues`` are the finite λ(Γ₁, Γ₂).
+
+    Attributes
+    ----------
+    lambda_min : float, the minimum of ``J``.
+    W2 : (q,) array, the unit parity parameter attaining it.
+    eigenvalues : array, the finite generalised eigenvalues, ascending.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> G1, G2 = np.diag([1.0, 2.0]), np.diag([1.0, 4.0])
+    >>> theorem1(G1, G2).eigenvalues.round(6).tolist()
+    [0.5, 1.0]
+
+    References
+    ----------
+    Varrier et al. 2014, §4.3, Theorem 1, (21)–(23).
+    """
 
     lambda_min: float
     W2: np.ndarray
@@ -153,11 +220,31 @@ def theorem1(gamma1: np.ndarray, gamma2: np.ndarray, *, sign_ref: np.ndarray | N
     singular the residual can decouple the uncertainty exactly: ``λ_min = 0`` and ``W₂``
     maximises Γ₂ on ``null Γ₁``.  The sign makes ``sign_ref · W₂ ≥ 0``.
 
+    Parameters
+    ----------
+    gamma1, gamma2 : (q, q) array_like, ``Γ₁`` (positive semidefinite) and ``Γ₂``.
+    sign_ref : (q,) array_like or None, the reference of the sign of ``W₂``.
+
+    Returns
+    -------
+    EigenDesign
+
+    Raises
+    ------
+    ParameterError
+        ``Γ₁`` not square, or ``Γ₁`` and ``Γ₂`` of different sizes.
+    DesignError
+        ``Γ₂ = 0`` on the parity space (or on ``null Γ₁``): the fault is not detectable.
+
     Examples
     --------
     >>> import numpy as np
     >>> round(theorem1(np.diag([1.0, 2.0]), np.diag([1.0, 4.0])).lambda_min, 12)
     0.5
+
+    References
+    ----------
+    Varrier et al. 2014, §4.3, Theorem 1, (21)–(23).
     """
     G1 = validate.as_square("gamma1 (Γ₁)", gamma1)
     G2 = validate.as_matrix("gamma2 (Γ₂)", gamma2)
@@ -191,6 +278,33 @@ def theorem1_batch(gamma1: np.ndarray, gamma2: np.ndarray, sign_ref: np.ndarray 
 
     Same result as :func:`theorem1` (``eigh(L⁻¹Γ₂L⁻ᵀ)``); falls back to it when some Γ₁ is not
     positive definite.
+
+    Parameters
+    ----------
+    gamma1, gamma2 : (..., q, q) array_like, stacks of ``Γ₁`` and ``Γ₂``.
+    sign_ref : (..., q) array_like or None, per element the reference of the sign of ``W₂``.
+
+    Returns
+    -------
+    lambda_min : (...) array
+    W2 : (..., q) array, unit vectors.
+
+    Raises
+    ------
+    DesignError
+        From the :func:`theorem1` fallback, for a fault that is not detectable (the Cholesky path's
+        ``LinAlgError`` is caught internally).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> G1, G2 = np.diag([1.0, 2.0]), np.diag([1.0, 4.0])
+    >>> theorem1_batch(np.stack([G1, G1]), np.stack([G2, 2 * G2]))[0].round(6).tolist()
+    [0.5, 0.25]
+
+    References
+    ----------
+    Varrier et al. 2014, §4.3, Theorem 1, (21)–(23).
     """
     G1, G2 = np.asarray(gamma1, dtype=float), np.asarray(gamma2, dtype=float)
     shape, q = G1.shape[:-2], G1.shape[-1]
@@ -217,6 +331,28 @@ def pointwise_theorem1(lpv: LPVModel, uncertainties: Sequence[Uncertainty], s: i
 
     Returns a function of a 1-D array of ρ giving (N, q), signed so that the constant-fault
     response ``W₂ᵀ P H_fs 𝟙`` is ≥ 0; pass it as ``W2=`` to :func:`lpv_parity_residuals`.
+
+    Parameters
+    ----------
+    lpv, uncertainties, s : as in :func:`robust_criteria`.
+    rows : sequence of int, the rows of ``H_os1`` (fixed, so that ``P(ρ)`` is continuous in ρ).
+    **criteria_kw : further keywords of :func:`robust_criteria`.
+
+    Returns
+    -------
+    callable, ``rho (N,) -> W₂ (N, q)``.
+
+    Examples
+    --------
+    >>> from fdikit.plants import varrier_lateral_lpv, varrier_uncertainty
+    >>> lpv, unc = varrier_lateral_lpv(), [varrier_uncertainty()]
+    >>> w2 = pointwise_theorem1(lpv, unc, 3, rows=(0, 1))
+    >>> w2([0.04, 0.05]).shape
+    (2, 6)
+
+    References
+    ----------
+    Varrier et al. 2014, §4.3, Theorem 1; (16).
     """
     def w2(rho: np.ndarray) -> np.ndarray:
         cr = robust_criteria(lpv, uncertainties, np.asarray(rho, dtype=float), s, rows=rows, **criteria_kw)
@@ -227,17 +363,57 @@ def pointwise_theorem1(lpv: LPVModel, uncertainties: Sequence[Uncertainty], s: i
 
 # ---------------------------------------------------------------------------------------------- P2 and κ
 def kappa_max(gamma1: np.ndarray, gamma2: np.ndarray) -> float:
-    """Largest κ with ``Γ₁ − κ²Γ₂ ≻ 0``: ``sqrt(min λ_min(Γ₁, Γ₂))`` over the batch (Remark 4, re-derived)."""
+    """Largest κ with ``Γ₁ − κ²Γ₂ ≻ 0``: ``sqrt(min λ_min(Γ₁, Γ₂))`` over the batch (Remark 4, re-derived).
+
+    Parameters
+    ----------
+    gamma1, gamma2 : (..., q, q) array_like, ``Γ₁`` and ``Γ₂`` (one pair or a stack).
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> G1, G2 = np.diag([1.0, 2.0]), np.diag([1.0, 4.0])
+    >>> round(kappa_max(G1, G2), 6)
+    0.707107
+
+    References
+    ----------
+    Varrier et al. 2014, §4.4.1, Remark 4.
+    """
     return float(np.sqrt(np.min(theorem1_batch(gamma1, gamma2)[0])))
 
 
 def gamma_kappa(gamma1: np.ndarray, gamma2: np.ndarray, kappa: float) -> np.ndarray:
     """``Γ_κ = Γ₁ − κ²Γ₂`` (Varrier et al. 2014, (25)); DesignError unless it is positive definite.
 
+    Parameters
+    ----------
+    gamma1, gamma2 : (..., q, q) array_like, ``Γ₁`` and ``Γ₂``.
+    kappa : float, ``κ >= 0``.
+
+    Returns
+    -------
+    (..., q, q) array
+
     Raises
     ------
     DesignError
         If ``κ² ≥ λ_min(Γ₁, Γ₂)``; the message gives the largest valid κ.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> G1, G2 = np.diag([1.0, 2.0]), np.diag([1.0, 4.0])
+    >>> gamma_kappa(G1, G2, 0.5).tolist()
+    [[0.75, 0.0], [0.0, 1.0]]
+
+    References
+    ----------
+    Varrier et al. 2014, §4.4.1, (24)–(25), Remark 4.
     """
     k_max = kappa_max(gamma1, gamma2)
     if not (np.isfinite(kappa) and 0 <= kappa < k_max):
@@ -249,7 +425,29 @@ def gamma_kappa(gamma1: np.ndarray, gamma2: np.ndarray, kappa: float) -> np.ndar
 
 
 def p2_solution(gamma1: np.ndarray, gamma2: np.ndarray, kappa: float, c: np.ndarray) -> np.ndarray:
-    """Closed form of 𝒫₂ (24) with ``cᵀW₂ = 1``: ``W₂ = Γ_κ⁻¹c / (cᵀΓ_κ⁻¹c)`` (Lagrange; re-derived)."""
+    """Closed form of 𝒫₂ (24) with ``cᵀW₂ = 1``: ``W₂ = Γ_κ⁻¹c / (cᵀΓ_κ⁻¹c)`` (Lagrange; re-derived).
+
+    Parameters
+    ----------
+    gamma1, gamma2 : (q, q) array_like, ``Γ₁`` and ``Γ₂``.
+    kappa : float, ``0 <= κ < κ_max``.
+    c : (q,) array_like, the normalisation vector.
+
+    Returns
+    -------
+    (q,) array, ``W₂`` with ``cᵀW₂ = 1``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> G1, G2 = np.diag([1.0, 2.0]), np.diag([1.0, 4.0])
+    >>> p2_solution(G1, G2, 0.5, np.ones(2)).round(6).tolist()
+    [0.571429, 0.428571]
+
+    References
+    ----------
+    Varrier et al. 2014, §4.4, (24); §4.4.1, (28).
+    """
     Gk = gamma_kappa(gamma1, gamma2, kappa)
     x = np.linalg.solve(Gk, np.asarray(c, dtype=float))
     return x / float(np.dot(c, x))
@@ -259,7 +457,25 @@ def p2_solution(gamma1: np.ndarray, gamma2: np.ndarray, kappa: float, c: np.ndar
 class LmiDesign:
     """Solution of the LTI LMI (27)/(31): ``W2``, ``gamma`` = ``W₂ᵀΓ_κW₂`` attained (checked against the
     solver's γ), the smallest eigenvalue of the scaled LMI block at ``γ(1 + 1e-8)``, the ratio ``J``, the
-    normalisation and (for ``"l1"``) the sign vector."""
+    normalisation and (for ``"l1"``) the sign vector.
+
+    Attributes
+    ----------
+    W2 : (q,) array; gamma : float, ``W₂ᵀΓ_κW₂``; min_eig : float; J : float, ``W₂ᵀΓ₁W₂ / W₂ᵀΓ₂W₂``.
+    normalization : str, ``"linear"`` or ``"l1"``; sign : (q,) array or None; status : str, the solver status.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> G1, G2 = np.diag([1.0, 2.0]), np.diag([1.0, 4.0])
+    >>> r = lti_lmi(G1, G2, 0.5)
+    >>> round(r.gamma, 4), round(r.J, 4), r.status
+    (0.4286, 0.6538, 'optimal')
+
+    References
+    ----------
+    Varrier et al. 2014, §4.4.1, (27)–(31).
+    """
 
     W2: np.ndarray
     gamma: float
@@ -278,6 +494,34 @@ def lti_lmi(gamma1: np.ndarray, gamma2: np.ndarray, kappa: float, *, normalizati
     exactly, by enumerating ``σ ∈ {±1}^q`` with ``σ₁ = +1`` (``±W₂`` are equivalent) and
     keeping the best SDP.  The returned matrices are checked: the LMI block's smallest
     eigenvalue and the normalisation, not only the solver status.
+
+    Parameters
+    ----------
+    gamma1, gamma2 : (q, q) array_like, ``Γ₁`` and ``Γ₂``; kappa : float, ``0 <= κ < κ_max``.
+    normalization : ``"linear"`` (default) or ``"l1"``; c : (q,) array_like, default ``𝟙``; eps : float, ``ε``.
+    solver : str, cvxpy solver name (default ``"CLARABEL"``).
+
+    Returns
+    -------
+    LmiDesign
+
+    Raises
+    ------
+    ParameterError
+        An unknown ``normalization``, or ``"l1"`` with q > 12.
+    DesignError
+        ``Γ_κ`` not positive definite (κ too large), no solution, or a solution that fails the checks.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> G1, G2 = np.diag([1.0, 2.0]), np.diag([1.0, 4.0])
+    >>> lti_lmi(G1, G2, 0.5).W2.round(4).tolist()
+    [0.5714, 0.4286]
+
+    References
+    ----------
+    Varrier et al. 2014, §4.4.1, (27), (29)–(31).
     """
     import cvxpy as cp
 
@@ -340,6 +584,19 @@ class RobustParityDesign:
     kappa, kappa_max : κ and the largest valid κ on the design grid; degrees : ρ-degrees of
     Γ₁, Γ₂, det Γ_κ and adj Γ_κ (the paper's "products", §5.3); box_vertices : 2^(adj degree);
     truncation_error : sup over the grid of ‖adj − truncated adj‖ / ‖adj‖.
+    lpv, uncertainties, s, rows, rho_min, rho_max, order, method, criteria_kw : the design's arguments.
+
+    Examples
+    --------
+    >>> from fdikit.plants import varrier_lateral_lpv, varrier_uncertainty
+    >>> lpv, unc = varrier_lateral_lpv(), [varrier_uncertainty()]
+    >>> d = robust_lpv_parity(lpv, unc, 3, kappa=0.1, rho_max=0.2, rho_nominal=0.048, method="adjugate")
+    >>> d.W_vertices.shape, d.w2(0.05).shape, d.gamma is None
+    ((6, 6), (6,), True)
+
+    References
+    ----------
+    Varrier et al. 2014, §4.5, (37); §5.3, (49).
     """
 
     lpv: LPVModel
@@ -433,11 +690,42 @@ def robust_lpv_parity(
     (``method="adjugate"``).  ``c`` defaults to Theorem 1's ``W₂*`` at ``rho_nominal``
     (default the middle of the range).  ``criteria_kw`` go to :func:`robust_criteria`.
 
+    Parameters
+    ----------
+    lpv, uncertainties, s : as in :func:`robust_criteria`.
+    kappa : float, ``0 <= κ < κ_max`` (checked on the grid).
+    rho_min, rho_max : float, the scheduling range (``0 <= rho_min < rho_max``; default ``rho_min = 0``).
+    rho_nominal : float or None, where ``c`` and the rows are computed (default the middle of the range).
+    order : int, the truncation degree N (default 5).
+    method : ``"lmi"`` (default) or ``"adjugate"``; objective : ``"common"`` or ``"sum"`` (see polytopic_lmi).
+    repair, repair_factor : the vertex repair (``"inverse"`` or ``"paper"``; default factor 10).
+    c : (q,) array_like or None, the normalisation vector; rows : rows of ``H_os1``.
+    grid, points : ρ grid size for the checks (41) and FFT points of the polynomial fit (64).
+    solver : str, cvxpy solver (default ``"CLARABEL"``); **criteria_kw : keywords of :func:`robust_criteria`.
+
+    Returns
+    -------
+    RobustParityDesign
+
     Raises
     ------
+    ParameterError
+        A bad range, ``method``, ``order`` (or an argument :func:`robust_criteria` refuses).
     DesignError
         If Γ_κ is not positive definite somewhere on the grid (the message gives κ_max), or an
         LMI is infeasible.
+
+    Examples
+    --------
+    >>> from fdikit.plants import varrier_lateral_lpv, varrier_uncertainty
+    >>> lpv, unc = varrier_lateral_lpv(), [varrier_uncertainty()]
+    >>> d = robust_lpv_parity(lpv, unc, 3, kappa=0.1, rho_max=0.2, rho_nominal=0.048, method="adjugate")
+    >>> d.order, round(d.kappa_max, 4), len(d.n_repaired), d.method
+    (5, 0.149, 6, 'adjugate')
+
+    References
+    ----------
+    Varrier et al. 2014, §4.5–4.6, (32)–(46).
     """
     if not (0 <= rho_min < rho_max) or not np.isfinite(rho_max):
         raise ParameterError(f"need 0 <= rho_min < rho_max < inf, got [{rho_min}, {rho_max}]")
