@@ -103,7 +103,8 @@ def _imm():
 
 
 def _convex():
-    from fdikit.multimodel.convex import convex_model_set, dual_convex_filter
+    from fdikit.multimodel.convex import convex_model_set
+    from fdikit.multimodel.convex_filter import dual_convex_filter
 
     ms = convex_model_set([[0.9]], [[[0.0]], [[1.0]]], [[1.0]], Q=[[1e-4]], R=[[1e-2]], names=["stuck", "nominal"])
     u = np.sin(0.3 * np.arange(30)).reshape(-1, 1)

@@ -18,7 +18,7 @@ from fdikit.diagnosis import Diagnosis
 from fdikit.residuals import Residuals
 
 if TYPE_CHECKING:
-    from fdikit.multimodel.convex import ConvexFilterResult
+    from fdikit.multimodel.convex_filter import ConvexFilterResult
     from fdikit.multimodel.imm import IMMResult
     from fdikit.multimodel.kalman import KalmanResult
     from fdikit.trace import Trace
@@ -515,7 +515,8 @@ def plot_weights(result: ConvexFilterResult, t=None, raw: bool = False, ax=None,
     Examples
     --------
     >>> import matplotlib.pyplot as plt
-    >>> from fdikit.multimodel.convex import convex_model_set, dual_convex_filter
+    >>> from fdikit.multimodel.convex import convex_model_set
+    >>> from fdikit.multimodel.convex_filter import dual_convex_filter
     >>> ms = convex_model_set([[0.9]], [[[0.0]], [[1.0]]], [[1.0]], Q=[[1e-4]], R=[[1e-2]],
     ...                       names=["stuck", "nominal"])
     >>> u = np.ones((5, 1))

@@ -12,20 +12,18 @@ from scipy.stats import norm
 
 from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.multimodel.cp_design import convex_weights, cp_model_set
+from fdikit.multimodel.lv_design import limit_value_model_set
 from fdikit.multimodel.model_set import (
     affine_weights,
     first_order_discretize,
     gap_rank,
-    limit_value_model_set,
-    minimum_mismatch_points,
     nearest_model,
-    observability_condition,
-    od_model_set,
-    pivoted_qr,
     taylor_remainder_bound,
     unvectorize,
     vectorize,
 )
+from fdikit.multimodel.observability import minimum_mismatch_points, observability_condition
+from fdikit.multimodel.od_design import od_model_set, pivoted_qr
 from fdikit.plants.msd import (
     MSD_RANGES,
     msd_matrices,
@@ -339,7 +337,7 @@ def test_observability_matrix_of_a_linear_system_is_the_kalman_matrix():
 def test_pair_observability_of_identical_models_is_singular():
     """Two identical local models make the weight unobservable (cond = inf); distinct ones give a finite
     condition number equal to the direct Jacobian's (3.7)–(3.9)."""
-    from fdikit.multimodel.model_set import pair_observability
+    from fdikit.multimodel.observability import pair_observability
 
     A, B, C = np.array([[0.9, 0.2], [-0.1, 0.8]]), np.array([0.1, 0.3]), np.array([[1.0, 0.0]])
     assert pair_observability((A, B), (A, B), C, [np.array([0.5, -0.2])], [0.3], [1.0]) == np.inf

@@ -20,11 +20,8 @@ import numpy as np
 
 from fdikit import validate
 from fdikit.errors import ParameterError
-from fdikit.multimodel.convex import (
-    ConvexFilterResult,
-    ConvexModelSet,
-    check_data,
-)
+from fdikit.multimodel.convex import ConvexModelSet
+from fdikit.multimodel.convex_filter import ConvexFilterResult, check_data
 from fdikit.multimodel.simplex import constrain_weights
 
 __all__ = ["augmented_jacobians", "augmented_ekf"]

@@ -25,8 +25,9 @@ import numpy as np
 from fdikit.errors import ParameterError
 from fdikit.faults import NO_FAULT
 from fdikit.gaussian import LinearGaussianModel
-from fdikit.multimodel.convex import ConvexModelSet, convex_model_set, dual_convex_filter
+from fdikit.multimodel.convex import ConvexModelSet, convex_model_set
 from fdikit.multimodel.convex_ekf import augmented_ekf
+from fdikit.multimodel.convex_filter import dual_convex_filter
 from fdikit.plants.target_tracking import (
     PI_TRACKING,
     Q_TRACKING,
