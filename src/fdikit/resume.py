@@ -34,7 +34,6 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import json
-import math
 import numbers
 import os
 import re
@@ -44,6 +43,7 @@ import tempfile
 from collections.abc import Mapping
 from pathlib import Path
 
+from fdikit import validate
 from fdikit.atomic import write_bytes, write_text
 from fdikit.errors import ParameterError
 
@@ -71,13 +71,23 @@ def option_name(name: str) -> str:
     return f"{name} (--{name.replace('_', '-')})"
 
 
+def _shown(value) -> str:
+    """How a rejected number is quoted: ``repr`` for a non-number, ``nan``/``inf`` as such, others with ``:g``."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        return repr(value)
+    return f"{float(value):g}"
+
+
 def check_count(value, name: str, minimum: int = 1) -> int:
-    """``value`` as a whole number ``>= minimum``; :class:`ParameterError` naming ``name`` otherwise."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise ParameterError(f"{option_name(name)} must be an integer >= {minimum}, got {value!r}")
-    if value < minimum:
-        raise ParameterError(f"{option_name(name)} must be an integer >= {minimum}, got {value}")
-    return int(value)
+    """``value`` as a whole number ``>= minimum``; :class:`ParameterError` naming ``name`` otherwise.
+
+    :func:`fdikit.validate.integer` does the check; the message keeps the command-line wording
+    (the argument both as parameter and as option, and the accepted range).
+    """
+    try:
+        return validate.integer(name, value, minimum=minimum)
+    except ParameterError:
+        raise ParameterError(f"{option_name(name)} must be an integer >= {minimum}, got {value!r}") from None
 
 
 def check_seed(value, name: str = "seed") -> int:
@@ -86,26 +96,23 @@ def check_seed(value, name: str = "seed") -> int:
 
 
 def check_positive(value, name: str, *, maximum: float | None = None, hint: str = "") -> float:
-    """``value`` as a finite float ``> 0`` (and ``<= maximum`` when given)."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise ParameterError(f"{option_name(name)} must be a finite number > 0, got {value!r}{hint}")
-    value = float(value)
-    if not math.isfinite(value):
-        raise ParameterError(f"{option_name(name)} must be a finite number > 0, got {value}{hint}")
-    if value <= 0:
-        raise ParameterError(f"{option_name(name)} must be a finite number > 0, got {value:g}{hint}")
+    """``value`` as a finite float ``> 0`` (and ``<= maximum`` when given): :func:`fdikit.validate.positive`
+    with the command-line wording."""
+    try:
+        value = validate.positive(name, value)
+    except ParameterError:
+        raise ParameterError(f"{option_name(name)} must be a finite number > 0, got {_shown(value)}{hint}") from None
     if maximum is not None and value > maximum:
         raise ParameterError(f"{option_name(name)} must be at most {maximum:g}, got {value:g}{hint}")
     return value
 
 
 def check_nonnegative(value, name: str) -> float:
-    """``value`` as a finite float ``>= 0``."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(float(value)):
-        raise ParameterError(f"{option_name(name)} must be a finite number >= 0, got {value!r}")
-    if value < 0:
-        raise ParameterError(f"{option_name(name)} must be a finite number >= 0, got {value:g}")
-    return float(value)
+    """``value`` as a finite float ``>= 0``: :func:`fdikit.validate.non_negative` with the command-line wording."""
+    try:
+        return validate.non_negative(name, value)
+    except ParameterError:
+        raise ParameterError(f"{option_name(name)} must be a finite number >= 0, got {_shown(value)}") from None
 
 
 def check_output_file(path, name: str = "out") -> Path:
