@@ -59,16 +59,49 @@ __all__ = ["DiscreteGtfdfDesign", "dgtfdf", "DiscreteGtmfdfDesign", "dgtmfdf"]
 class DiscreteGtfdfDesign(FieldReport):
     """Discrete single-fault game filter (DGTFDF, Murray 2012, (5.42)–(5.43)).
 
+    Made by :func:`dgtfdf` (or :func:`~fdikit.design.game.single_fault.single_fault_game_filter` on a discrete
+    model); ``report()`` gives the ``REPORT`` fields as a dict, ``internal_form()`` plant and filter in series, and
+    ``information(k)`` ``Θ(k) = P(k)⁻¹``.
+
     Attributes
     ----------
-    generator : observer (5.3) at the final gain, projected residual of ``target``.
-    gain : the observer (predictor) gain ``Φ L(k1 − 1)``: the generator's state matrix is ``Φ − gain·C``.
-    filter_gain : Murray's filtered-form ``L(k1 − 1)`` (``gain = Φ @ filter_gain``).
-    filter_gains : ``L(k) = Σ(k)⁻¹CᵀV⁻¹``, shape (steps, n, p), filtered form.
-    covariances : ``P(k) = Θ(k)⁻¹``, shape (steps + 1, n, n).  levels : ``λ_max(Q^½ĤCP(k)CᵀĤQ^½)`` (< 1).
-    poles : eigenvalues of ``Φ(I − LC)`` at the final gain.
-    settled : the gain's last relative change is below ``settle_rtol``; settling_step : first k after
-        which every relative change stays below it (None if it has not settled).
+    generator : ResidualGenerator
+        The observer (5.3) at the final gain with the projected residual of ``target`` (``"<target>[j]"``).
+    target : str
+        The target fault.
+    gain : (n, p) array
+        The observer (predictor) gain ``Φ L(k1 − 1)``: the generator's state matrix is ``Φ − gain·C``.
+    filter_gain : (n, p) array
+        Murray's filtered-form ``L(k1 − 1)`` (``gain = Φ @ filter_gain``).
+    filter_gains : (steps, n, p) array
+        ``L(k) = Σ(k)⁻¹CᵀV⁻¹``, filtered form, k = k0 … k1 − 1.
+    covariances : (steps + 1, n, n) array
+        ``P(k) = Θ(k)⁻¹``, k = k0 … k1.
+    levels : (steps,) array
+        ``λ_max(Q^½ĤCP(k)CᵀĤQ^½)`` (all below 1: ``Γ(k) > 0``).
+    poles : (n,) complex array
+        Eigenvalues of ``Φ(I − LC)`` at the final gain.
+    settled : bool
+        Whether the gain's last relative change is below ``settle_rtol``.
+    settling_step : int or None
+        The first k after which every relative change of the gain stays below ``settle_rtol`` (None if it has
+        not settled).
+
+    Examples
+    --------
+    >>> from fdikit.design.game.discrete_setup import discrete_game_setup
+    >>> from fdikit.plants.white_speyer import white_speyer
+    >>> st = discrete_game_setup(white_speyer().discretize(0.01), ["f1"], ["f2"], gamma=1e-2, Vbar=1.0, Q=1e-3,
+    ...                          M=5.0, P0=1e-2, steps=50)
+    >>> d = dgtfdf(st)
+    >>> d.target, d.filter_gains.shape, d.covariances.shape, d.generator.residuals
+    ('f1', (50, 3, 2), (51, 3, 3), ('f1[0]',))
+    >>> bool(np.allclose(d.gain, st.model.A @ d.filter_gain))
+    True
+
+    References
+    ----------
+    Murray 2012, §5.3, (5.42)–(5.43); the observer: §5.1.1, (5.3).
     """
 
     generator: ResidualGenerator
@@ -83,7 +116,7 @@ class DiscreteGtfdfDesign(FieldReport):
     settling_step: int | None
 
     def information(self, k: int = -1) -> np.ndarray:
-        """``Θ(k) = P(k)⁻¹``."""
+        """``Θ(k) = P(k)⁻¹`` (n x n) at step ``k`` (default the last, k1)."""
         Pi = np.linalg.inv(self.covariances[k])
         return (Pi + Pi.T) / 2
 
@@ -96,19 +129,48 @@ def dgtfdf(setup: DiscreteGameSetup, targets: str | Sequence[str] | None = None,
 
     From ``Θ(k0) = Π_0``: ``Σ = Θ − Cᵀ(ĤQĤ − V⁻¹)C``, ``Θ̃ = [ΦΣ⁻¹Φᵀ + F̂MF̂ᵀ/γ]⁻¹``, ``L(k) = Σ⁻¹CᵀV⁻¹``,
     computed as ``Σ⁻¹ = Γ⁻¹ − L CΓ⁻¹``, ``L = Γ⁻¹Cᵀ(V + CΓ⁻¹Cᵀ)⁻¹`` with ``Γ = Θ − CᵀĤQĤC > 0`` checked at
-    every step.  ``targets`` names the one target of the setup to detect (a fault name or a
-    one-element sequence; default: the setup's only target); it is blocked from its ``F̂_i``.  A bank
-    of these is the "UIO" of Murray §6.1.1.  The generator uses the last gain.  ``filter_gain(s)`` hold
-    Murray's ``L``; ``gain = Φ @ filter_gain`` is the observer gain (module docstring).
+    every step.  The target is blocked from its ``F̂_i``.  A bank of these is the "UIO" of Murray §6.1.1.
+    The generator uses the last gain.  ``filter_gain(s)`` hold Murray's ``L``; ``gain = Φ @ filter_gain`` is the
+    observer gain (module docstring).
+
+    Parameters
+    ----------
+    setup : DiscreteGameSetup
+        From :func:`~fdikit.design.game.discrete_setup.discrete_game_setup` (γ, ``V``, ``Q``, ``M``, ``P0``
+        and the horizon).
+    targets : str or one-element sequence of str, optional
+        The one target of the setup to detect (a ``":magnitude"``/``":rate"`` suffix is ignored); default the
+        setup's only target.
+    settle_rtol : float, optional
+        Relative change of the gain from one step to the next below which it counts as settled (default 1e-8).
+
+    Returns
+    -------
+    DiscreteGtfdfDesign
+        The generator at the last gain, the gain sequence, the covariances, the levels and the poles.
+
+    Raises
+    ------
+    ParameterError
+        ``setup`` not a :class:`~fdikit.design.game.discrete_setup.DiscreteGameSetup`, or more than one target
+        named.
+    DesignError
+        No target named when the setup has several, a name that is not a target of the setup, or positivity of
+        ``Γ = Θ − CᵀĤQĤC`` lost at a step (γ is not attainable with these weights; the message gives the step).
 
     Examples
     --------
+    >>> from fdikit.design.game.discrete_setup import discrete_game_setup
     >>> from fdikit.plants.white_speyer import white_speyer
     >>> m = white_speyer().discretize(0.01)
-    >>> st = discrete_game_setup(m, ["f1"], ["f2"], gamma=1e-2, Vbar=1e-2 / 0.01, Q=1e-3, M=5.0, steps=2000)
+    >>> st = discrete_game_setup(m, ["f1"], ["f2"], gamma=1e-2, Vbar=1e-2 / 0.01, Q=1e-3, M=5.0, steps=1000)
     >>> d = dgtfdf(st)
-    >>> d.settled, bool(np.all(np.abs(d.poles) < 1))
-    (True, True)
+    >>> d.settled, d.settling_step, bool(np.all(np.abs(d.poles) < 1))
+    (True, 417, True)
+
+    References
+    ----------
+    Murray 2012, §5.3, (5.42)–(5.43) (erratum: (5.42b) prints Λ for Σ), Proposition 5.2; the bank: §6.1.1.
     """
     validate.instance("setup", setup, DiscreteGameSetup, "build it with discrete_game_setup(...)")
     if targets is None and len(setup.names) > 1:
@@ -151,15 +213,47 @@ def dgtfdf(setup: DiscreteGameSetup, targets: str | Sequence[str] | None = None,
 class DiscreteGtmfdfDesign(FieldReport):
     """Discrete multiple-fault game filter (DGTMFDF, Murray 2012, (5.31)–(5.41)), one constant gain.
 
+    Made by :func:`dgtmfdf` (or :func:`~fdikit.design.game.multi_fault.game_filter` on a discrete model);
+    ``report()`` gives the ``REPORT`` fields as a dict and ``internal_form()`` plant and filter in series.
+
     Attributes
     ----------
-    generator : observer (5.3) with the projected residuals of every target.
-    gain : the observer (predictor) gain ``Φ L`` (state matrix ``Φ − gain·C``); filter_gain : Murray's ``L``.
-    poles : eigenvalues of ``Φ(I − LC)``; sigma_min : ``σ_min(I − LC)``.
-    cost, initial_cost : ``J̄`` at the final and the initial gain; gradient : ``∂J̄/∂L`` at the end.
-    method : stages run (``'fixed-point'``, ``'gradient'`` or both); iterations : accepted (5.41)
-        steps, optimiser iterations.  riccati : the DARI solution at the final gain.
-    notes : why each stage stopped.
+    generator : ResidualGenerator
+        The observer (5.3) with the projected residuals ``"<target>[j]"`` of every target.
+    gain : (n, p) array
+        The observer (predictor) gain ``Φ L``: the generator's state matrix is ``Φ − gain·C``.
+    filter_gain : (n, p) array
+        Murray's filtered-form ``L`` (``gain = Φ @ filter_gain``).
+    poles : (n,) complex array
+        Eigenvalues of ``Φ(I − LC)`` (moduli at most ``max_radius``).
+    sigma_min : float
+        ``σ_min(I − LC)``.
+    cost, initial_cost : float
+        ``J̄`` (5.31) at the final and at the initial gain.
+    gradient : (n, p) array
+        ``∂J̄/∂L`` at the final gain.
+    method : str
+        The stages run: ``'fixed-point'``, ``'gradient'`` or ``'fixed-point+gradient'``.
+    iterations : tuple of int
+        Accepted (5.41) steps and optimiser iterations.
+    riccati : GameRiccatiSolution
+        The DARI solution at the final gain (:func:`~fdikit.design.game.discrete_setup.discrete_game_riccati`).
+    notes : tuple of str
+        Why each stage stopped.
+
+    Examples
+    --------
+    >>> from fdikit.design.game.discrete_setup import discrete_game_setup
+    >>> from fdikit.plants.white_speyer import white_speyer
+    >>> st = discrete_game_setup(white_speyer().discretize(0.01), ["f1", "f2"], gamma=1.0, Vbar=1.0, Q=0.1,
+    ...                          M=1.0, K=1.0, N=1.0, steps=20)
+    >>> d = dgtmfdf(st, maxiter=20)
+    >>> d.generator.residuals, d.filter_gain.shape, sorted(d.riccati.covariances)
+    (('f1[0]', 'f2[0]'), (3, 2), ['f1', 'f2'])
+
+    References
+    ----------
+    Murray 2012, §5.2.2, (5.31)–(5.41); the observer: §5.1.1, (5.3).
     """
 
     generator: ResidualGenerator
@@ -202,26 +296,61 @@ def dgtmfdf(
 ) -> DiscreteGtmfdfDesign:
     """Discrete game-theoretic multiple-fault detection filter, constant gain (Murray 2012, §5.2.2, (5.31)–(5.41)).
 
+    Minimises the secondary cost ``J̄`` (:func:`~fdikit.design.game.discrete_setup.secondary_cost`) over one
+    constant gain that keeps every target's DARI feasible (module docstring).
+
     Parameters
     ----------
-    setup : from :func:`discrete_game_setup`, with nonzero ``K_i``/``N_i``.
-    L0 : initial gain in Murray's filtered form (``filter_gain``; an observer gain ``G`` is ``Φ⁻¹G``);
+    setup : DiscreteGameSetup
+        From :func:`~fdikit.design.game.discrete_setup.discrete_game_setup`, with nonzero ``K_i``/``N_i``.
+    L0 : (n, p) array, optional
+        Initial gain in Murray's filtered form (``filter_gain``; an observer gain ``G`` is ``Φ⁻¹G``);
         default the mean of the targets' :func:`dgtfdf` filter gains or the one of them with the lowest
         cost (the first acceptable).  A Beard–Jones gain is a good start at small γ.
-    method : ``'fixed-point'`` iterates (5.41), accepting a (halved up to 4 times) step only if
+    method : {'auto', 'fixed-point', 'gradient'}, optional
+        ``'fixed-point'`` iterates (5.41), accepting a (halved up to 4 times) step only if
         ``σ_min(I − LC) ≥ min_sigma``, the DARI stays feasible and ``J̄`` does not rise;
         ``'gradient'`` runs ``scipy.optimize.minimize(method='trust-constr')`` with a BFGS Hessian
         and the exact gradient on ``J̄`` (rejected gains count as +∞, so the region shrinks);
-        ``'auto'`` runs the first, then the second unless (5.41) converged.
-    maxiter : iterations of each stage.  min_sigma : the (5.41) guard.  xtol : (5.41) convergence.
-    max_radius : every accepted gain keeps ``ρ(Φ(I − LC)) ≤ max_radius`` (< 1); use
-        ``exp(−σΔt)`` for a decay rate σ.  The optimum usually sits on this bound.
+        ``'auto'`` (default) runs the first, then the second unless (5.41) converged.
+    maxiter : int, optional
+        Iterations of each stage (default 200).
+    min_sigma : float, optional
+        The (5.41) guard on ``σ_min(I − LC)`` (default 1e-3).
+    max_radius : float, optional
+        Every accepted gain keeps ``ρ(Φ(I − LC)) ≤ max_radius`` (in (0, 1); default 0.99); use
+        ``exp(−σΔt)`` for a decay rate σ [1/s].  The optimum usually sits on this bound.
+    xtol : float, optional
+        (5.41) has converged when its step is below ``xtol`` times ``‖L‖`` (default 1e-8).
+
+    Returns
+    -------
+    DiscreteGtmfdfDesign
+        The generator at the final gain, both gain forms, the poles, the cost before and after, the stages run
+        and the DARI solution.
 
     Raises
     ------
+    ParameterError
+        ``setup`` not a :class:`~fdikit.design.game.discrete_setup.DiscreteGameSetup`, an unknown ``method``,
+        ``maxiter`` not a positive integer, ``max_radius`` outside (0, 1), or ``L0`` not an n x p matrix.
     DesignError
-        Bad ``method`` or ``max_radius``, all cost weights zero (the multiplier vanishes, §5.2.2), or
-        an unacceptable ``L0`` (no acceptable default).
+        All cost weights zero (the multiplier vanishes, §5.2.2), an unacceptable ``L0`` (DARI infeasible,
+        ``I − L0C`` singular or ``ρ(Φ(I − L0C)) > max_radius``), or no acceptable default start.
+
+    Examples
+    --------
+    >>> from fdikit.design.game.discrete_setup import discrete_game_setup
+    >>> from fdikit.plants.white_speyer import white_speyer
+    >>> st = discrete_game_setup(white_speyer().discretize(0.01), ["f1", "f2"], gamma=1.0, Vbar=1.0, Q=0.1,
+    ...                          M=1.0, K=1.0, N=1.0, steps=20)
+    >>> d = dgtmfdf(st, maxiter=20)
+    >>> d.method, bool(d.cost < d.initial_cost), bool(np.abs(d.poles).max() <= 0.99)
+    ('fixed-point+gradient', True, True)
+
+    References
+    ----------
+    Murray 2012, §5.2.2, (5.31)–(5.41), Remarks 5.1 and 5.3; the stability bound: §6.1, Remarks 6.1–6.2.
     """
     validate.instance("setup", setup, DiscreteGameSetup, "build it with discrete_game_setup(...)")
     if method not in ("auto", "fixed-point", "gradient"):

@@ -60,11 +60,42 @@ GUARD = 1.0 - 1e-10  # λ_max(RPRᵀ) at or above this: Γ = P⁻¹ − RᵀR is
 class DiscreteGameSetup:
     """Partition, weights and horizon of a discrete game filter (Murray 2012, (5.8), (5.9), (5.39)).
 
+    Made by :func:`discrete_game_setup`, which checks every weight; the designs
+    :func:`~fdikit.design.game.discrete.dgtfdf` and :func:`~fdikit.design.game.discrete.dgtmfdf` take it.  The
+    properties ``model`` and ``names`` give the plant and the target names (design order); the methods give the
+    per-target matrices of the recursions.
+
     Attributes
     ----------
-    problem : targets, ``F̂_i``, ``Ĥ_i``.  gamma : γ (small = strong blocking).  V : ``V̄/γ``.
-    P_init : ``P(k0) = P0/γ = Π_0⁻¹``.  steps : horizon ``k1 − k0``.
-    Q, M, K, N : per-target weights (p x p; k̂_i; k̂_i; k_i square).
+    problem : GameProblem
+        The targets ``F_i``, complementary faults ``F̂_i`` and projectors ``Ĥ_i``
+        (:func:`~fdikit.design.game.setup.game_problem`).
+    gamma : float
+        The attenuation bound γ > 0 of (5.8) (small = strong blocking).
+    V : (p, p) array
+        The noise weight ``V = V̄/γ`` (5.9).
+    P_init : (n, n) array
+        The initial covariance ``P(k0) = P0/γ = Π_0⁻¹``.
+    steps : int
+        The horizon ``k1 − k0`` in samples.
+    Q : dict of str to (p, p) array
+        Output weight ``Q_i ≥ 0`` on ``Ĥ_i C e_i`` by target.
+    M : dict of str to (k̂_i, k̂_i) array
+        Complementary-fault weight ``M_i > 0`` by target (k̂_i columns of ``F̂_i``).
+    K, N : dict of str to (k̂_i, k̂_i) and (k_i, k_i) arrays
+        Secondary-cost weights of (5.39) on ``F̂_i`` and on ``F_i`` by target (zero: no secondary cost).
+
+    Examples
+    --------
+    >>> from fdikit.plants.white_speyer import white_speyer
+    >>> st = discrete_game_setup(white_speyer().discretize(0.01), ["f1"], ["f2"], gamma=1e-2, Vbar=1.0, Q=1e-3,
+    ...                          M=5.0, steps=50)
+    >>> st.names, st.steps, float(st.V[0, 0]), st.nuisance_covariance("f1").shape, st.output_weight_root("f1").shape
+    (('f1',), 50, 100.0, (3, 3), (2, 3))
+
+    References
+    ----------
+    Murray 2012, §5.1.1, (5.8); §5.1.2, (5.9); §5.2.2, (5.39).
     """
 
     problem: GameProblem
@@ -79,24 +110,26 @@ class DiscreteGameSetup:
 
     @property
     def model(self) -> FaultModel:
+        """The discrete plant (``problem.model``)."""
         return self.problem.model
 
     @property
     def names(self) -> tuple[str, ...]:
+        """The target names in design order."""
         return self.problem.names
 
     def nuisance_covariance(self, name: str) -> np.ndarray:
-        """``F̂_i M_i F̂_iᵀ / γ``."""
+        """``F̂_i M_i F̂_iᵀ / γ`` (n x n) of target ``name``."""
         F = self.problem.complementary[name]
         return F @ self.M[name] @ F.T / self.gamma
 
     def cost_weight(self, name: str) -> np.ndarray:
-        """``W_i = F̂_iK_iF̂_iᵀ/γ − F_iN_iF_iᵀ`` of the example cost (5.39)."""
+        """``W_i = F̂_iK_iF̂_iᵀ/γ − F_iN_iF_iᵀ`` (n x n) of the example cost (5.39), target ``name``."""
         F, Fh = self.problem.targets[name], self.problem.complementary[name]
         return Fh @ self.K[name] @ Fh.T / self.gamma - F @ self.N[name] @ F.T
 
     def output_weight_root(self, name: str) -> np.ndarray:
-        """``R_i = Q_i^½ Ĥ_i C``, so that ``CᵀĤ_iQ_iĤ_iC = R_iᵀR_i``."""
+        """``R_i = Q_i^½ Ĥ_i C`` (p x n), so that ``CᵀĤ_iQ_iĤ_iC = R_iᵀR_i``, of target ``name``."""
         w, U = np.linalg.eigh(self.Q[name])
         return (U * np.sqrt(np.clip(w, 0.0, None))) @ U.T @ self.problem.projectors[name] @ self.model.C
 
@@ -129,24 +162,64 @@ def discrete_game_setup(
 ) -> DiscreteGameSetup:
     """Partition the faults of a discrete model and fix the weights (Murray 2012, (5.8), (5.9), (5.39)).
 
+    Sampling a continuous design at Δt: ``Q_d = Q_cΔt``, ``M_d = M_c/Δt`` (fault columns ZOH-sampled,
+    ≈ ``F_cΔt``), ``V_d = V_c/Δt``.  ``Q·P0/γ`` must stay below 1 along ``ĤC`` or the DARI fails at k0 — the
+    initial error reaches the a-priori residual.
+
     Parameters
     ----------
-    model : discrete FaultModel (sample a continuous plant with ``model.discretize(dt)``).
-    targets, nuisance : as in :func:`~fdikit.design.game.setup.game_problem`.
-    gamma : attenuation bound γ > 0.  Vbar : measurement-noise weight ``V̄ > 0``; ``V = V̄/γ``.
-    Q, M, K, N : output weight ``Q_i ≥ 0`` (p x p), complementary-fault weight ``M_i > 0`` and
-        secondary-cost weights ``K_i`` (on ``F̂_i``), ``N_i`` (on ``F_i``): scalar, matrix or a
-        mapping target → value.  Sampling a continuous design at Δt: ``Q_d = Q_cΔt``,
-        ``M_d = M_c/Δt`` (fault columns ZOH-sampled, ≈ ``F_cΔt``), ``V_d = V_c/Δt``.
-    P0 : initial-error weight, ``P(k0) = P0/γ`` (``Π_0 = γP0⁻¹``).  ``Q·P0/γ`` must stay below 1
-        along ``ĤC`` or the DARI fails at k0 — the initial error reaches the a-priori residual.
-    steps : horizon ``k1 − k0`` in samples.
+    model : FaultModel
+        The plant, discrete (sample a continuous plant with ``model.discretize(dt)``); ``Φ = model.A`` must be
+        invertible.
+    targets : sequence of str or mapping name → (n, k) array
+        The faults to detect, as in :func:`~fdikit.design.game.setup.game_problem`.
+    nuisance : sequence of str, mapping or ``'others'``, optional
+        The faults to block: ``()`` (default) none, ``'others'`` every other fault input of the model.
+    gamma : float
+        The attenuation bound γ > 0 of (5.8) (small = strong blocking).
+    Vbar : float or (p, p) array
+        Measurement-noise weight ``V̄ > 0`` of (5.8); the recursions use ``V = V̄/γ``.
+    Q : float, array or mapping target → value
+        Output weight ``Q_i ≥ 0`` (p x p; a scalar means ``Q_i · I``).
+    M : float, array or mapping target → value
+        Complementary-fault weight ``M_i > 0``, sized to the columns of ``F̂_i``.
+    K, N : float, array or mapping target → value, optional
+        Secondary-cost weights of (5.39), ``K_i`` on ``F̂_i`` and ``N_i`` on ``F_i`` (default 0: no secondary
+        cost; :func:`~fdikit.design.game.discrete.dgtmfdf` needs one of them nonzero).
+    P0 : float or (n, n) array, optional
+        Initial-error weight ``P0 > 0`` (default 1): ``P(k0) = P0/γ`` (``Π_0 = γP0⁻¹``).
+    steps : int, optional
+        The horizon ``k1 − k0`` in samples (default 500).
+    rtol : float, optional
+        Relative rank tolerance of the subspace computations of
+        :func:`~fdikit.design.game.setup.game_problem`.
+
+    Returns
+    -------
+    DiscreteGameSetup
+        The partition, ``V = V̄/γ``, ``P(k0) = P0/γ``, the horizon and the per-target weights.
 
     Raises
     ------
     DesignError
-        Continuous model, γ ≤ 0, singular Φ, ``V̄``, ``P0`` or ``M_i`` not positive definite, a weight
-        of the wrong size.
+        A continuous model, a singular Φ, a name given both as target and nuisance, or a target hidden by its
+        complementary faults (:func:`~fdikit.design.game.setup.game_problem`).
+    ParameterError
+        γ not positive and finite, ``steps`` not a positive integer, ``V̄``, ``P0`` or ``M_i`` not positive
+        definite, a weight of the wrong size or not symmetric positive semidefinite, a weight mapping that misses
+        a target, or an unknown fault name.
+
+    Examples
+    --------
+    >>> from fdikit.plants.white_speyer import white_speyer
+    >>> m = white_speyer().discretize(0.01)
+    >>> st = discrete_game_setup(m, ["f1", "f2"], gamma=1.0, Vbar=1.0, Q=0.1, M=1.0, K=1.0, N=1.0, steps=20)
+    >>> st.names, st.M["f1"].shape, float(st.P_init[0, 0])
+    (('f1', 'f2'), (1, 1), 1.0)
+
+    References
+    ----------
+    Murray 2012, §5.1.1, (5.1), (5.8), Assumptions 5.1–5.5; §5.1.2, (5.9); §5.2.2, (5.39).
     """
     if not model.is_discrete:
         raise DesignError("the discrete game filter needs a discrete model; sample the plant with model.discretize(dt)")
@@ -176,11 +249,30 @@ def discrete_game_setup(
 class GameRiccatiSolution:
     """Forward solution of the DGTMFDF Riccati equations for a given gain.
 
+    Made by :func:`discrete_game_riccati`; ``information(name, k)`` gives ``Π_i(k) = P_i(k)⁻¹``.
+
     Attributes
     ----------
-    covariances : ``P_i(k)`` by target, shape (steps + 1, n, n), ``P_i(k0) = P0/γ``.
-    levels : ``λ_max(Q_i^½Ĥ_iCP_i(k)CᵀĤ_iQ_i^½)``, k = k0 … k1 − 1; below 1 ⇔ ``Γ_i(k) > 0``.
-    gamma_inverses : ``Γ_i(k)⁻¹``, shape (steps, n, n).
+    covariances : dict of str to (steps + 1, n, n) array
+        ``P_i(k)`` by target, k = k0 … k1, ``P_i(k0) = P0/γ``.
+    levels : dict of str to (steps,) array
+        ``λ_max(Q_i^½Ĥ_iCP_i(k)CᵀĤ_iQ_i^½)`` by target, k = k0 … k1 − 1; below 1 ⇔ ``Γ_i(k) > 0``.
+    gamma_inverses : dict of str to (steps, n, n) array
+        ``Γ_i(k)⁻¹`` by target, k = k0 … k1 − 1.
+
+    Examples
+    --------
+    >>> from fdikit.design.game.discrete import dgtfdf
+    >>> from fdikit.plants.white_speyer import white_speyer
+    >>> st = discrete_game_setup(white_speyer().discretize(0.01), ["f1"], ["f2"], gamma=1e-2, Vbar=1.0, Q=1e-3,
+    ...                          M=5.0, P0=1e-2, steps=50)
+    >>> sol = discrete_game_riccati(st, dgtfdf(st).filter_gain)
+    >>> sol.covariances["f1"].shape, sol.levels["f1"].shape, sol.information("f1").shape
+    ((51, 3, 3), (50,), (3, 3))
+
+    References
+    ----------
+    Murray 2012, §5.2.1, (5.17), (5.29)–(5.30), Proposition 5.2.
     """
 
     covariances: dict[str, np.ndarray]
@@ -188,7 +280,7 @@ class GameRiccatiSolution:
     gamma_inverses: dict[str, np.ndarray]
 
     def information(self, name: str, k: int = -1) -> np.ndarray:
-        """``Π_i(k) = P_i(k)⁻¹``."""
+        """``Π_i(k) = P_i(k)⁻¹`` of target ``name`` (default the last step, k1)."""
         Pi = np.linalg.inv(self.covariances[name][k])
         return (Pi + Pi.T) / 2
 
@@ -214,17 +306,44 @@ def infeasible(setup: DiscreteGameSetup, name: str, k: int, P: np.ndarray, level
 def discrete_game_riccati(setup: DiscreteGameSetup, L) -> GameRiccatiSolution:
     """Propagate the DARI with equality (Murray 2012, (5.17), (5.29)–(5.30)) for a given gain, all targets at once.
 
-    ``L`` (Murray's filtered form, a design's ``filter_gain``) is n x p (constant) or a (steps, n, p)
-    sequence.  Raises :class:`DesignError` naming the target, the step and the smallest eigenvalue of
-    ``P⁻¹ − CᵀĤQĤC`` when positivity is lost, or when ``I − L(k)C`` is singular.
+    ``P(k+1) = Φ [(I − LC)Γ⁻¹(I − LC)ᵀ + L V Lᵀ] Φᵀ + F̂MF̂ᵀ/γ`` with ``Γ = P⁻¹ − CᵀĤQĤC`` from
+    ``P(k0) = P0/γ`` (module docstring); ``Γ > 0`` is checked at every step (Proposition 5.2).
+
+    Parameters
+    ----------
+    setup : DiscreteGameSetup
+        From :func:`discrete_game_setup`.
+    L : (n, p) or (steps, n, p) array
+        The gain in Murray's filtered form (a design's ``filter_gain``; an observer gain ``G`` is ``Φ⁻¹G``),
+        constant or one per step.
+
+    Returns
+    -------
+    GameRiccatiSolution
+        ``P_i(k)``, the levels ``λ_max(RPRᵀ)`` and ``Γ_i(k)⁻¹`` of every target.
+
+    Raises
+    ------
+    DesignError
+        ``L`` of another shape, ``I − L(k)C`` singular, or positivity of ``P⁻¹ − CᵀĤQĤC`` lost (the message
+        names the target, the step and the smallest eigenvalue: γ is not met with this gain).
 
     Examples
     --------
+    The time-varying DGTFDF gains reproduce the design's own covariances:
+
+    >>> from fdikit.design.game.discrete import dgtfdf
     >>> from fdikit.plants.white_speyer import white_speyer
     >>> m = white_speyer().discretize(0.01)
     >>> st = discrete_game_setup(m, ["f1"], ["f2"], gamma=1e-2, Vbar=1e-2 / 0.01, Q=1e-3, M=5.0, P0=1e-2, steps=50)
-    >>> bool(discrete_game_riccati(st, dgtfdf(st).filter_gain).levels["f1"].max() < 1)
-    True
+    >>> d = dgtfdf(st)
+    >>> sol = discrete_game_riccati(st, d.filter_gains)
+    >>> bool(sol.levels["f1"].max() < 1), bool(np.allclose(sol.covariances["f1"], d.covariances))
+    (True, True)
+
+    References
+    ----------
+    Murray 2012, §5.2.1, (5.17), (5.23), (5.29)–(5.30), Proposition 5.2 (§5.4); §5.3, (5.44b).
     """
     m, steps, names = setup.model, setup.steps, setup.names
     n = m.n
@@ -300,7 +419,42 @@ def secondary_cost(setup: DiscreteGameSetup, L) -> tuple[float, np.ndarray]:
     """``J̄(L) = Σ_i Σ_{k=k0}^{k1−1} tr(W_iΠ_i(k))`` and its exact gradient (Murray 2012, (5.31)–(5.40)).
 
     ``L`` is constant over the horizon; the gradient is (5.34) summed over k with the backward
-    multiplier (5.35) from ``Δ(k1) = 0`` (5.36).  :class:`DesignError` when the DARI is infeasible.
+    multiplier (5.35) from ``Δ(k1) = 0`` (5.36).  ``W_i`` is the weight (5.39) of
+    :meth:`DiscreteGameSetup.cost_weight`.
+
+    Parameters
+    ----------
+    setup : DiscreteGameSetup
+        From :func:`discrete_game_setup`, with the weights ``K_i``, ``N_i``.
+    L : (n, p) array
+        The constant gain in Murray's filtered form (a design's ``filter_gain``).
+
+    Returns
+    -------
+    cost : float
+        ``J̄(L)``.
+    gradient : (n, p) array
+        ``∂J̄/∂L``.
+
+    Raises
+    ------
+    DesignError
+        ``L`` not n x p, ``I − LC`` singular, or the DARI infeasible with this gain
+        (:func:`discrete_game_riccati`).
+
+    Examples
+    --------
+    >>> from fdikit.design.game.discrete import dgtfdf
+    >>> from fdikit.plants.white_speyer import white_speyer
+    >>> st = discrete_game_setup(white_speyer().discretize(0.01), ["f1", "f2"], gamma=1.0, Vbar=1.0, Q=0.1,
+    ...                          M=1.0, K=1.0, N=1.0, steps=20)
+    >>> J, g = secondary_cost(st, dgtfdf(st, "f1").filter_gain)
+    >>> round(J, 6), g.shape
+    (0.000557, (3, 2))
+
+    References
+    ----------
+    Murray 2012, §5.2.2, (5.31), (5.34)–(5.37), (5.39)–(5.40).
     """
     L = _constant_gain(setup, L)
     cost, grad, _, _ = _adjoint(setup, L, discrete_game_riccati(setup, L))
@@ -312,6 +466,37 @@ def gain_update(setup: DiscreteGameSetup, L) -> np.ndarray:
 
     ``L⁺ = [Σ Γ_iΛ_i(Γ_i + CᵀV⁻¹C)]⁻¹ [Σ Γ_iΛ_iCᵀV⁻¹]``.  Its residual ``Σ Γ_iΛ_i[(Γ_i + CᵀV⁻¹C)L − CᵀV⁻¹]``
     equals ``(I − LC)ᵀ·½∇J̄·V⁻¹(I − CL)``, so a fixed point is stationary only while ``I − LC`` is invertible.
+
+    Parameters
+    ----------
+    setup : DiscreteGameSetup
+        From :func:`discrete_game_setup`, with the weights ``K_i``, ``N_i``.
+    L : (n, p) array
+        The constant gain in Murray's filtered form at which ``Γ_i`` and ``Λ_i`` are evaluated.
+
+    Returns
+    -------
+    numpy.ndarray
+        The next (n, p) gain ``L⁺`` of the fixed-point iteration, filtered form.
+
+    Raises
+    ------
+    DesignError
+        ``L`` not n x p, ``I − LC`` singular or the DARI infeasible (:func:`discrete_game_riccati`), or
+        ``Σ Γ_iΛ_i(Γ_i + CᵀV⁻¹C)`` singular (the null spaces overlap across targets, Remark 5.3).
+
+    Examples
+    --------
+    >>> from fdikit.design.game.discrete import dgtfdf
+    >>> from fdikit.plants.white_speyer import white_speyer
+    >>> st = discrete_game_setup(white_speyer().discretize(0.01), ["f1", "f2"], gamma=1.0, Vbar=1.0, Q=0.1,
+    ...                          M=1.0, K=1.0, N=1.0, steps=20)
+    >>> gain_update(st, dgtfdf(st, "f1").filter_gain).shape
+    (3, 2)
+
+    References
+    ----------
+    Murray 2012, §5.2.2, (5.37), (5.40)–(5.41), Remark 5.3.
     """
     L = _constant_gain(setup, L)
     _, _, lhs, rhs = _adjoint(setup, L, discrete_game_riccati(setup, L))
@@ -328,6 +513,34 @@ def discrete_game_generator(setup: DiscreteGameSetup, L, targets: Sequence[str] 
 
     ``x̄(k+1) = Φ(I − LC) x̄ + (Bu − ΦL Du) u + ΦL y``, ``r = y − C x̄ − Du u``; ``Q_i`` is an orthonormal
     basis of ``Im Ĥ_i`` and the residuals are named ``<target>[j]``, each isolating its target.
+
+    Parameters
+    ----------
+    setup : DiscreteGameSetup
+        From :func:`discrete_game_setup` (the model and the projectors ``Ĥ_i``).
+    L : (n, p) array
+        The constant gain in Murray's filtered form; the generator's observer gain is ``Φ L``.
+    targets : sequence of str, optional
+        The targets whose projected residuals are produced, in this order (default every target of the setup).
+
+    Returns
+    -------
+    ResidualGenerator
+        The discrete filter with state matrix ``Φ(I − LC)`` and residuals ``<target>[j]``.
+
+    Examples
+    --------
+    >>> from fdikit.plants.white_speyer import white_speyer
+    >>> m = white_speyer().discretize(0.01)
+    >>> st = discrete_game_setup(m, ["f1", "f2"], gamma=1.0, Vbar=1.0, Q=0.1, M=1.0, steps=20)
+    >>> L = np.full((3, 2), 0.1)
+    >>> gen = discrete_game_generator(st, L)
+    >>> gen.residuals, bool(np.allclose(gen.A, m.A @ (np.eye(3) - L @ m.C)))
+    (('f1[0]', 'f2[0]'), True)
+
+    References
+    ----------
+    Murray 2012, §5.1.1, (5.3), (5.6); §2.2.2 (the discrete detection filter).
     """
     m = setup.model
     names, blocks, isolates = [], [], []
