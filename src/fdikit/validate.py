@@ -165,21 +165,28 @@ def as_covariance(
     error: type[Exception] = ParameterError,
     definite: bool = False,
     scalar_ok: bool = True,
+    diagonal_ok: bool = False,
+    rtol: float = 1e-12,
 ) -> np.ndarray:
     """A symmetric positive semidefinite (``definite``: positive definite) ``n x n`` matrix.
 
-    A scalar means ``value · I``.  Symmetry and the eigenvalue test use a tolerance relative
-    to the largest entry (1e-12).  Returns the symmetric part.
+    A scalar means ``value · I``; with ``diagonal_ok`` a vector of ``n`` variances means their
+    diagonal matrix.  Symmetry and the eigenvalue test use a tolerance ``rtol`` relative to the
+    largest entry.  Returns the symmetric part.
     """
     raw = as_array(name, value, error=error)
     if scalar_ok and raw.size == 1 and raw.ndim <= 2:
         raw = raw.reshape(())
+    if diagonal_ok and raw.ndim == 1 and raw.size == n:
+        raw = np.diag(raw)
     if raw.shape != (n, n) and not (raw.ndim == 0 and (scalar_ok or n == 1)):
-        raise error(f"{name} must be a {n}x{n} covariance matrix{' (a scalar means σ² I)' if scalar_ok else ''}; "
-                    f"use np.diag(variances) for independent components; got shape {raw.shape}")
+        kinds = " (a scalar means σ² I)" if scalar_ok else ""
+        kinds = f" (a scalar means σ² I, {n} variances their diagonal)" if diagonal_ok else kinds
+        raise error(f"{name} must be a {n}x{n} covariance matrix{kinds}; use np.diag(variances) for independent "
+                    f"components; got shape {raw.shape}")
     out = as_matrix(name, raw, (n, n), error=error, scalar_ok=scalar_ok)
     scale = max(1.0, float(np.abs(out).max(initial=0.0)))
-    if not np.allclose(out, out.T, rtol=0.0, atol=1e-12 * scale):
+    if not np.allclose(out, out.T, rtol=0.0, atol=rtol * scale):
         raise error(f"{name} must be symmetric; pass (M + M.T) / 2 or a diagonal matrix")
     out = (out + out.T) / 2
     if n:
@@ -188,7 +195,7 @@ def as_covariance(
             raise error(
                 f"{name} must be positive definite (smallest eigenvalue {low:.3g}); add a small positive diagonal"
             )
-        if low < -1e-12 * scale:
+        if low < -rtol * scale:
             raise error(f"{name} must be positive semidefinite (smallest eigenvalue {low:.3g}); "
                         "a covariance has non-negative eigenvalues")
     return out

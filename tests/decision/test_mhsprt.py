@@ -562,7 +562,7 @@ def test_bad_input_is_refused():
     np.testing.assert_allclose(reg.cov, [[1 + 1e-6, 1.0], [1.0, 1 + 1e-6]])
     with pytest.raises(ParameterError, match="low <= high"):
         UniformMeanDensity(1.0, 0.0, 1.0)
-    with pytest.raises(ParameterError, match="positive semi-definite"):
+    with pytest.raises(ParameterError, match="mean_cov must be positive semidefinite"):
         gaussian_mean_density(0.0, 1.0, -1.0)
     rng = np.random.default_rng(0)
     sing = _res(np.column_stack([rng.standard_normal(50), np.ones(50)]))

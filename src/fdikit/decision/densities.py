@@ -13,6 +13,7 @@ import numpy as np
 import scipy.linalg
 from scipy.special import log_ndtr, logsumexp, ndtr
 
+from fdikit import validate
 from fdikit.errors import DataError, ParameterError
 
 __all__ = ["GaussianDensity", "UniformMeanDensity", "gaussian_mean_density"]
@@ -30,14 +31,7 @@ def _vec(value, name: str, n: int | None = None) -> np.ndarray:
 
 def _cov(value, n: int, name: str = "covariance", regularization: float = 0.0, definite: bool = True) -> np.ndarray:
     """A scalar (σ² I), a vector (diagonal) or an (n, n) matrix → a symmetric positive definite matrix, or refuse."""
-    c = np.asarray(value, dtype=float)
-    c = c * np.eye(n) if c.ndim == 0 else np.diag(c) if c.ndim == 1 else c
-    if c.shape != (n, n) or not np.all(np.isfinite(c)):
-        raise ParameterError(f"{name} must be a finite ({n}, {n}) matrix, got shape {c.shape}")
-    scale = np.abs(c).max(initial=0.0)
-    if np.abs(c - c.T).max(initial=0.0) > 1e-8 * scale:
-        raise ParameterError(f"{name} is not symmetric (max |Λ − Λᵀ| = {np.abs(c - c.T).max():.3g})")
-    c = 0.5 * (c + c.T)
+    c = validate.as_covariance(name, value, n, diagonal_ok=True, rtol=1e-8)
     if regularization:
         if not regularization > 0:
             raise ParameterError(f"regularization must be positive, got {regularization}")

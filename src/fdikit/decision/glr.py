@@ -40,6 +40,7 @@ import numpy as np
 import scipy.linalg
 from scipy.stats import chi2
 
+from fdikit import validate
 from fdikit.decision.common import (
     checked_names,
     checked_residuals,
@@ -294,7 +295,7 @@ def as_covariance(cov, q: int) -> np.ndarray:
     >>> as_covariance(2.0, 3).tolist()
     [2.0, 2.0, 2.0]
     """
-    c = np.asarray(cov, dtype=float)
+    c = validate.as_array("covariance", cov, error=DataError, finite=False)  # a diagonal stays a vector (fast path)
     if c.ndim == 0:
         c = np.full(q, float(c))
     if c.ndim == 1:
