@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from fdikit import FaultModel
-from fdikit import linalg as la
+from fdikit import fault_maps as fmaps
 from fdikit.analysis.gains import fault_to_residual_gain, fdi_report
 from fdikit.design.game.multi_fault import game_filter
 from fdikit.design.game.reduced_order import goh_detector
@@ -49,19 +49,19 @@ CONTROL_MSG = "'u' is a control; its actuator fault is 'u_actuator'"
 # ---------------------------------------------------------------------- resolve_faults
 def test_resolve_faults_takes_fault_names():
     m = _plant()
-    maps = la.resolve_faults(m, ["y0_sensor", "y1_sensor:magnitude", "u_actuator"])
+    maps = fmaps.resolve_faults(m, ["y0_sensor", "y1_sensor:magnitude", "u_actuator"])
     assert list(maps) == ["y0_sensor", "y1_sensor", "u_actuator"]
-    np.testing.assert_array_equal(maps["y0_sensor"], la.sensor_fault_map(m, "y0"))
-    np.testing.assert_array_equal(maps["y1_sensor"], la.sensor_fault_map(m, "y1", "magnitude"))
+    np.testing.assert_array_equal(maps["y0_sensor"], fmaps.sensor_fault_map(m, "y0"))
+    np.testing.assert_array_equal(maps["y1_sensor"], fmaps.sensor_fault_map(m, "y1", "magnitude"))
     np.testing.assert_array_equal(maps["u_actuator"], m.Bu)
     # one name, and the fault inputs of a model by their own names (pure sensor fault -> its sensor map)
-    assert list(la.resolve_faults(m, "y2_sensor:rate")) == ["y2_sensor"]
+    assert list(fmaps.resolve_faults(m, "y2_sensor:rate")) == ["y2_sensor"]
     fm = _faulty()
-    np.testing.assert_array_equal(la.resolve_faults(fm, ["y0_sensor"])["y0_sensor"], la.sensor_fault_map(m, "y0"))
-    np.testing.assert_array_equal(la.resolve_faults(fm, ["u_actuator"])["u_actuator"], m.Bu)
+    np.testing.assert_array_equal(fmaps.resolve_faults(fm, ["y0_sensor"])["y0_sensor"], fmaps.sensor_fault_map(m, "y0"))
+    np.testing.assert_array_equal(fmaps.resolve_faults(fm, ["u_actuator"])["u_actuator"], m.Bu)
     # explicit maps keep working, under their own keys
     F = np.array([[1.0], [0.0], [0.0]])
-    np.testing.assert_array_equal(la.resolve_faults(m, {"my_fault": F})["my_fault"], F)
+    np.testing.assert_array_equal(fmaps.resolve_faults(m, {"my_fault": F})["my_fault"], F)
 
 
 @pytest.mark.parametrize("model", [_plant(), _faulty()], ids=["plain", "with-fault-inputs"])
@@ -72,33 +72,33 @@ def test_resolve_faults_takes_fault_names():
 ])
 def test_signal_names_are_refused_with_the_fault_name(model, name, message):
     with pytest.raises(ParameterError, match=message):
-        la.resolve_faults(model, [name])
+        fmaps.resolve_faults(model, [name])
     with pytest.raises(ParameterError, match=message):
-        la.resolve_fault(model, name)
+        fmaps.resolve_fault(model, name)
 
 
 def test_unknown_names_and_bad_suffixes():
     m = _plant()
     with pytest.raises(ModelError, match="'zz' is not a fault of the model.*'y0_sensor'.*'u_actuator'"):
-        la.resolve_faults(m, ["zz"])
+        fmaps.resolve_faults(m, ["zz"])
     with pytest.raises(ModelError, match="sensor faults only"):
-        la.resolve_fault(m, "u_actuator:magnitude")
+        fmaps.resolve_fault(m, "u_actuator:magnitude")
     with pytest.raises(ParameterError, match="suffix"):
-        la.resolve_fault(m, "y0_sensor:bias")
+        fmaps.resolve_fault(m, "y0_sensor:bias")
     with pytest.raises(ModelError, match="not a fault input of the model; add it with model.with_sensor_faults"):
-        la.check_fault_inputs(m, ["y1_sensor"])
+        fmaps.check_fault_inputs(m, ["y1_sensor"])
 
 
 def test_resolve_nuisance_convention():
     m = _faulty()
-    assert la.resolve_nuisance(m, ()) == {}
-    others = la.resolve_nuisance(m, "others", ["y0_sensor"])
-    explicit = la.resolve_faults(m, ["y2_sensor", "u_actuator"])
+    assert fmaps.resolve_nuisance(m, ()) == {}
+    others = fmaps.resolve_nuisance(m, "others", ["y0_sensor"])
+    explicit = fmaps.resolve_faults(m, ["y2_sensor", "u_actuator"])
     assert list(others) == list(explicit)
     for k in explicit:
         np.testing.assert_array_equal(others[k], explicit[k])
     with pytest.raises(ParameterError, match="'others'"):
-        la.resolve_nuisance(m, None)
+        fmaps.resolve_nuisance(m, None)
 
 
 # ---------------------------------------------------------------------- designs refuse signal names

@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 
+from fdikit import fault_maps as fm
 from fdikit import linalg as la
 from fdikit.errors import DesignError, ParameterError
 from fdikit.plants.path_vehicle import path_vehicle_12, path_vehicle_14
@@ -379,12 +380,12 @@ GROUPS_12 = {
 def test_r_geo_1_sensor_maps(output):
     """R-GEO-1: C F¹ = e_i and F² = A F¹ (eq. (3.5)); 'magnitude'/'rate' pick the columns."""
     i = M12.outputs.index(output)
-    F = la.sensor_fault_map(M12, output)
+    F = fm.sensor_fault_map(M12, output)
     assert F.shape == (12, 2)
     np.testing.assert_allclose(M12.C @ F[:, 0], np.eye(12)[i], atol=1e-9)
     np.testing.assert_allclose(F[:, 1], M12.A @ F[:, 0], rtol=1e-12)
-    np.testing.assert_array_equal(la.sensor_fault_map(M12, output, "magnitude"), F[:, 1:])
-    np.testing.assert_array_equal(la.sensor_fault_map(M12, output, "rate"), F[:, :1])
+    np.testing.assert_array_equal(fm.sensor_fault_map(M12, output, "magnitude"), F[:, 1:])
+    np.testing.assert_array_equal(fm.sensor_fault_map(M12, output, "rate"), F[:, :1])
 
 
 def test_r_geo_1_rank_deficient_c_raises():
@@ -394,13 +395,13 @@ def test_r_geo_1_rank_deficient_c_raises():
     ok = []
     for output in m.outputs:
         try:
-            la.sensor_fault_map(m, output)
+            fm.sensor_fault_map(m, output)
             ok.append(output)
         except DesignError as exc:
             assert "not in the range of C" in str(exc)
     assert ok == ["air_mass"]
     with pytest.raises(ParameterError, match="direction"):
-        la.sensor_fault_map(M12, "air_mass", "bias")
+        fm.sensor_fault_map(M12, "air_mass", "bias")
 
 
 def test_r_geo_2_actuator_detection_spaces():
@@ -409,25 +410,25 @@ def test_r_geo_2_actuator_detection_spaces():
     A, C = M14.A, M14.C
     expect = {"throttle": 2, "brake": 2, "steering": 1}
     for control, nu in expect.items():
-        F = la.actuator_fault_map(M14, control)
+        F = fm.actuator_fault_map(M14, control)
         assert la.invariant_zeros(A, C, F)[0].size == 0
         T = la.detection_space(A, C, F)
         assert T.shape[1] == la.caisa(A, C, F).shape[1] == nu, control
         krylov = np.hstack([np.linalg.matrix_power(A, k) @ F for k in range(nu)])
         assert _angle(T, krylov) < 1e-10
-    F = la.actuator_fault_map(M14, "throttle")
+    F = fm.actuator_fault_map(M14, "throttle")
     np.testing.assert_array_equal(C @ F, 0)
     CAF = (C @ A @ F).ravel()
     np.testing.assert_allclose(CAF, 2.35 * 90.91 * np.eye(12)[0], rtol=1e-12)
     with pytest.raises(DesignError):  # the 12-state steering column has a feedthrough
-        la.actuator_fault_map(M12, "steering")
+        fm.actuator_fault_map(M12, "steering")
 
 
 def test_r_geo_2_sensor_detection_spaces_are_the_fault_maps():
     """Every 2-D sensor fault on the 12-state midpoint model: no invariant zeros (C is invertible there, so
     none can exist) and T* = W* = Im F."""
     for output in M12.outputs:
-        F = la.sensor_fault_map(M12, output)
+        F = fm.sensor_fault_map(M12, output)
         assert la.invariant_zeros(M12.A, M12.C, F)[0].size == 0, output
         assert _angle(la.detection_space(M12.A, M12.C, F), F) < 1e-10, output
 
@@ -438,7 +439,7 @@ def test_path14_air_mass_zeros():
     (A − z I) e_τb = −0.07 e_ωe ∈ Im F (F = [e_ma, A e_ma] spans e_ma, e_ωe).  Hence ν = 4 there.
     On the midpoint model only −90.91 remains (AB08ND's default tolerance missed it before the fix)."""
     A, C = M14.A, M14.C
-    F = la.sensor_fault_map(M14, "air_mass")
+    F = fm.sensor_fault_map(M14, "air_mass")
     z, d = la.invariant_zeros(A, C, F)
     order = np.argsort(z.real)
     np.testing.assert_allclose(z.real[order], [-90.91, -1.25], rtol=1e-12)
@@ -447,16 +448,16 @@ def test_path14_air_mass_zeros():
     assert _angle(d[order[1]].real.reshape(-1, 1), e[:, [12]]) < 1e-10
     assert la.detection_space(A, C, F).shape[1] == 4
     m = path_vehicle_14("midpoint")
-    z, d = la.invariant_zeros(m.A, m.C, la.sensor_fault_map(m, "air_mass"))
+    z, d = la.invariant_zeros(m.A, m.C, fm.sensor_fault_map(m, "air_mass"))
     np.testing.assert_allclose(z.real, [-90.91], rtol=1e-12)
 
 
 def test_r_geo_3_throttle_air_mass_separability():
     """R-GEO-3: (throttle, air mass 2-D) not output separable; (throttle, air-mass magnitude A F¹) separable."""
     A, C = M14.A, M14.C
-    T_thr = la.detection_space(A, C, la.actuator_fault_map(M14, "throttle"))
-    T_am2 = la.detection_space(A, C, la.sensor_fault_map(M14, "air_mass"))
-    T_am1 = la.detection_space(A, C, la.sensor_fault_map(M14, "air_mass", "magnitude"))
+    T_thr = la.detection_space(A, C, fm.actuator_fault_map(M14, "throttle"))
+    T_am2 = la.detection_space(A, C, fm.sensor_fault_map(M14, "air_mass"))
+    T_am1 = la.detection_space(A, C, fm.sensor_fault_map(M14, "air_mass", "magnitude"))
     assert la.output_separable(C, [T_thr, T_am2]) == (False, [(0, 1)])
     assert la.output_separable(C, [T_thr, T_am1]) == (True, [])
 
@@ -465,7 +466,7 @@ def test_r_geo_3_throttle_air_mass_separability():
 def test_r_geo_4_sensor_groups(group):
     """R-GEO-4, groups 1–3 (12-state midpoint): ν = 2 each, Σν = 8 (ν₀ = 4), output separable, mutually
     detectable.  With C invertible nobody has zeros, so mutual detectability holds trivially (∅ = ∅)."""
-    Fs = [la.sensor_fault_map(M12, o) for o in GROUPS_12[group]]
+    Fs = [fm.sensor_fault_map(M12, o) for o in GROUPS_12[group]]
     Ts = [la.detection_space(M12.A, M12.C, F) for F in Fs]
     assert [T.shape[1] for T in Ts] == [2, 2, 2, 2]
     assert la.output_separable(M12.C, Ts) == (True, [])
@@ -485,8 +486,8 @@ def test_r_geo_4_group_4_reconstructed_data():
     separable, with a margin that comes from those sub-print-precision couplings only.
     """
     A, C = M14.A, M14.C
-    Fs = [la.actuator_fault_map(M14, "throttle"), la.actuator_fault_map(M14, "brake"),
-          la.actuator_fault_map(M14, "steering"), la.sensor_fault_map(M14, "air_mass", "magnitude")]
+    Fs = [fm.actuator_fault_map(M14, "throttle"), fm.actuator_fault_map(M14, "brake"),
+          fm.actuator_fault_map(M14, "steering"), fm.sensor_fault_map(M14, "air_mass", "magnitude")]
     Ts = [la.detection_space(A, C, F) for F in Fs]
     assert [T.shape[1] for T in Ts] == [2, 2, 1, 1]
     assert la.output_separable(C, Ts) == (False, [])
@@ -494,9 +495,9 @@ def test_r_geo_4_group_4_reconstructed_data():
     ok, joint, union = la.mutually_detectable(A, C, Fs)
     assert ok and joint.size == 0 and union.size == 0
     m = path_vehicle_14("midpoint")
-    Fb = la.actuator_fault_map(m, "brake")
-    Fs = [la.actuator_fault_map(m, "throttle"), np.hstack([Fb, m.A @ Fb]),
-          la.actuator_fault_map(m, "steering"), la.sensor_fault_map(m, "air_mass", "magnitude")]
+    Fb = fm.actuator_fault_map(m, "brake")
+    Fs = [fm.actuator_fault_map(m, "throttle"), np.hstack([Fb, m.A @ Fb]),
+          fm.actuator_fault_map(m, "steering"), fm.sensor_fault_map(m, "air_mass", "magnitude")]
     Ts = [la.detection_space(m.A, m.C, F) for F in Fs]
     assert [T.shape[1] for T in Ts] == [2, 2, 1, 1]
     assert la.output_separable(m.C, Ts) == (True, [])
@@ -561,20 +562,20 @@ def test_time_varying_sensor_fault_map():
         return C0 + t * C1
 
     t, i = 0.7, 2
-    F = la.sensor_fault_map_tv(A, C, i, t)
+    F = fm.sensor_fault_map_tv(A, C, i, t)
     Ci = np.linalg.inv(C(t))
     F1 = Ci[:, i]
     dF1 = -Ci @ C1 @ Ci[:, i]
     np.testing.assert_allclose(F[:, 0], F1, rtol=1e-12)
     np.testing.assert_allclose(F[:, 1], A(t) @ F1 - dF1, rtol=1e-7)
-    exact = la.sensor_fault_map_tv(A, C, i, t, dF1=lambda _t: dF1)
+    exact = fm.sensor_fault_map_tv(A, C, i, t, dF1=lambda _t: dF1)
     np.testing.assert_allclose(exact[:, 1], A(t) @ F1 - dF1, rtol=1e-12)
     from fdikit import FaultModel
 
     m = FaultModel(A=A0, C=C0)
-    np.testing.assert_allclose(la.sensor_fault_map_tv(lambda _t: A0, lambda _t: C0, i, 5.0),
-                               la.sensor_fault_map(m, m.outputs[i]), rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(fm.sensor_fault_map_tv(lambda _t: A0, lambda _t: C0, i, 5.0),
+                               fm.sensor_fault_map(m, m.outputs[i]), rtol=1e-9, atol=1e-12)
     from fdikit.errors import DesignError
 
     with pytest.raises(DesignError, match="not in the range"):
-        la.sensor_fault_map_tv(A, lambda _t: np.zeros((n, n)), i, t)
+        fm.sensor_fault_map_tv(A, lambda _t: np.zeros((n, n)), i, t)

@@ -136,7 +136,7 @@ def _dgtmfdf():
 
 def _goh():
     from fdikit.design.game.reduced_order import goh_filter
-    from fdikit.linalg import resolve_faults
+    from fdikit.fault_maps import resolve_faults
 
     m = f16xl_longitudinal()
     faults = resolve_faults(m, ["y_theta_sensor", "elevon_actuator"]) | {"gust": m.Bd}

@@ -25,9 +25,10 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from fdikit import linalg
+from fdikit import fault_maps, linalg
 from fdikit.errors import DesignError, ModelError
-from fdikit.linalg import output_projector, resolve_faults
+from fdikit.fault_maps import resolve_faults
+from fdikit.linalg import output_projector
 from fdikit.model import FaultModel, actuator_fault_name, sensor_fault_name
 
 __all__ = ["MatrixFunction", "LTVModel", "invariant_generators", "ltv_projector"]
@@ -121,7 +122,7 @@ class LTVModel:
     def from_lti(cls, model: FaultModel, faults: Mapping[str, np.ndarray] | Sequence[str]) -> LTVModel:
         """Constant matrices of a continuous :class:`FaultModel`.
 
-        ``faults``: fault names resolved by :func:`fdikit.linalg.resolve_faults` (``'<output>_sensor'``,
+        ``faults``: fault names resolved by :func:`fdikit.fault_maps.resolve_faults` (``'<output>_sensor'``,
         ``'<control>_actuator'``, fault inputs of the model; a bare signal name raises
         :class:`~fdikit.errors.ParameterError`) or a mapping name → ``F``.
         """
@@ -186,11 +187,11 @@ def _family_fault(at, ref: FaultModel, spec: str, step: float) -> tuple[str, Mat
         if suffix:
             raise ModelError(f"{spec!r}: the suffix applies to sensor faults only")
         return base, lambda t: at(t).Bd[:, [ref.disturbances.index(base)]]
-    kind, signal, suffix = linalg.split_fault_name(ref, spec)
+    kind, signal, suffix = fault_maps.split_fault_name(ref, spec)
     if kind == "sensor":
         idx = ref.outputs.index(signal)
         cols = {"": [0, 1], "rate": [0], "magnitude": [1]}[suffix]
-        return sensor_fault_name(signal), lambda t: linalg.sensor_fault_map_tv(
+        return sensor_fault_name(signal), lambda t: fault_maps.sensor_fault_map_tv(
             lambda s: at(s).A, lambda s: at(s).C, idx, t, step=step)[:, cols]
     if kind == "actuator":
         return actuator_fault_name(signal), lambda t: at(t).Bu[:, [ref.controls.index(signal)]]

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from fdikit import FaultModel, ModelError
-from fdikit import linalg as la
+from fdikit import fault_maps as fm
 from fdikit.analysis.gains import (
     GainTable,
     default_freqs,
@@ -205,12 +205,12 @@ def test_fdi_report_midpoint_group_4_is_clean():
     """With the ±0.00 entries at their rounding midpoints and the brake taken 2-D (report §4.1) the set is
     separable and mutually detectable: no advice."""
     m = path_vehicle_14("midpoint")
-    Fb = la.actuator_fault_map(m, "brake")
+    Fb = fm.actuator_fault_map(m, "brake")
     maps = {
-        "throttle": la.actuator_fault_map(m, "throttle"),
+        "throttle": fm.actuator_fault_map(m, "throttle"),
         "brake": np.hstack([Fb, m.A @ Fb]),
-        "steering": la.actuator_fault_map(m, "steering"),
-        "air_mass:magnitude": la.sensor_fault_map(m, "air_mass", "magnitude"),
+        "steering": fm.actuator_fault_map(m, "steering"),
+        "air_mass:magnitude": fm.sensor_fault_map(m, "air_mass", "magnitude"),
     }
     rep = fdi_report(m, maps)
     assert [f.nu for f in rep.faults] == [2, 2, 1, 1]
@@ -273,15 +273,15 @@ def test_fdi_report_inseparable_actuators_and_undetectable_fault():
 def test_resolve_fault_names():
     m = path_vehicle_14().with_sensor_faults(["air_mass"]).with_actuator_faults(["throttle"])
     F, kind = resolve_fault(m, "air_mass_sensor")
-    np.testing.assert_array_equal(F, la.sensor_fault_map(m, "air_mass"))
+    np.testing.assert_array_equal(F, fm.sensor_fault_map(m, "air_mass"))
     assert kind == "sensor"
     F, kind = resolve_fault(m, "air_mass_sensor:magnitude")
-    np.testing.assert_array_equal(F, la.sensor_fault_map(m, "air_mass")[:, 1:])
+    np.testing.assert_array_equal(F, fm.sensor_fault_map(m, "air_mass")[:, 1:])
     assert kind == "sensor:magnitude"
     assert resolve_fault(m, "air_mass_sensor:rate")[0].shape == (14, 1)
     # the same names on a model without the fault inputs: <output>_sensor and <control>_actuator still resolve
     plain = path_vehicle_14()
-    np.testing.assert_array_equal(resolve_fault(plain, "air_mass_sensor")[0], la.sensor_fault_map(m, "air_mass"))
+    np.testing.assert_array_equal(resolve_fault(plain, "air_mass_sensor")[0], fm.sensor_fault_map(m, "air_mass"))
     np.testing.assert_array_equal(resolve_fault(plain, "throttle_actuator")[0], m.Bu[:, [0]])
     F, kind = resolve_fault(m, "throttle_actuator")
     np.testing.assert_array_equal(F, m.Bu[:, [0]])

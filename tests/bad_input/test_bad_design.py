@@ -40,7 +40,7 @@ from fdikit.design import (
 )
 from fdikit.errors import DataError, DesignError, ModelError, ParameterError
 from fdikit.estimate import SteeringFaultIsolator, isolate_steering_faults, isolation_error_bound, lateral_fault_map
-from fdikit.linalg import resolve_faults
+from fdikit.fault_maps import resolve_faults
 from fdikit.lpv import LPVModel, stacked_matrices
 from fdikit.plants import white_speyer
 

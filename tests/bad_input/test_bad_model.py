@@ -11,8 +11,8 @@ from fdikit.analysis.gains import default_freqs, fault_to_residual_gain, structu
 from fdikit.analysis.geometry import fdi_report
 from fdikit.design import kalman
 from fdikit.errors import DataError, ModelError, ParameterError
+from fdikit.fault_maps import actuator_fault_map, resolve_fault, sensor_fault_map, sensor_fault_map_tv
 from fdikit.linalg import (
-    actuator_fault_map,
     caisa,
     contains,
     detection_space,
@@ -23,9 +23,6 @@ from fdikit.linalg import (
     orth,
     output_separable,
     rank,
-    resolve_fault,
-    sensor_fault_map,
-    sensor_fault_map_tv,
     span_sum,
 )
 from fdikit.lti import dlsim_blocked, lifted_matrices

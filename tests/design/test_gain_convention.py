@@ -34,7 +34,7 @@ from fdikit.design.game.single_fault import game_filter_bank, single_fault_game_
 from fdikit.design.observers.beard_jones import beard_jones, restricted_diagonal
 from fdikit.design.observers.full_order import kalman, observer
 from fdikit.design.observers.hinf import hinf_detection_filter
-from fdikit.linalg import resolve_faults
+from fdikit.fault_maps import resolve_faults
 from fdikit.plants.f16xl import F16XL_DRYDEN_GAIN, f16xl_gust, f16xl_longitudinal
 from fdikit.plants.white_speyer import white_speyer
 

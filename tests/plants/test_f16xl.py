@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from fdikit import linalg
+from fdikit import fault_maps, linalg
 from fdikit.errors import ParameterError
 from fdikit.plants.f16xl import F16XL_A, F16XL_DRYDEN_GAIN, f16xl_gust, f16xl_longitudinal
 
@@ -37,7 +37,7 @@ def test_printed_accelerometer_fault_map():
     This pins C(2,4) = 0 (C e_4 must be ∝ e_3) and C(3,4) = −0.0299 (F¹ = e_4/C(3,4)).
     """
     m = f16xl_gust()
-    F, kind = linalg.resolve_fault(m, "y_Az_sensor")
+    F, kind = fault_maps.resolve_fault(m, "y_Az_sensor")
     assert kind == "sensor"
     np.testing.assert_allclose(m.C @ F[:, 0], [0, 0, 1, 0], atol=1e-12)
     np.testing.assert_allclose(F[:, 0], [0, 0, 0, 1 / -0.0299, 0], rtol=1e-12, atol=1e-12)
@@ -51,7 +51,7 @@ def test_faults_have_no_invariant_zeros_and_are_mutually_detectable():
     """App. C.5: (C, A, F¹_Az), (C, A, F²_Az), (C, A, F_δ) have no invariant zeros, the minimal
     unobservability subspaces are the fault directions, and the faults are mutually detectable."""
     m = f16xl_gust()
-    F_az = linalg.resolve_fault(m, "y_Az_sensor")[0]
+    F_az = fault_maps.resolve_fault(m, "y_Az_sensor")[0]
     F_d = m.Bu
     for F in (F_az[:, [0]], F_az[:, [1]], F_d, F_az):
         zeros, _ = linalg.invariant_zeros(m.A, m.C, F)

@@ -30,7 +30,7 @@ import numpy as np
 from fdikit import validate
 from fdikit.analysis.geometry import FaultGeometry, FdiReport, fdi_report
 from fdikit.errors import ModelError, ParameterError
-from fdikit.linalg import check_fault_inputs, resolve_fault
+from fdikit.fault_maps import check_fault_inputs, resolve_fault
 from fdikit.model import FaultModel
 from fdikit.residuals import ResidualGenerator
 

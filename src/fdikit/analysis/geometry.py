@@ -24,7 +24,7 @@ import numpy as np
 
 from fdikit import linalg, validate
 from fdikit.errors import ModelError
-from fdikit.linalg import resolve_fault
+from fdikit.fault_maps import resolve_fault
 from fdikit.model import FaultModel
 
 __all__ = ["FaultGeometry", "FdiReport", "fdi_report"]

@@ -42,7 +42,7 @@ def f16xl_longitudinal() -> FaultModel:
     FaultModel
         States ``u, w, q, theta``; outputs ``y_u, y_w, y_q, y_theta`` (``C = I``); control
         ``elevon``; disturbance ``gust`` (``B_wg`` = column 2 of ``A``).  The three faults of
-        the example are named by :func:`fdikit.linalg.resolve_faults`: ``'y_theta_sensor'`` (the
+        the example are named by :func:`fdikit.fault_maps.resolve_faults`: ``'y_theta_sensor'`` (the
         pitch-angle sensor, ``[e_4, A e_4]``), ``'elevon_actuator'`` (``F_δ = B_δ``) and the gust
         as a fault map ``{'gust': model.Bd}``.
 
@@ -89,7 +89,7 @@ def f16xl_gust(
     like ``w``); outputs ``y_q`` (deg/s), ``y_alpha`` (deg), ``y_Az``, ``y_Ax`` (ft/s²); control
     ``elevon`` (deg); noise inputs (unit-PSD white) ``wind`` (through ``B_ω = gust_gain e_5``) and
     the sensor noises ``nu_q, nu_alpha, nu_Az, nu_Ax`` (through ``D = diag(d_q, 0.143, 0.245, 0.245)``).
-    The faults of the example are named through :func:`fdikit.linalg.resolve_faults`:
+    The faults of the example are named through :func:`fdikit.fault_maps.resolve_faults`:
     ``'y_Az_sensor'`` (the normal accelerometer, ``[F¹, A F¹]`` with ``C F¹ = e_3``) and
     ``'elevon_actuator'`` (``F_δ = B_δ``).  ``A[:4, :4]`` and ``B_δ[:4]`` are Murray's §6.1 model (:data:`F16XL_A`).
 

@@ -142,7 +142,7 @@ def path_longitudinal_7() -> FaultModel:
     ``A`` with A(2,3) = +19.0734 and ``C`` in the labelled row order (module docstring); no
     controls (``B``, ``D`` are not printed), no fault inputs.  The air-mass sensor fault of the
     example is the target (``'air_mass_sensor'`` resolves to ``[f, A f]`` with ``C f = e_1`` via
-    :func:`fdikit.linalg.resolve_faults`); the printed nuisance maps are in
+    :func:`fdikit.fault_maps.resolve_faults`); the printed nuisance maps are in
     :func:`path_longitudinal_7_fault_maps`.
     ``resolve_faults(model, ['engine_speed_sensor', 'accel_x_sensor'])``
     gives the exact maps of this (rounded) model instead, which differ from the printed ones by

@@ -19,7 +19,7 @@ from fdikit.design.game.riccati import game_cost, game_riccati, solve_game_are
 from fdikit.design.game.setup import game_problem
 from fdikit.design.game.single_fault import game_filter_bank, single_fault_game_filter
 from fdikit.errors import DesignError, ParameterError
-from fdikit.linalg import resolve_faults
+from fdikit.fault_maps import resolve_faults
 from fdikit.plants.f16xl import f16xl_longitudinal
 from fdikit.plants.white_speyer import white_speyer
 

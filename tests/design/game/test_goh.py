@@ -18,7 +18,7 @@ from fdikit.design.game.goh import goh_riccati, goh_riccati_transient, goh_trans
 from fdikit.design.game.reduced_order import goh_detector, goh_filter
 from fdikit.design.game.single_fault import single_fault_game_filter
 from fdikit.errors import DesignError, ParameterError
-from fdikit.linalg import resolve_faults
+from fdikit.fault_maps import resolve_faults
 from fdikit.plants.f16xl import f16xl_longitudinal
 from fdikit.plants.path_longitudinal import path_longitudinal_7, path_longitudinal_7_fault_maps
 from fdikit.plants.white_speyer import white_speyer

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from fdikit import FaultModel
 from fdikit.design.observers.beard_jones import beard_jones, restricted_diagonal
 from fdikit.errors import DesignError, ModelError, ParameterError
-from fdikit.linalg import resolve_faults
+from fdikit.fault_maps import resolve_faults
 
 W = np.logspace(-2, 3, 40)
 

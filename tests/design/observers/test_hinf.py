@@ -8,7 +8,7 @@ import pytest
 import scipy.linalg
 from scipy.integrate import quad_vec
 
-from fdikit import FaultModel, linalg
+from fdikit import FaultModel, fault_maps, linalg
 from fdikit.design.observers.beard_jones import beard_jones
 from fdikit.design.observers.detection_gain import detection_gain_family
 from fdikit.design.observers.hinf import enhancement_direction, hinf_detection_filter
@@ -77,7 +77,7 @@ def test_family_keeps_every_detection_space_invariant(seed):
     A, C = rng.standard_normal((n, n)), rng.standard_normal((p, n))
     hidden = linalg.null(C)[:, [0]]  # C f = 0: detection space [f, A f]
     model = FaultModel(A, C, Bu=rng.standard_normal((n, 1)), outputs=["a", "b", "c", "d"])
-    fam = detection_gain_family(model, {"hidden": hidden, "a_sensor": linalg.sensor_fault_map(model, "a"),
+    fam = detection_gain_family(model, {"hidden": hidden, "a_sensor": fault_maps.sensor_fault_map(model, "a"),
                                         "plain": rng.standard_normal((n, 1))})
     assert {k: W.shape[1] for k, W in fam.spaces.items()} == {"hidden": 2, "a_sensor": 2, "plain": 1}
     assert fam.row_bases["hidden"].shape == (2, 1) and np.allclose(fam.row_bases["a_sensor"], np.eye(2))
@@ -189,7 +189,7 @@ def test_residual_directions_are_decoupled(plant, corrected):
 
 def test_column_signs_do_not_change_the_filter(plant, corrected):
     """Flipping fault columns flips residual signs only: Y, L and the poles are unchanged."""
-    F = linalg.resolve_fault(plant, AZ)[0] * [-1.0, 1.0]
+    F = fault_maps.resolve_fault(plant, AZ)[0] * [-1.0, 1.0]
     d = hinf_detection_filter(plant, {AZ: F, DELTA: -plant.Bu}, gamma=1.2)
     np.testing.assert_allclose(d.gain, corrected.gain, rtol=1e-7, atol=1e-9 * np.abs(corrected.gain).max())
     np.testing.assert_allclose(np.sort(d.poles.real), np.sort(corrected.poles.real), rtol=1e-7)
@@ -221,7 +221,7 @@ def test_bad_input_is_rejected(plant):
 def test_enhancement_direction_matches_the_report(plant, printed):
     """App. C.5: q = [−0.126, −0.992] for the A_z residual.  In the coordinates of the printed F_Az columns
     (F¹ ∝ +e_4) we get ±[0.068, 0.998]: |cos| = 0.9986 (3.3°)."""
-    F = linalg.resolve_fault(plant, AZ)[0] * [-1.0, 1.0]  # positive multiples of the printed columns
+    F = fault_maps.resolve_fault(plant, AZ)[0] * [-1.0, 1.0]  # positive multiples of the printed columns
     d = hinf_detection_filter(plant, {AZ: F, DELTA: plant.Bu}, gamma=1.2, form="printed")
     np.testing.assert_allclose(np.sort(d.poles.real), np.sort(printed.poles.real), rtol=1e-7)
     e = enhancement_direction(d, AZ)

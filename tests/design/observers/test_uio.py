@@ -16,8 +16,9 @@ import scipy.linalg
 from fdikit import DesignError, FaultModel, ModelError, ParameterError
 from fdikit.design.observers.full_order import observer_generator
 from fdikit.design.observers.uio import uio, uio_bank, unknown_input_matrix
+from fdikit.fault_maps import sensor_fault_map
 from fdikit.faults import Bias, Drift, FaultScenario
-from fdikit.linalg import invariant_zeros, rank, sensor_fault_map
+from fdikit.linalg import invariant_zeros, rank
 from fdikit.plants import path_vehicle_14
 from fdikit.residuals import stack_generators
 from fdikit.simulate import simulate
@@ -126,7 +127,7 @@ def test_unknown_input_directions():
     m = _random_model(5)
     E, where = unknown_input_matrix(m, ["y6_sensor", "u0_actuator"])
     assert where == {"y6_sensor": slice(0, 2), "u0_actuator": slice(2, 4), "gust": slice(4, 5)}
-    # a pure sensor fault is linalg.sensor_fault_map's [F1, A F1]
+    # a pure sensor fault is fault_maps.sensor_fault_map's [F1, A F1]
     np.testing.assert_allclose(E[:, :2], sensor_fault_map(m, "y6"), atol=1e-13)
     # Bf and Df both nonzero: [F1, A F1 − b] with C F1 = Df column
     b, dcol = m.Bf[:, 0], m.Df[:, 0]

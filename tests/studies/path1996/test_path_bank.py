@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from fdikit.decision import ThresholdEvaluator
+from fdikit.fault_maps import sensor_fault_map
 from fdikit.faults import Bias, FaultScenario
-from fdikit.linalg import sensor_fault_map
 from fdikit.metrics import score
 from fdikit.model import sensor_fault_name
 from fdikit.plants import path_vehicle_12, path_vehicle_14

@@ -224,7 +224,7 @@ def game_filter(
     Parameters
     ----------
     model : FaultModel, continuous (steady-state design) or discrete (Murray Ch. 5, above).
-    targets : target faults (fault names resolved by :func:`fdikit.linalg.resolve_faults`, or a
+    targets : target faults (fault names resolved by :func:`fdikit.fault_maps.resolve_faults`, or a
         mapping name → F); ``F̂_i`` = the other targets plus the ``nuisance`` faults.
     nuisance : faults every residual must block: ``()`` (default) none, ``'others'`` every fault
         input of the model that is not a target, or names / a mapping name → F.

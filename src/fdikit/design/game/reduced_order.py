@@ -149,7 +149,7 @@ def goh_filter(
     Parameters
     ----------
     model : continuous FaultModel.
-    targets : fault names (resolved by :func:`fdikit.linalg.resolve_faults`: ``'<output>_sensor'``,
+    targets : fault names (resolved by :func:`fdikit.fault_maps.resolve_faults`: ``'<output>_sensor'``,
         ``'<control>_actuator'``, fault inputs of the model) or a mapping name → F.
     nuisance : faults blocked from every residual (names or mapping; ``()`` none, ``'others'`` every
         fault input of the model that is not a target).
@@ -174,7 +174,7 @@ def goh_filter(
     --------
     F-16XL (Murray 2012, §6.1.2): three targets, no nuisance, four states — no complementary subspace.
 
-    >>> from fdikit.linalg import resolve_faults
+    >>> from fdikit.fault_maps import resolve_faults
     >>> from fdikit.plants.f16xl import f16xl_longitudinal
     >>> m = f16xl_longitudinal()
     >>> faults = resolve_faults(m, ["y_theta_sensor", "elevon_actuator"]) | {"gust": m.Bd}

@@ -20,7 +20,7 @@ import numpy as np
 
 from fdikit import linalg, validate
 from fdikit.errors import DesignError, ParameterError
-from fdikit.linalg import resolve_faults, resolve_nuisance
+from fdikit.fault_maps import resolve_faults, resolve_nuisance
 from fdikit.model import FaultModel
 
 __all__ = ["GameProblem", "game_problem", "per_target", "weight"]
@@ -193,13 +193,13 @@ def game_problem(
     model : FaultModel
         The plant (continuous or discrete; only ``A`` and ``C`` are used).
     targets : fault name, sequence of fault names, or mapping name → F
-        The faults to detect.  Names are resolved by :func:`fdikit.linalg.resolve_faults`
+        The faults to detect.  Names are resolved by :func:`fdikit.fault_maps.resolve_faults`
         (``'<output>_sensor'`` is the sensor fault ``[F¹, A F¹]``, ``'<control>_actuator'`` an
         actuator fault, a fault input of the model its column); a mapping gives explicit n x k
         maps.  A bare signal name raises :class:`ParameterError`.
     nuisance : as ``targets``, or ``'others'``
         The faults to block: ``()`` (default) none, ``'others'`` every fault input of the model
-        that is not a target (:func:`fdikit.linalg.resolve_nuisance`).
+        that is not a target (:func:`fdikit.fault_maps.resolve_nuisance`).
     rtol : float, optional
         Relative rank tolerance of the subspace computations.
 

@@ -31,7 +31,7 @@ from fdikit.design.game.riccati import checked_gamma, require_continuous, solve_
 from fdikit.design.game.setup import GameProblem, game_problem, per_target, weight
 from fdikit.design.observers.full_order import observer_generator
 from fdikit.errors import DesignError, ParameterError
-from fdikit.linalg import resolve_nuisance
+from fdikit.fault_maps import resolve_nuisance
 from fdikit.model import FaultModel
 from fdikit.protocols import joined_form
 from fdikit.residuals import ResidualGenerator, stack_generators
@@ -185,7 +185,7 @@ def single_fault_game_filter(
     Parameters
     ----------
     model : FaultModel, continuous (steady-state design) or discrete (Murray Ch. 5, above).
-    targets : the one fault to detect — a fault name resolved by :func:`fdikit.linalg.resolve_faults`
+    targets : the one fault to detect — a fault name resolved by :func:`fdikit.fault_maps.resolve_faults`
         (``'<output>_sensor'`` = sensor fault ``[F¹, A F¹]``, ``'<control>_actuator'`` = actuator fault,
         a fault input of the model), a one-element sequence of it, or a mapping ``{name: F}``.
     nuisance : faults to block (names or mapping), forming ``F̂``: ``()`` (default) none, ``'others'``
@@ -353,7 +353,7 @@ def game_filter_bank(
     model : FaultModel
         The plant, continuous.
     targets : sequence of str or mapping name → (n, k) array
-        The faults, one filter each (fault names resolved by :func:`fdikit.linalg.resolve_faults`).
+        The faults, one filter each (fault names resolved by :func:`fdikit.fault_maps.resolve_faults`).
     nuisance : sequence of str, mapping or ``'others'``
         Faults every filter blocks besides the other targets: ``()`` (default) none.
     gamma : float

@@ -52,7 +52,7 @@ import scipy.linalg
 from fdikit import linalg, lti, validate
 from fdikit.design.observers.full_order import observer_generator
 from fdikit.errors import DesignError, ParameterError
-from fdikit.linalg import resolve_faults
+from fdikit.fault_maps import resolve_faults
 from fdikit.model import FaultModel
 from fdikit.protocols import joined_form
 from fdikit.residuals import ResidualGenerator, stack_generators

@@ -29,7 +29,7 @@ import scipy.linalg
 
 from fdikit import linalg
 from fdikit.errors import DesignError, ModelError, ParameterError
-from fdikit.linalg import resolve_faults
+from fdikit.fault_maps import resolve_faults
 from fdikit.model import FaultModel
 
 __all__ = ["DetectionGainFamily", "detection_gain_family"]
@@ -145,7 +145,7 @@ def detection_gain_family(
     Parameters
     ----------
     model : FaultModel (continuous; only ``A`` and ``C`` are used).
-    targets : fault names resolved by :func:`fdikit.linalg.resolve_faults` (``'<output>_sensor'`` is
+    targets : fault names resolved by :func:`fdikit.fault_maps.resolve_faults` (``'<output>_sensor'`` is
         the sensor fault ``[F¹, A F¹]`` with ``C F¹ = e_i``, ``'<control>_actuator'`` a column of ``Bu``),
         or a mapping name → fault map ``F``.
     rtol : relative rank tolerance of the subspace computations (default ``None``: fdikit.linalg's default).

@@ -27,7 +27,7 @@ Unknown-input directions ``E`` (:func:`unknown_input_matrix`):
       x̄[k+1] = A x̄[k] + Bu u[k] + (b − A F¹) μ[k] + F¹ μ[k+1]   (discrete),
 
   a state fault with the two directions ``[F¹, A F¹ − b]`` — for ``b = 0`` exactly
-  :func:`fdikit.linalg.sensor_fault_map`'s ``[F¹, A F¹]`` (Douglas et al. 1996, eq. (3.4);
+  :func:`fdikit.fault_maps.sensor_fault_map`'s ``[F¹, A F¹]`` (Douglas et al. 1996, eq. (3.4);
   Murray 2012, (2.3)/(2.17)).  ``μ`` and ``μ'`` are decoupled as two independent inputs;
   the transfer from ``μ`` to ``r`` is then zero for any signal, differentiable or not.
   ``d`` must lie in the range of ``C`` (:class:`DesignError` otherwise);
@@ -57,7 +57,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg
 
-from fdikit import linalg, lti, validate
+from fdikit import fault_maps, linalg, lti, validate
 from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import joined_form
@@ -362,7 +362,7 @@ def uio(
 
     if not isinstance(model, FaultModel):
         raise ParameterError(f"uio needs a FaultModel, got {type(model).__name__}")
-    given = linalg.check_fault_inputs(model, targets, "target")
+    given = fault_maps.check_fault_inputs(model, targets, "target")
     if len(given) != 1:
         raise ParameterError(f"uio detects one target fault, got {list(given)}; use uio_bank for several")
     target = given[0]
@@ -372,7 +372,7 @@ def uio(
     if isinstance(nuisance, str) and nuisance == "others":
         nuisance = tuple(f for f in model.faults if f != target)
     else:
-        nuisance = tuple(dict.fromkeys(linalg.check_fault_inputs(model, nuisance, "nuisance")))
+        nuisance = tuple(dict.fromkeys(fault_maps.check_fault_inputs(model, nuisance, "nuisance")))
         if target in nuisance:
             raise ParameterError(f"the target {target!r} is also listed as a nuisance fault; remove it from nuisance")
     A, C, Bu, Du = model.A, model.C, model.Bu, model.Du
@@ -545,14 +545,14 @@ def uio_bank(
     ----------
     Murray 2012, §1.1.1, Remark 2.4.
     """
-    faults = model.faults if targets is None else linalg.check_fault_inputs(model, targets, "target")
+    faults = model.faults if targets is None else fault_maps.check_fault_inputs(model, targets, "target")
     if not faults:
         raise ModelError("uio_bank needs at least one fault; the model has none (add faults with with_*_faults)")
     if nuisance is None:
         raise ParameterError("nuisance=None is not a fault set; use () for none or 'others' for every other fault")
     if isinstance(nuisance, str) and nuisance == "others":
         nuisance = model.faults
-    extra = tuple(f for f in linalg.check_fault_inputs(model, nuisance, "nuisance") if f not in faults)
+    extra = tuple(f for f in fault_maps.check_fault_inputs(model, nuisance, "nuisance") if f not in faults)
     bank = []
     for f in faults:
         try:

@@ -41,7 +41,7 @@ import numpy as np
 from fdikit import validate
 from fdikit.design.observers.beard_jones import BeardJonesDesign, beard_jones
 from fdikit.errors import DesignError, ParameterError
-from fdikit.linalg import resolve_faults
+from fdikit.fault_maps import resolve_faults
 from fdikit.model import FaultModel, actuator_fault_name, sensor_fault_name
 from fdikit.plants.path_vehicle import path_vehicle_12, path_vehicle_14
 from fdikit.residuals import ResidualGenerator, stack_generators
