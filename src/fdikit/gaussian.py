@@ -87,17 +87,17 @@ class LinearGaussianModel:
     name: str = ""
 
     def __init__(self, A, C, Q, R, B=None, D=None, name: str = "") -> None:
-        A = validate.as_sized_matrix("A", A, error=ModelError)
+        A = validate.as_matrix("A", A, error=ModelError, promote=True)
         n = A.shape[0]
         if A.shape != (n, n):
             raise ModelError(f"A must be square, got shape {A.shape}")
-        C = validate.as_sized_matrix("C", C, cols=n, error=ModelError)
+        C = validate.as_matrix("C", C, (None, n), error=ModelError, promote=True)
         p = C.shape[0]
-        B = np.zeros((n, 0)) if B is None else validate.as_sized_matrix("B", B, rows=n, error=ModelError)
+        B = np.zeros((n, 0)) if B is None else validate.as_matrix("B", B, (n, None), error=ModelError, promote=True)
         D = (np.zeros((p, B.shape[1])) if D is None
-             else validate.as_sized_matrix("D", D, p, B.shape[1], error=ModelError))
-        Q = validate.psd_part("Q", validate.as_sized_matrix("Q", Q, n, n, error=ModelError), error=ModelError)
-        R = validate.psd_part("R", validate.as_sized_matrix("R", R, p, p, error=ModelError), error=ModelError)
+             else validate.as_matrix("D", D, (p, B.shape[1]), error=ModelError, promote=True))
+        Q = validate.psd_part("Q", validate.as_matrix("Q", Q, (n, n), error=ModelError, promote=True), error=ModelError)
+        R = validate.psd_part("R", validate.as_matrix("R", R, (p, p), error=ModelError, promote=True), error=ModelError)
         if p and np.linalg.eigvalsh(R)[0] <= 1e-14 * max(1.0, float(np.max(np.abs(R)))):
             raise ModelError("R must be positive definite (the innovation covariance must be invertible)")
         object.__setattr__(self, "name", str(name))
@@ -176,8 +176,8 @@ class NonlinearGaussianModel:
     h_jacobian: Fun | None = None
 
     def __post_init__(self) -> None:
-        Q = validate.as_sized_matrix("Q", self.Q, error=ModelError)
-        R = validate.as_sized_matrix("R", self.R, error=ModelError)
+        Q = validate.as_matrix("Q", self.Q, error=ModelError, promote=True)
+        R = validate.as_matrix("R", self.R, error=ModelError, promote=True)
         object.__setattr__(self, "Q", validate.psd_part("Q", Q, error=ModelError))
         object.__setattr__(self, "R", validate.psd_part("R", R, error=ModelError))
         if not callable(self.f) or not callable(self.h):

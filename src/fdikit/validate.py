@@ -167,12 +167,13 @@ def as_covariance(
     scalar_ok: bool = True,
     diagonal_ok: bool = False,
     rtol: float = 1e-12,
+    psd_rtol: float | None = None,
 ) -> np.ndarray:
     """A symmetric positive semidefinite (``definite``: positive definite) ``n x n`` matrix.
 
     A scalar means ``value · I``; with ``diagonal_ok`` a vector of ``n`` variances means their
     diagonal matrix.  Symmetry and the eigenvalue test use a tolerance ``rtol`` relative to the
-    largest entry.  Returns the symmetric part.
+    largest entry (``psd_rtol``, when given, for the eigenvalues).  Returns the symmetric part.
     """
     raw = as_array(name, value, error=error)
     if scalar_ok and raw.size == 1 and raw.ndim <= 2:
@@ -195,7 +196,7 @@ def as_covariance(
             raise error(
                 f"{name} must be positive definite (smallest eigenvalue {low:.3g}); add a small positive diagonal"
             )
-        if low < -rtol * scale:
+        if low < -(rtol if psd_rtol is None else psd_rtol) * scale:
             raise error(f"{name} must be positive semidefinite (smallest eigenvalue {low:.3g}); "
                         "a covariance has non-negative eigenvalues")
     return out
@@ -316,44 +317,9 @@ def instance(name: str, value, cls: type | tuple[type, ...], hint: str = "", *,
     return value
 
 
-def as_sized_matrix(name: str, value, rows: int | None = None, cols: int | None = None, *,
-                    error: type[Exception] = ParameterError) -> np.ndarray:
-    """A finite 2-D matrix with ``rows`` rows and ``cols`` columns (each checked when given); a scalar or vector is
-    promoted to a 2-D matrix (``np.atleast_2d``)."""
-    out = np.atleast_2d(as_array(name, value, error=error, finite=False))
-    if out.ndim != 2:
-        raise error(f"{name} must be a 2-D matrix, got an array with {out.ndim} dimensions")
-    if rows is not None and out.shape[0] != rows:
-        raise error(f"{name} has shape {out.shape} but must have {rows} rows; give a {rows} x {cols} matrix")
-    if cols is not None and out.shape[1] != cols:
-        raise error(f"{name} has shape {out.shape} but must have {cols} columns; give a {rows} x {cols} matrix")
-    if not np.all(np.isfinite(out)):
-        raise error(f"{name} has a non-finite entry; every entry must be a finite number")
-    return out
-
-
-def as_sized_vector(name: str, value, size: int, *, error: type[Exception] = ParameterError,
-                    finite: bool = False) -> np.ndarray:
-    """Any array of exactly ``size`` entries, flattened to a vector (non-finite entries allowed unless ``finite``)."""
-    out = as_array(name, value, error=error, finite=finite).reshape(-1)
-    if out.size != size:
-        raise error(f"{name} has {out.size} entries but must have {size}; pass a vector of length {size}")
-    return out
-
-
-def psd_part(name: str, M: np.ndarray, *, error: type[Exception] = ParameterError) -> np.ndarray:
-    """Symmetric part of ``M`` after checking symmetry and positive semi-definiteness."""
-    scale = max(1.0, float(np.max(np.abs(M)))) if M.size else 1.0
-    if M.shape[0] != M.shape[1]:
-        raise error(f"{name} must be square, got shape {M.shape}")
-    if np.max(np.abs(M - M.T), initial=0.0) > 1e-8 * scale:
-        raise error(f"{name} is not symmetric; pass a symmetric covariance matrix (e.g. (M + M.T) / 2)")
-    Ms = 0.5 * (M + M.T)
-    if M.size:
-        lam = float(np.linalg.eigvalsh(Ms)[0])
-        if lam < -1e-10 * scale:
-            raise error(
-                f"{name} is not positive semi-definite (smallest eigenvalue {lam:.3g}); "
-                "a covariance matrix must have non-negative eigenvalues"
-            )
-    return Ms
+def psd_part(name: str, M, *, error: type[Exception] = ParameterError) -> np.ndarray:
+    """Symmetric part of the square covariance ``M``: :func:`as_covariance` with the tolerances of the Kalman
+    steps (symmetry to 1e-8, eigenvalues to −1e-10 of the largest entry)."""
+    M = as_array(name, M, error=error)
+    return as_covariance(name, M, M.shape[0] if M.ndim else 1, error=error, scalar_ok=False, rtol=1e-8,
+                         psd_rtol=1e-10)

@@ -234,15 +234,15 @@ def test_discrete_fault_model_input(case):
 
 def test_bad_input_errors(case):
     model, x0, P0, u, y = case
-    with pytest.raises(ModelError, match="Q is not positive semi-definite"):
+    with pytest.raises(ModelError, match="Q must be positive semidefinite"):
         LinearGaussianModel(model.A, model.C, Q=-np.eye(4), R=model.R)
-    with pytest.raises(ModelError, match="R is not symmetric"):
+    with pytest.raises(ModelError, match="R must be symmetric"):
         LinearGaussianModel(model.A, model.C, Q=model.Q, R=[[1.0, 0.5], [0.0, 1.0]])
     with pytest.raises(ModelError, match="R must be positive definite"):
         LinearGaussianModel(model.A, model.C, Q=model.Q, R=np.zeros((2, 2)))
-    with pytest.raises(ModelError, match="C has shape"):
+    with pytest.raises(ModelError, match=r"C has 3 columns but must have 4 \(shape \(2, 3\)\)"):
         LinearGaussianModel(model.A, np.ones((2, 3)), Q=model.Q, R=model.R)
-    with pytest.raises(ParameterError, match="P0 is not positive semi-definite"):
+    with pytest.raises(ParameterError, match="P0 must be positive semidefinite"):
         KalmanFilter(model, x0, -P0)
     with pytest.raises(ParameterError, match="x0 has 3 entries"):
         KalmanFilter(model, x0[:3], P0)
@@ -252,7 +252,7 @@ def test_bad_input_errors(case):
         kalman_filter(model, u[:10], y, x0, P0)
     with pytest.raises(ParameterError, match="form must be"):
         KalmanFilter(model, x0, P0, form="information")
-    with pytest.raises(ModelError, match="Q is not positive semi-definite"):
+    with pytest.raises(ModelError, match="Q must be positive semidefinite"):
         NonlinearGaussianModel(f=lambda x, u: x, h=lambda x, u: x, Q=[[-1.0]], R=[[1.0]])
 
 

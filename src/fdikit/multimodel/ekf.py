@@ -243,15 +243,15 @@ class ExtendedKalmanFilter:
         if not isinstance(model, NonlinearGaussianModel):
             raise ParameterError(f"model must be a NonlinearGaussianModel, got {type(model).__name__}")
         self.model = model
-        self.x = validate.as_sized_vector("x0", x0, model.n, error=ParameterError, finite=True)
-        P0 = validate.as_sized_matrix("P0", P0, model.n, model.n, error=ParameterError)
+        self.x = validate.as_vector("x0", x0, model.n, error=ParameterError)
+        P0 = validate.as_matrix("P0", P0, (model.n, model.n), error=ParameterError, promote=True)
         self.P = validate.psd_part("P0", P0, error=ParameterError)
 
     def step(self, u, y) -> KalmanStep:
         """Update with ``y(k)`` (skipped if it has a NaN), then predict with ``u(k)``."""
         m = self.model
-        u = validate.as_sized_vector("u", np.zeros(0) if u is None else u, m.n_inputs, error=DataError)
-        y = validate.as_sized_vector("y", y, m.p, error=DataError)
+        u = validate.as_vector("u", np.zeros(0) if u is None else u, m.n_inputs, error=DataError, finite=False)
+        y = validate.as_vector("y", y, m.p, error=DataError, finite=False)
         if not np.all(np.isfinite(u)):
             raise DataError("u has a NaN/inf entry; the time update needs every input (fill or drop the sample)")
         valid = bool(np.all(np.isfinite(y)))

@@ -217,8 +217,8 @@ class KalmanFilter:
         self.model = _as_model(model, Q, R)
         n = self.model.n
         self.form = form
-        self.x = validate.as_sized_vector("x0", x0, n, error=ParameterError, finite=True)
-        P0 = validate.as_sized_matrix("P0", P0, n, n, error=ParameterError)
+        self.x = validate.as_vector("x0", x0, n, error=ParameterError)
+        P0 = validate.as_matrix("P0", P0, (n, n), error=ParameterError, promote=True)
         P0 = validate.psd_part("P0", P0, error=ParameterError)
         self.P = P0
         self._S = psd_sqrt(P0, "P0")
@@ -235,8 +235,8 @@ class KalmanFilter:
     def step(self, u, y) -> KalmanStep:
         """Update with ``y(k)``, predict with ``u(k)``; returns the :class:`KalmanStep`."""
         m = self.model
-        u = validate.as_sized_vector("u", np.zeros(0) if u is None else u, m.m, error=DataError)
-        y = validate.as_sized_vector("y", y, m.p, error=DataError)
+        u = validate.as_vector("u", np.zeros(0) if u is None else u, m.m, error=DataError, finite=False)
+        y = validate.as_vector("y", y, m.p, error=DataError, finite=False)
         if not np.all(np.isfinite(u)):
             raise DataError("u has a NaN/inf entry; the time update needs every input (fill or drop the sample)")
         valid = bool(np.all(np.isfinite(y)))

@@ -74,7 +74,7 @@ def psd_sqrt(M, name: str = "covariance") -> np.ndarray:
     ----------
     Hallouzi 2008, §2.3.2, (2.25)–(2.26): the factors ``S`` with ``S Sᵀ = P`` of the square-root filter.
     """
-    M = validate.psd_part(name, validate.as_sized_matrix(name, M, error=ModelError), error=ModelError)
+    M = validate.psd_part(name, validate.as_matrix(name, M, error=ModelError, promote=True), error=ModelError)
     try:
         return np.linalg.cholesky(M)
     except np.linalg.LinAlgError:
