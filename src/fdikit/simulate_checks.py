@@ -161,7 +161,25 @@ def check_signal(name: str, value, t: np.ndarray, names: Sequence[str]) -> np.nd
 def check_noise(std_name: str, std, cov_name: str, cov, k: int, what: str) -> np.ndarray | None:
     """Covariance of ``k`` noise signals from ``std`` (standard deviations) or ``cov`` (a covariance), or None.
 
-    :func:`fdikit.validate.noise_covariance` (the std/cov convention), after refusing noise for no signal.
+    Parameters
+    ----------
+    std_name, std, cov_name, cov, k, what :
+        As for :func:`fdikit.validate.noise_covariance` (the std/cov convention), which does the check.
+
+    Returns
+    -------
+    (k, k) ndarray or None
+
+    Raises
+    ------
+    ParameterError
+        Noise given for no signal (``k == 0``: the model has no noise inputs), or as
+        :func:`fdikit.validate.noise_covariance`.
+
+    Examples
+    --------
+    >>> check_noise("noise_std", 0.5, "noise_cov", None, 2, "state").tolist()
+    [[0.25, 0.0], [0.0, 0.25]]
     """
     if (std is not None or cov is not None) and k == 0:
         name = std_name if std is not None else cov_name

@@ -206,10 +206,42 @@ def noise_covariance(std_name: str, std, cov_name: str, cov, k: int, what: str =
                      error: type[Exception] = ParameterError) -> np.ndarray | None:
     """The ``k x k`` covariance of ``k`` noise signals given either as a standard deviation or as a covariance.
 
-    The std/cov convention of ``docs/ARCHITECTURE.md``: ``std`` is a standard deviation σ (a scalar, or one per
-    signal, each >= 0) and gives ``diag(σ²)``; ``cov`` is a covariance (a ``k x k`` symmetric positive
-    semidefinite matrix, or a scalar/vector of variances meaning ``σ² I`` / ``diag``).  Giving both is an error;
-    giving neither returns None.  A std of ``s`` and a cov of ``s**2`` give the same matrix, bit for bit.
+    The std/cov convention of ``docs/ARCHITECTURE.md``.  A std of ``s`` and a cov of ``s**2`` give the
+    same matrix, bit for bit.
+
+    Parameters
+    ----------
+    std_name, cov_name : str
+        The two parameter names, as the messages quote them (``"noise_std"``, ``"noise_cov"``).
+    std : float, (k,) array_like or None
+        Standard deviations σ (a scalar for every signal, or one per signal), finite and >= 0.
+    cov : float, (k,) or (k, k) array_like or None
+        A covariance: a variance for every signal (``σ² I``), ``k`` variances (``diag``) or a
+        symmetric positive semidefinite ``k x k`` matrix.
+    k : int
+        Number of noise signals.
+    what : str, default "signal"
+        What one signal is, for the messages ("output", "state" ...).
+    error : exception class, default ParameterError
+
+    Returns
+    -------
+    (k, k) ndarray or None
+        The covariance, or None when neither is given.
+
+    Raises
+    ------
+    ParameterError
+        (or ``error``) When both are given, or the one given is not finite, of the wrong size or shape,
+        negative, asymmetric or not positive semidefinite.
+
+    Examples
+    --------
+    >>> from fdikit.validate import noise_covariance
+    >>> noise_covariance("v_std", [0.1, 0.2], "v_cov", None, 2).round(3).tolist()
+    [[0.01, 0.0], [0.0, 0.04]]
+    >>> noise_covariance("v_std", None, "v_cov", 0.01, 2).tolist()
+    [[0.01, 0.0], [0.0, 0.01]]
     """
     if std is not None and cov is not None:
         raise error(f"give {std_name} or {cov_name}, not both: {std_name} is a standard deviation σ (a scalar or one "
