@@ -69,7 +69,7 @@ class LTVModel:
         ``eps/step^j`` of accuracy at order ``j``: supply derivatives when ``β ≥ 2``.
     controls, outputs : tuple of str
         Names of the columns of ``u`` and ``y`` (for
-        :meth:`fdikit.design.game.time_varying.LTVDetectionFilter.run_trace`).
+        :meth:`fdikit.design.game.ltv_filter.LTVDetectionFilter.run_trace`).
     constant : bool
         The matrices do not depend on time (set by :meth:`from_lti`; the geometry is then
         computed once).

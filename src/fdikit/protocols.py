@@ -33,7 +33,7 @@ class DesignResult(Protocol):
         The filter reading the model's named controls and outputs.  Parameter-varying and
         time-varying designs hold their own generator types instead
         (:class:`~fdikit.design.parity.scheduled.ScheduledResidualGenerator`,
-        :class:`~fdikit.design.game.time_varying.LTVDetectionFilter`, or the scheduled design itself),
+        :class:`~fdikit.design.game.ltv_filter.LTVDetectionFilter`, or the scheduled design itself),
         each with its own ``run``.
 
     Examples

@@ -12,7 +12,7 @@ Excluded, because their generator is not an observer ``A − L C`` of the model 
   the state matrix ``N = T A − K1 C`` (``T = I − H C``); there is no ``gain`` — ``K1``, ``K = K1 + N H`` and
   ``H`` are reported under the UIO's own names (Chen & Patton 1999).
 * ``ltv_game_filter`` / ``ltv_detection_filter``: time-varying; the filter is an
-  :class:`~fdikit.design.game.time_varying.LTVDetectionFilter` (its own runner integrates
+  :class:`~fdikit.design.game.ltv_filter.LTVDetectionFilter` (its own runner integrates
   ``A(t) − L(t) C(t)``), not an LTI :class:`~fdikit.residuals.ResidualGenerator`; ``gain`` is a function of t.
 * the parity designs (``fdikit.design.parity``) have no observer gain.
 

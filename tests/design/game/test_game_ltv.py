@@ -21,8 +21,9 @@ from scipy.optimize import brentq
 
 from fdikit import FaultModel
 from fdikit.design import restricted_diagonal
+from fdikit.design.game.ltv_filter import ltv_detection_filter
 from fdikit.design.game.setup import game_problem
-from fdikit.design.game.time_varying import ltv_detection_filter, ltv_feasibility, ltv_game_filter
+from fdikit.design.game.time_varying import ltv_feasibility, ltv_game_filter
 from fdikit.design.observers.full_order import observer_generator
 from fdikit.errors import DataError, DesignError, ModelError, ParameterError
 from fdikit.ltv import LTVModel, invariant_generators, ltv_projector

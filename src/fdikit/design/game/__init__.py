@@ -13,6 +13,8 @@ discrete and time-varying filters, and the γ → 0 limit (Goh transformation, r
   (Murray 2012, Ch. 5): setup, DARI propagation, secondary cost, gain formula (5.41), residual generator.
 * :mod:`fdikit.design.game.discrete` — Discrete-time game-theoretic detection filters: DGTFDF and DGTMFDF (Murray
   2012, Ch. 5).
+* :mod:`fdikit.design.game.ltv_filter` — Time-varying detection filter with projected residuals (Murray 2012,
+  (3.7), (3.9)–(3.10)): the runner of the finite-horizon filters.
 * :mod:`fdikit.design.game.time_varying` — Finite-horizon, time-varying game-theoretic detection filters (Murray
   2012, Ch. 3).
 * :mod:`fdikit.design.game.goh` — The γ → 0 limit of the game filter: Goh transformation (Algorithm 4.1) and the Goh
@@ -45,9 +47,11 @@ __getattr__, __dir__, __all__ = lazy.attach(
         "discrete": [
             "DiscreteGtfdfDesign", "DiscreteGtmfdfDesign", "dgtfdf", "dgtmfdf",
         ],
+        "ltv_filter": [
+            "LTVDetectionFilter", "ltv_detection_filter",
+        ],
         "time_varying": [
-            "LTVDetectionFilter", "LTVFeasibility", "LTVGameDesign", "ltv_detection_filter", "ltv_feasibility",
-            "ltv_game_filter",
+            "LTVFeasibility", "LTVGameDesign", "ltv_feasibility", "ltv_game_filter",
         ],
         "goh": [
             "GohRiccatiSolution", "GohTransformation", "goh_riccati", "goh_riccati_rhs", "goh_riccati_transient",

@@ -28,25 +28,23 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
 from scipy.integrate import solve_ivp
 
 from fdikit import validate
+from fdikit.design.game.ltv_filter import LTVDetectionFilter, complements
 from fdikit.design.game.setup import weight
-from fdikit.errors import DataError, DesignError, ModelError, ParameterError
+from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.ltv import LTVModel, MatrixFunction, invariant_generators, ltv_projector
 from fdikit.protocols import no_internal_form
-from fdikit.residuals import Residuals
 
 __all__ = [
-    "LTVDetectionFilter",
     "LTVGameDesign",
     "LTVFeasibility",
-    "ltv_detection_filter",
     "ltv_game_filter",
     "ltv_feasibility",
 ]
@@ -58,160 +56,6 @@ def _check_visible(model: LTVModel, target: str, H: np.ndarray, t: float, rtol: 
     if np.linalg.norm(H @ C @ E) <= 1e-9 * max(np.linalg.norm(C @ E), 1e-300):
         raise DesignError(f"target {target!r} is not output separable from its complementary faults at t = {t:g}: "
                           "Ĥ C W* = 0 (Murray Assumption 3.2); drop a nuisance fault or add a sensor")
-
-
-# ---------------------------------------------------------------------- the filter
-@dataclass(frozen=True, eq=False)
-class LTVDetectionFilter:
-    """Time-varying observer ``x̂' = A x̂ + B u + L(t)(y − C x̂ − D u)`` with projected residuals ``Ĥ_i(t) r``.
-
-    Murray 2012, (3.7) and (3.9).  Attributes: ``model``; ``gain`` ``t -> L(t)`` (n x p);
-    ``complementary`` target -> names of ``F̂_i``; ``gain_batch`` optional ``(N,) times ->
-    (N, n, p)`` gains (used by :meth:`run` when given).
-    """
-
-    model: LTVModel
-    gain: MatrixFunction
-    complementary: dict[str, tuple[str, ...]]
-    rtol: float = 1e-6
-    gain_batch: Callable[[np.ndarray], np.ndarray] | None = None
-    _cache: dict = field(default_factory=dict, repr=False, compare=False)
-
-    def projector(self, target: str, t: float) -> np.ndarray:
-        """``Ĥ_i(t)`` of a target."""
-        return ltv_projector(self.model, self.complementary[target], t, self.rtol)
-
-    def _steps(self, t: np.ndarray, m: int, hold: str):
-        """Step matrices on a grid (cached: several runs on one grid pay once)."""
-        key = (t.tobytes(), m, hold)
-        if key in self._cache:
-            return self._cache[key]
-        model, h = self.model, np.diff(t)
-        mids = t[:-1] + h / 2
-        C0 = model.matrix("C", t[0])
-        p, n = C0.shape
-        B = (lambda s: model.matrix("B", s)) if m else (lambda s: np.zeros((n, 0)))
-        D = (lambda s: model.matrix("D", s)) if (m and model.D is not None) else (lambda s: np.zeros((p, m)))
-        Ls = self.gain_batch(mids) if self.gain_batch is not None else np.array([self.gain(s) for s in mids])
-        q = m + p
-        size = n + q * (2 if hold == "foh" else 1)
-        aug = np.zeros((t.size - 1, size, size))
-        for k, s in enumerate(mids):
-            L, C = Ls[k], model.matrix("C", s)
-            aug[k, :n, :n] = (model.matrix("A", s) - L @ C) * h[k]
-            aug[k, :n, n:n + q] = np.hstack([B(s) - L @ D(s), L]) * h[k]
-            if hold == "foh":
-                aug[k, n:n + q, n + q:] = np.eye(q)
-        E = _expm_batch(aug)
-        Phi, G0 = E[:, :n, :n], E[:, :n, n:n + q]
-        G1 = E[:, :n, n + q:] if hold == "foh" else np.zeros_like(G0)
-        Cs = np.array([model.matrix("C", s) for s in t])
-        Ds = np.array([D(s) for s in t])
-        Hs = {k: np.array([self.projector(k, s) for s in t]) for k in self.complementary}
-        self._cache.clear()
-        self._cache[key] = (Phi, G0 - G1, G1, Cs, Ds, Hs)
-        return self._cache[key]
-
-    def run(self, t, y, u=None, x0=None, hold: str = "foh") -> Residuals:
-        """Projected residuals on sampled data ``(t_k, y_k, u_k)``.
-
-        Each step ``[t_k, t_{k+1}]`` is integrated exactly for inputs interpolated linearly
-        between samples (``hold='foh'``, default) or held (``'zoh'``, as
-        :meth:`ResidualGenerator.run`), with ``A, B, C, L`` frozen at the step midpoint
-        (second order in the time variation).  A high-gain (small γ) filter needs ``'foh'``:
-        a held ``y`` lags by half a sample and leaks ``O(dt)`` into every residual.  Then
-        ``r_k = y_k − C(t_k) x̂_k − D(t_k) u_k`` and the columns ``'<target>:<output>'``
-        hold ``Ĥ_i(t_k) r_k``.  Stable for any gain size.
-        """
-        t, y = np.asarray(t, dtype=float).ravel(), np.atleast_2d(np.asarray(y, dtype=float).T).T
-        C0 = self.model.matrix("C", t[0])
-        m = 0 if self.model.B is None else self.model.matrix("B", t[0]).shape[1]
-        u = np.zeros((t.size, m)) if u is None else np.atleast_2d(np.asarray(u, dtype=float).T).T
-        (N, p), bad = y.shape, [f"hold must be 'foh' or 'zoh', got {hold!r}"] if hold not in ("foh", "zoh") else []
-        if t.size < 2 or np.any(np.diff(t) <= 0) or not np.all(np.isfinite(t)):
-            bad.append("t must be finite and strictly increasing with at least 2 samples")
-        if N != t.size or p != C0.shape[0] or u.shape != (N, m):
-            bad.append(f"y has shape {y.shape} and u {u.shape}; need ({t.size}, {C0.shape[0]}) and ({t.size}, {m}): "
-                       "one row per time, one column per output / control")
-        elif not (np.all(np.isfinite(y)) and np.all(np.isfinite(u))):
-            bad.append("y and u must be finite; clean or interpolate the data")
-        if bad:
-            raise DataError(bad[0])
-        Phi, G0, G1, Cs, Ds, Hs = self._steps(t, m, hold)
-        w = np.hstack([u, y])
-        x = np.zeros((N, C0.shape[1]))
-        x[0] = 0.0 if x0 is None else np.asarray(x0, dtype=float)
-        for k in range(N - 1):
-            x[k + 1] = Phi[k] @ x[k] + G0[k] @ w[k] + G1[k] @ w[k + 1]
-        r = y - np.einsum("kpn,kn->kp", Cs, x) - np.einsum("kpm,km->kp", Ds, u)
-        out_names = self.model.outputs or tuple(f"y{i}" for i in range(p))
-        cols = [np.einsum("kij,kj->ki", Hs[k], r) for k in self.complementary]
-        names = tuple(f"{k}:{o}" for k in self.complementary for o in out_names)
-        isolates = tuple(k for k in self.complementary for _ in out_names)
-        return Residuals(t, np.hstack(cols), names, isolates, meta={"filter": "ltv", "hold": hold})
-
-    def run_trace(self, trace, x0=None) -> Residuals:
-        """:meth:`run` on a :class:`~fdikit.trace.Trace`, reading the model's named controls and outputs."""
-        if not self.model.outputs:
-            raise DataError("the model has no output names; use run(t, y, u)")
-        y = trace.columns("y", self.model.outputs)
-        u = trace.columns("u", self.model.controls) if self.model.controls else None
-        return self.run(trace.t, y, u, x0)
-
-
-def ltv_detection_filter(model: LTVModel, targets: Sequence[str], nuisance: Sequence[str], gain: MatrixFunction,
-                         rtol: float = 1e-6) -> LTVDetectionFilter:
-    """A detection filter with a given gain schedule ``L(t)``; target ``i``'s residual is ``Ĥ_i(t) r``."""
-    return LTVDetectionFilter(model, gain, _complements(model, targets, nuisance), rtol)
-
-
-_PADE13 = (64764752532480000.0, 32382376266240000.0, 7771770303897600.0, 1187353796428800.0, 129060195264000.0,
-           10559470521600.0, 670442572800.0, 33522128640.0, 1323241920.0, 40840800.0, 960960.0, 16380.0, 182.0, 1.0)
-
-
-def _expm_batch(A: np.ndarray) -> np.ndarray:
-    """``expm`` of a stack of small matrices: Padé(13) scaling and squaring (Higham 2005), vectorised.
-
-    Agrees with :func:`scipy.linalg.expm` to ~1e-12 and is 3–10x faster than calling it per step.
-    """
-    b = _PADE13
-    s = np.ceil(np.log2(np.maximum(np.abs(A).sum(axis=-2).max(axis=-1), 1e-300) / 5.371920351148152))
-    s = np.maximum(s, 0).astype(int)
-    A = A / (2.0**s)[:, None, None]
-    eye = np.eye(A.shape[-1])
-    A2 = A @ A
-    A4, A6 = A2 @ A2, A2 @ A2 @ A2
-    U = A @ (A6 @ (b[13] * A6 + b[11] * A4 + b[9] * A2) + b[7] * A6 + b[5] * A4 + b[3] * A2 + b[1] * eye)
-    V = A6 @ (b[12] * A6 + b[10] * A4 + b[8] * A2) + b[6] * A6 + b[4] * A4 + b[2] * A2 + b[0] * eye
-    E = np.linalg.solve(V - U, V + U)
-    for k in range(int(s.max(initial=0))):
-        E[s > k] = E[s > k] @ E[s > k]
-    return E
-
-
-def _complements(model: LTVModel, targets: Sequence[str] | str,
-                 nuisance: Sequence[str] | str) -> dict[str, tuple[str, ...]]:
-    """Complementary faults by target; ``nuisance='others'`` is every other fault of the LTV model."""
-    targets = [targets] if isinstance(targets, str) else [str(k) for k in targets]
-    if nuisance is None:
-        raise ParameterError("nuisance=None is not a fault set; use () for none or 'others' for every other fault")
-    if isinstance(nuisance, str):
-        nuisance = [k for k in model.faults if k not in targets] if nuisance == "others" else [nuisance]
-    nuisance = [str(k) for k in nuisance]
-    if not targets:
-        raise ParameterError("no target fault given; name at least one fault to detect")
-    for k in targets + nuisance:
-        if k not in model.faults:
-            if k in model.outputs or k in model.controls:
-                kind, fault = ("output", f"{k}_sensor") if k in model.outputs else ("control", f"{k}_actuator")
-                what = "sensor" if kind == "output" else "actuator"
-                raise ParameterError(f"{k!r} is an {kind}; its {what} fault is {fault!r}; faults are named by fault "
-                                     f"name, not by signal name (the LTV model has {list(model.faults)})")
-            raise ParameterError(f"no fault named {k!r}; the LTV model has {list(model.faults)}")
-    both = set(targets) & set(nuisance)
-    if both:
-        raise DesignError(f"{sorted(both)} given both as target and as nuisance; each fault is one or the other")
-    return {k: tuple(j for j in targets if j != k) + tuple(nuisance) for k in targets}
 
 
 #: Methods of :func:`scipy.integrate.solve_ivp`.
@@ -321,11 +165,34 @@ def _integrate(rhs, jac, P_start: np.ndarray, t: np.ndarray, scale: float, escap
 class LTVGameDesign:
     """A finite-horizon single-fault game filter (Murray 2012, (3.29)–(3.30), covariance form).
 
+    Made by :func:`ltv_game_filter`; ``poles(k)`` gives the frozen-time eigenvalues of ``A − L C`` at ``t_k``,
+    ``generator`` the filter and ``report()`` the fields as a dict (``internal_form()`` raises: it is time-varying).
+
     Attributes
     ----------
-    filter : the time-varying filter (gain from the dense Riccati solution, projector ``Ĥ(t)``).
-    target : the target fault; t : design grid; covariance : ``P(t_k)`` (N, n, n);
-    gains : ``L(t_k) = P Cᵀ V⁻¹`` (N, n, p); projector : ``Ĥ(t_k)`` (N, p, p); gamma : the bound.
+    filter : LTVDetectionFilter
+        The time-varying filter (gain from the dense Riccati solution, projector ``Ĥ(t)``).
+    target : str
+        The target fault.
+    t : (N,) array
+        The design grid.
+    covariance, gains, projector : (N, n, n), (N, n, p) and (N, p, p) arrays
+        ``P(t_k)``, ``L(t_k) = P Cᵀ V⁻¹`` and ``Ĥ(t_k)`` on the grid.
+    gamma : float
+        The attenuation bound γ.
+
+    Examples
+    --------
+    >>> from fdikit.ltv import LTVModel
+    >>> from fdikit.plants.white_speyer import white_speyer
+    >>> m = LTVModel.from_lti(white_speyer("stable-extra-zero"), ["f1", "f2"])
+    >>> d = ltv_game_filter(m, "f1", ["f2"], np.linspace(0, 1, 3), gamma=1e-2, M=0.05, Q=1e-3)
+    >>> d.target, d.gains.shape, d.covariance.shape, d.projector.shape
+    ('f1', (3, 3, 2), (3, 3, 3), (3, 2, 2))
+
+    References
+    ----------
+    Murray 2012, §3.3, (3.29)–(3.30).
     """
 
     filter: LTVDetectionFilter
@@ -375,21 +242,42 @@ def ltv_game_filter(model: LTVModel, targets: str | Sequence[str], nuisance: Seq
 
     Parameters
     ----------
-    model : LTVModel.
-    targets : the one fault of the model to detect (a fault name or a one-element sequence).
-    nuisance : faults to block: a sequence of fault names, ``()`` none, or ``'others'`` every
-        other fault of the model.
-    t : time grid, ``t[0] = t0`` and ``t[-1] = t1``.
-    gamma : attenuation bound (3.11); M, Q, V, P0 : weights (scalar = multiple of I).
-    rtol, atol, method : ``solve_ivp`` settings.
-    escape : finite escape is declared when ``max|P_ij|`` exceeds ``escape`` times
+    model : LTVModel
+        The plant.
+    targets : str or one-element sequence of str
+        The one fault of the model to detect.
+    nuisance : sequence of str or ``'others'``
+        The faults to block: fault names, ``()`` none, or ``'others'`` every other fault of the model.
+    t : (N,) array
+        Time grid [s], strictly increasing, ``t[0] = t0`` and ``t[-1] = t1``.
+    gamma : float
+        Attenuation bound γ > 0 of (3.11) (small = strong blocking).
+    M, Q, V, P0 : float or array, optional
+        Complementary-fault, projected-output, noise (``V = V̄/γ``) and initial-error weights (a scalar is a
+        multiple of I; defaults 1, 1e-3, 1, 1); ``M`` and ``Q`` may map target -> weight.
+    rtol, atol, method : optional
+        :func:`scipy.integrate.solve_ivp` settings (defaults 1e-8, scaled to ``P0/γ``, ``'BDF'``).
+    escape : float, optional
+        Finite escape is declared when ``max|P_ij|`` exceeds ``escape`` (default 1e4) times
         ``max(1, ‖P0‖/γ, ‖F̂MF̂ᵀ‖(t1 − t0)/γ)``; the time is extrapolated (``P ~ 1/(t_e − t)``).
+    geometry_rtol : float, optional
+        Relative rank tolerance of the projector and separability checks (default 1e-6).
+
+    Returns
+    -------
+    LTVGameDesign
+        The filter with the dense gain ``L(t)``, and ``P``, ``L``, ``Ĥ`` on the grid.
 
     Raises
     ------
     DesignError
-        On finite escape (the time is in the message), bad weights, or a target that is not
-        output separable from the nuisance.
+        On finite escape (the time is in the message), or a target that is not output separable from the
+        nuisance, or a name given both as target and nuisance.
+    ParameterError
+        More than one target, an unknown fault or a bare signal name, γ not positive, bad weights, a bad grid or
+        an unknown integration method.
+    ModelError
+        ``A(t0)`` and ``C(t0)`` of inconsistent sizes.
 
     Examples
     --------
@@ -399,6 +287,12 @@ def ltv_game_filter(model: LTVModel, targets: str | Sequence[str], nuisance: Seq
     >>> d = ltv_game_filter(m, "f1", ["f2"], np.linspace(0, 4, 5), gamma=1e-6, M=0.05, Q=1e-3)
     >>> np.round(np.sort_complex(d.poles()), 2)
     array([-316.27+0.j  ,   -3.53-1.79j,   -3.53+1.79j])
+
+    (Murray 2012, Remark 6.6, prints −3.5305 ± 1.7895j and −316.27 for the steady state.)
+
+    References
+    ----------
+    Murray 2012, §3.1.1, (3.10); §3.3, (3.29)–(3.32); Douglas et al. 1996, §9.1, (9.1); §9.2, (9.17).
     """
     validate.choice("integration method", method, _IVP_METHODS)
     given = [targets] if isinstance(targets, str) else list(targets)
@@ -406,7 +300,7 @@ def ltv_game_filter(model: LTVModel, targets: str | Sequence[str], nuisance: Seq
         raise ParameterError(f"ltv_game_filter detects one target fault, got {given}; check several with "
                              "ltv_feasibility")
     target = str(given[0])
-    comp = _complements(model, [target], nuisance)[target]
+    comp = complements(model, [target], nuisance)[target]
     t = _grid(t)
     for s in (t[0], t[len(t) // 2], t[-1]):
         _check_visible(model, target, ltv_projector(model, comp, s, geometry_rtol), s, geometry_rtol)
@@ -438,10 +332,32 @@ def ltv_game_filter(model: LTVModel, targets: str | Sequence[str], nuisance: Seq
 class LTVFeasibility:
     """Result of the finite-horizon check ``Ψ_i ≤ 0`` for a given gain (Murray 2012, (3.16)–(3.18), (3.32)).
 
+    Made by :func:`ltv_feasibility`; ``all_feasible`` says whether every target's DAP holds.
+
     Attributes
     ----------
-    t : the grid; feasible : target -> bool; escape_time : target -> time of finite escape or None;
-    covariance : target -> ``P_i(t_k)`` up to the escape (K, n, n).
+    t : (N,) array
+        The grid.
+    feasible : dict of str to bool
+        Whether the DAP of each target holds on ``[t0, t1]``.
+    escape_time : dict of str to float or None
+        The time of finite escape [s] by target (None: none on the horizon).
+    covariance : dict of str to (K, n, n) array
+        ``P_i(t_k)`` by target, up to the escape (K ≤ N).
+
+    Examples
+    --------
+    >>> from fdikit.ltv import LTVModel
+    >>> from fdikit.plants.white_speyer import white_speyer
+    >>> m = LTVModel.from_lti(white_speyer(), ["f1", "f2"])
+    >>> L = np.array([[38.179, 40.535], [13.995, 16.317], [2.0, 5.678]])
+    >>> res = ltv_feasibility(m, ["f1", "f2"], [], lambda t: L, [0.0, 0.5], gamma=1.0, M=0.05, Q=0.1, P0=1.0)
+    >>> res.all_feasible, res.escape_time
+    (True, {'f1': None, 'f2': None})
+
+    References
+    ----------
+    Murray 2012, §3.1.2, Problem 3.1; §3.2.1, (3.16)–(3.18); §3.3, (3.32).
     """
 
     t: np.ndarray
@@ -468,7 +384,27 @@ def ltv_feasibility(model: LTVModel, targets: Sequence[str], nuisance: Sequence[
     definite on the horizon is (3.15) = 0 with (3.17) tight and (3.18), so the game cost
     (3.12) is nonpositive (Problem 3.1).  ``M`` and ``Q`` may map target -> weight.  With
     small γ a fixed gain needs a small ``P0`` (``P0 ~ γ``): else the initial error alone
-    breaks the bound.  Settings as :func:`ltv_game_filter`.
+    breaks the bound.
+
+    Parameters
+    ----------
+    model : LTVModel
+        The plant.
+    targets : sequence of str
+        The faults sharing the gain, one DAP each.
+    nuisance : sequence of str or ``'others'``
+        The faults every target blocks besides the other targets: ``()`` none, ``'others'`` every other fault.
+    gain : callable
+        ``t -> L(t)``, the (n, p) gain schedule to check.
+    t : (N,) array
+        Time grid [s], strictly increasing, ``t[0] = t0`` and ``t[-1] = t1``.
+    gamma, M, Q, V, P0, rtol, atol, method, escape, geometry_rtol : optional
+        As in :func:`ltv_game_filter` (``gamma`` is required).
+
+    Returns
+    -------
+    LTVFeasibility
+        Feasibility, escape time and ``P_i(t_k)`` by target.
 
     Examples
     --------
@@ -479,8 +415,12 @@ def ltv_feasibility(model: LTVModel, targets: Sequence[str], nuisance: Sequence[
     >>> res = ltv_feasibility(m, ["f1", "f2"], [], lambda t: L, [0.0, 5.0], gamma=1.0, M=0.05, Q=0.1, P0=1.0)
     >>> res.feasible, round(res.escape_time["f1"], 3)
     ({'f1': False, 'f2': True}, 1.06)
+
+    References
+    ----------
+    Murray 2012, §3.1.2, Problem 3.1; §3.2.1, (3.12), (3.15)–(3.18); §3.3, (3.32).
     """
-    comps = _complements(model, targets, nuisance)
+    comps = complements(model, targets, nuisance)
     t = _grid(t)
     feasible, escapes, covs = {}, {}, {}
     for target, comp in comps.items():
