@@ -186,7 +186,7 @@ def as_covariance(
         raise error(f"{name} must be a {n}x{n} covariance matrix{kinds}; use np.diag(variances) for independent "
                     f"components; got shape {raw.shape}")
     out = as_matrix(name, raw, (n, n), error=error, scalar_ok=scalar_ok)
-    scale = max(1.0, float(np.abs(out).max(initial=0.0)))
+    scale = float(np.abs(out).max(initial=0.0))  # relative to the data: a covariance of 1e-8 rad² is judged as one of 1
     if not np.allclose(out, out.T, rtol=0.0, atol=rtol * scale):
         raise error(f"{name} must be symmetric; pass (M + M.T) / 2 or a diagonal matrix")
     out = (out + out.T) / 2
