@@ -1,7 +1,9 @@
 """Subspaces and the geometry of detection filters.
 
 Orthonormal bases and SVD rank decisions throughout; every tolerance scales with the
-data (``max(shape) · eps · σ_max`` by default, or a caller's relative tolerance).
+data (``1e3 · max(shape) · eps · σ_max`` by default, or a caller's relative tolerance).
+The subspace primitives (``rank``, ``orth``, ``null``, ``intersect``, ``span_sum``,
+``contains``) are defined in :mod:`fdikit.subspaces` and re-exported here.
 The fault maps ``F`` these functions take are built by :mod:`fdikit.fault_maps`.
 
 * the minimal (C, A)-invariant subspace containing ``F`` by CAISA (App. A, Theorem A.1,
@@ -21,6 +23,7 @@ import scipy.linalg
 
 from fdikit import validate
 from fdikit.errors import ParameterError
+from fdikit.subspaces import _EPS, _mat, _rtol, contains, intersect, null, orth, rank, span_sum  # re-exported
 
 __all__ = [
     "output_projector",
@@ -37,19 +40,6 @@ __all__ = [
     "mutually_detectable",
 ]
 
-_EPS = np.finfo(float).eps
-
-
-def _mat(name: str, M) -> np.ndarray:
-    """``M`` as a finite real or complex 2-D array (a vector is one row); ParameterError otherwise."""
-    return validate.as_matrix(name, M, promote=True, complex_ok=True)
-
-
-def _rtol(rtol):
-    if rtol is None:
-        return None
-    return validate.non_negative("rtol", rtol)
-
 
 def _system(A, C, F) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``A`` (n x n), ``C`` (p x n), ``F`` (n x k) as finite float matrices, shapes checked."""
@@ -60,81 +50,49 @@ def _system(A, C, F) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return A, C, F
 
 
-def _tol(M: np.ndarray, s: np.ndarray, rtol: float | None) -> float:
-    smax = s[0] if s.size else 0.0
-    return (rtol if rtol is not None else max(M.shape) * _EPS * 1e3) * max(smax, 0.0)
-
-
-def rank(M: np.ndarray, rtol: float | None = None) -> int:
-    """Numerical rank: singular values above ``rtol · σ_max`` (default ``1e3 · max(shape) · eps``)."""
-    M, rtol = _mat("M", M), _rtol(rtol)
-    if M.size == 0:
-        return 0
-    s = np.linalg.svd(M, compute_uv=False)
-    return int((s > _tol(M, s, rtol)).sum()) if s[0] > 0 else 0
-
-
-def orth(M: np.ndarray, rtol: float | None = None) -> np.ndarray:
-    """Orthonormal basis of the range of ``M`` (n x r)."""
-    M, rtol = _mat("M", M), _rtol(rtol)
-    if M.size == 0:
-        return np.zeros((M.shape[0], 0), dtype=M.dtype)
-    U, s, _ = np.linalg.svd(M, full_matrices=False)
-    r = int((s > _tol(M, s, rtol)).sum()) if s[0] > 0 else 0
-    return U[:, :r]
-
-
-def null(M: np.ndarray, rtol: float | None = None) -> np.ndarray:
-    """Orthonormal basis of the null space of ``M`` (columns)."""
-    M, rtol = _mat("M", M), _rtol(rtol)
-    if M.shape[0] == 0:
-        return np.eye(M.shape[1], dtype=M.dtype)
-    _, s, Vh = np.linalg.svd(M, full_matrices=True)
-    r = int((s > _tol(M, s, rtol)).sum()) if s.size and s[0] > 0 else 0
-    return Vh[r:].conj().T
-
-
-def span_sum(*bases: np.ndarray, rtol: float | None = None) -> np.ndarray:
-    """Orthonormal basis of ``Im U₁ + Im U₂ + …``."""
-    bases = [_mat(f"basis {i}", b) for i, b in enumerate(bases) if np.size(b)]
-    if not bases:
-        raise ParameterError("span_sum needs at least one non-empty basis")
-    rows = {b.shape[0] for b in bases}
-    if len(rows) > 1:
-        raise ParameterError(f"span_sum: the bases have different numbers of rows {sorted(rows)}; "
-                             "every basis must live in the same space")
-    return orth(np.hstack(bases), rtol)
-
-
-def intersect(U: np.ndarray, V: np.ndarray, rtol: float | None = None) -> np.ndarray:
-    """Orthonormal basis of ``Im U ∩ Im V``."""
-    U, V = orth(U, rtol), orth(V, rtol)
-    if U.shape[0] != V.shape[0]:
-        raise ParameterError(f"intersect: U has {U.shape[0]} rows but V has {V.shape[0]}; both bases must live in "
-                             "the same space")
-    if U.shape[1] == 0 or V.shape[1] == 0:
-        return np.zeros((U.shape[0], 0))
-    N = null(np.hstack([U, -V]), rtol)
-    return orth(U @ N[: U.shape[1]], rtol)
-
-
-def contains(U: np.ndarray, x: np.ndarray, rtol: float = 1e-8) -> bool:
-    """Whether every column of ``x`` lies in ``Im U`` (relative residual below ``rtol``)."""
-    Q = orth(U)
-    x = np.asarray(x)
-    x = _mat("x", x.reshape(-1, 1) if x.ndim == 1 else x)
-    if x.shape[0] != Q.shape[0]:
-        raise ParameterError(f"x has {x.shape[0]} rows but U has {Q.shape[0]}; pass vectors of length {Q.shape[0]}")
-    res = x - Q @ (Q.conj().T @ x)
-    return bool(np.linalg.norm(res) <= rtol * max(np.linalg.norm(x), _EPS))
-
-
 # ---------------------------------------------------------------------- geometry
 def caisa(A: np.ndarray, C: np.ndarray, F: np.ndarray, rtol: float | None = None) -> np.ndarray:
     """Minimal (C, A)-invariant subspace containing ``Im F`` (CAISA, Douglas et al. 1996, Thm. A.1).
 
     ``W⁰ = 0``, ``W^{k+1} = Im F + A (W^k ∩ Ker C)``; the sequence is nondecreasing and
     stops within ``n`` steps.  Returns an orthonormal basis.
+
+    Parameters
+    ----------
+    A : array_like
+        (n, n) state matrix.
+    C : array_like
+        (p, n) output matrix (a vector is one row).
+    F : array_like
+        (n, k) fault map (a vector is one column).
+    rtol : float, optional
+        Relative rank tolerance: singular values above ``rtol · σ_max`` count; default
+        ``1e3 · max(shape) · eps``.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, dim W*) orthonormal basis of ``W*``.
+
+    Raises
+    ------
+    ParameterError
+        If ``A`` is not square, ``C`` or ``F`` does not match its n states, a matrix is not finite, or
+        ``rtol`` is negative.
+
+    References
+    ----------
+    Douglas et al. 1996, App. A.3, Theorem A.1 (the report's ``W⁰ = ∅`` read as the zero subspace).
+
+    Examples
+    --------
+    With ``C F₁ ≠ 0`` the subspace is ``Im F₁`` itself:
+
+    >>> from fdikit.plants import white_speyer
+    >>> m = white_speyer()
+    >>> W = caisa(m.A, m.C, m.Bf[:, 0])
+    >>> W.shape, contains(W, m.Bf[:, 0])
+    ((3, 1), True)
     """
     A, C, F = _system(A, C, F)
     rtol = _rtol(rtol)
@@ -169,6 +127,45 @@ def invariant_zeros(
     directions, and Jordan-chain vectors ``(A − zI) x₂ + F η₂ = x₁, C x₂ = 0`` when it is
     defective.  So ``span(directions)`` is always the invariant-zero subspace ``V`` that
     :func:`detection_space` adds to ``W*``.
+
+    Parameters
+    ----------
+    A : array_like
+        (n, n) state matrix.
+    C : array_like
+        (p, n) output matrix (a vector is one row).
+    F : array_like
+        (n, k) fault map (a vector is one column).
+    rtol : float, optional
+        AB08ND's rank-decision tolerance; default ``1e5 · (n + max(p, k)) · eps``.
+
+    Returns
+    -------
+    zeros : numpy.ndarray
+        (ν,) complex array of the finite invariant zeros (imaginary round-off set to zero); empty if none.
+    directions : list of numpy.ndarray
+        One unit (n,) state direction per zero, in the same order (complex for a complex zero).
+
+    Raises
+    ------
+    ParameterError
+        If ``A`` is not square, ``C`` or ``F`` does not match its n states, a matrix is not finite, or
+        ``rtol`` is negative.
+
+    References
+    ----------
+    Murray 2012, §2.1.2, (2.12) (zero and direction); Douglas et al. 1996, §4.1 and App. A.3 (the zero
+    directions ``V``).
+
+    Examples
+    --------
+    The second White–Speyer fault has the zero −3 with direction ``e₁``:
+
+    >>> from fdikit.plants import white_speyer
+    >>> m = white_speyer()
+    >>> z, dirs = invariant_zeros(m.A, m.C, m.Bf[:, 1])
+    >>> np.round(z.real, 6).tolist(), np.round(np.abs(dirs[0]), 6).tolist()
+    ([-3.0], [1.0, 0.0, 0.0])
     """
     from slycot import ab08nd
 
@@ -254,6 +251,43 @@ def detection_space(A: np.ndarray, C: np.ndarray, F: np.ndarray, rtol: float | N
 
     ``W*`` from :func:`caisa`, ``V`` the span of the invariant-zero directions of
     ``(C, A, F)``.  Orthonormal basis (n x ν).
+
+    Parameters
+    ----------
+    A : array_like
+        (n, n) state matrix.
+    C : array_like
+        (p, n) output matrix (a vector is one row).
+    F : array_like
+        (n, k) fault map (a vector is one column).
+    rtol : float, optional
+        Rank tolerance of :func:`caisa` and of the sum (see :func:`rank`); the zeros use
+        :func:`invariant_zeros`' default.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, ν) orthonormal basis of ``T*`` (real: a complex direction contributes its real and imaginary
+        parts).
+
+    Raises
+    ------
+    ParameterError
+        If ``A`` is not square, ``C`` or ``F`` does not match its n states, a matrix is not finite, or
+        ``rtol`` is negative.
+
+    References
+    ----------
+    Douglas et al. 1996, §4.1 and App. A.3 (``T*ᵢ = W*ᵢ ⊕ Vᵢ``).
+
+    Examples
+    --------
+    The zero direction of ``f2`` makes its detection space two-dimensional:
+
+    >>> from fdikit.plants import white_speyer
+    >>> m = white_speyer()
+    >>> caisa(m.A, m.C, m.Bf[:, 1]).shape[1], detection_space(m.A, m.C, m.Bf[:, 1]).shape[1]
+    (1, 2)
     """
     A, C, F = _system(A, C, F)
     W = caisa(A, C, F, rtol)
@@ -268,6 +302,40 @@ def output_separable(
 
     Returns the verdict and the pairs ``(i, j)`` whose images intersect (the faults that
     are "detection equivalent" and cannot be told apart by their residual directions).
+
+    Parameters
+    ----------
+    C : array_like
+        (p, n) output matrix.
+    spaces : sequence of array_like
+        Bases (n, νᵢ) of the subspaces ``Tᵢ`` (e.g. :func:`detection_space` of each fault).
+    rtol : float, optional
+        Relative rank tolerance: singular values above ``rtol · σ_max`` count; default
+        ``1e3 · max(shape) · eps``.
+
+    Returns
+    -------
+    separable : bool
+        True when ``rank [C T₁, …, C T_q]`` is the sum of the ranks of the ``C Tᵢ``.
+    pairs : list of tuple of int
+        The index pairs ``(i, j)``, ``i < j``, whose output images intersect.
+
+    Raises
+    ------
+    ParameterError
+        If a space does not have n rows (the columns of ``C``), or a matrix is not finite.
+
+    References
+    ----------
+    Douglas et al. 1996, §4.1 and App. A.3, (a.7).
+
+    Examples
+    --------
+    >>> from fdikit.plants import white_speyer
+    >>> m = white_speyer()
+    >>> T = [detection_space(m.A, m.C, m.Bf[:, [i]]) for i in range(2)]
+    >>> output_separable(m.C, T)
+    (True, [])
     """
     C = _mat("C", C)
     spaces = [_mat(f"space {i}", T) for i, T in enumerate(spaces)]
@@ -293,6 +361,43 @@ def mutually_detectable(
 
     Returns the verdict, the zeros of ``(C, A, [F₁ … F_q])`` and the union of the zeros of
     each ``(C, A, F_i)``.  The two multisets are matched with a tolerance relative to ‖A‖.
+
+    Parameters
+    ----------
+    A : array_like
+        (n, n) state matrix.
+    C : array_like
+        (p, n) output matrix.
+    faults : sequence of array_like
+        The fault maps ``Fᵢ``, each (n, kᵢ).
+    rtol : float, default 1e-6
+        Two zeros match when they differ by at most ``rtol · max(‖A‖₂, 1)``.
+
+    Returns
+    -------
+    detectable : bool
+        True when the two multisets of zeros match one to one.
+    joint : numpy.ndarray
+        Complex zeros of ``(C, A, [F₁ … F_q])``.
+    union : numpy.ndarray
+        The zeros of every ``(C, A, Fᵢ)``, concatenated.
+
+    Raises
+    ------
+    ParameterError
+        If ``faults`` is empty, a matrix has the wrong shape or is not finite, or ``rtol`` is negative.
+
+    References
+    ----------
+    Douglas et al. 1996, §4.1 (the zero sets of each filter's faults) and App. A.3.
+
+    Examples
+    --------
+    >>> from fdikit.plants import white_speyer
+    >>> m = white_speyer()
+    >>> ok, joint, union = mutually_detectable(m.A, m.C, [m.Bf[:, [0]], m.Bf[:, [1]]])
+    >>> ok, np.round(joint.real, 6).tolist()
+    (True, [-3.0])
     """
     A = validate.as_square("A", A)
     C = validate.as_matrix("C", C, (None, A.shape[0]))
@@ -317,7 +422,34 @@ def mutually_detectable(
 def output_projector(C: np.ndarray, W: np.ndarray, rtol: float | None = None) -> np.ndarray:
     """Orthogonal projector ``I − h hᵀ`` onto the complement of ``range(C W)`` (``h`` an orthonormal basis).
 
-    The detection-space projector ``Ĥ`` of Murray 2012, (2.15); ``I`` when ``W`` has no columns.
+    The residual projector ``Ĥ`` of Murray 2012, (2.11); ``I`` when ``W`` has no columns.
+
+    Parameters
+    ----------
+    C : numpy.ndarray
+        (p, n) output matrix.
+    W : numpy.ndarray
+        (n, k) basis of the subspace to hide from the residual (e.g. the nuisance faults' ``Ŵ*``).
+    rtol : float, optional
+        Relative rank tolerance: singular values above ``rtol · σ_max`` count; default
+        ``1e3 · max(shape) · eps``.
+
+    Returns
+    -------
+    numpy.ndarray
+        (p, p) symmetric idempotent ``Ĥ`` with ``Ker Ĥ = C W``.
+
+    References
+    ----------
+    Murray 2012, §2.1.2, (2.11).
+
+    Examples
+    --------
+    >>> from fdikit.plants import white_speyer
+    >>> m = white_speyer()
+    >>> H = output_projector(m.C, caisa(m.A, m.C, m.Bf[:, 0]))
+    >>> np.round(H, 6).tolist(), np.allclose(H @ m.C @ m.Bf[:, 0], 0)
+    ([[0.5, 0.5], [0.5, 0.5]], True)
     """
     p = C.shape[0]
     if W.shape[1] == 0:
