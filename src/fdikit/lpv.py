@@ -21,7 +21,7 @@ the Markov parameters ``C A^{i−j−1} B``.
 
 Uncertain models (§2, (2), (5)) add scalar unknowns δ_i to ``A`` and ``C``
 (:class:`Uncertainty`); :func:`uncertain_stacked_matrices` expands the stacked matrices in the
-monomials of δ, the ``H̃`` maps of (14) used by the robust design (:mod:`fdikit.design.parity.robust`).
+monomials of δ, the ``H̃`` maps of (14) used by the robust design (:mod:`fdikit.design.parity.criteria`).
 The parity matrix and residuals built on these matrices are in :mod:`fdikit.design.parity.state_space`.
 """
 

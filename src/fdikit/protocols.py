@@ -32,7 +32,7 @@ class DesignResult(Protocol):
     generator : :class:`fdikit.residuals.ResidualGenerator`
         The filter reading the model's named controls and outputs.  Parameter-varying and
         time-varying designs hold their own generator types instead
-        (:class:`~fdikit.design.parity.scheduled.ScheduledResidualGenerator`,
+        (:class:`~fdikit.design.parity.scheduled_generator.ScheduledResidualGenerator`,
         :class:`~fdikit.design.game.ltv_filter.LTVDetectionFilter`, or the scheduled design itself),
         each with its own ``run``.
 

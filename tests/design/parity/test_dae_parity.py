@@ -10,15 +10,14 @@ import pytest
 import scipy.signal
 
 from fdikit import FaultModel
-from fdikit.design.parity.polynomial import (
+from fdikit.design.parity.polynomial import dae_form, parity_filter
+from fdikit.design.parity.polynomial_rank import (
     bar,
     bar_matrices,
-    dae_form,
     detectability,
     isolability,
     left_null_space,
     minimal_degree,
-    parity_filter,
 )
 from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.faults import Bias, FaultScenario, ScaleFactor

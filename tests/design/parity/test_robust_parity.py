@@ -16,6 +16,15 @@ import pytest
 import scipy.linalg
 import scipy.optimize
 
+from fdikit.design.parity.criteria import (
+    gamma_kappa,
+    kappa_max,
+    p2_solution,
+    robust_criteria,
+    theorem1,
+    theorem1_batch,
+)
+from fdikit.design.parity.lmi import lti_lmi
 from fdikit.design.parity.polytope import (
     adjugate,
     box_vertices,
@@ -26,16 +35,7 @@ from fdikit.design.parity.polytope import (
     repair_vertex,
     scheduling_weights,
 )
-from fdikit.design.parity.robust import (
-    gamma_kappa,
-    kappa_max,
-    lti_lmi,
-    p2_solution,
-    robust_criteria,
-    robust_lpv_parity,
-    theorem1,
-    theorem1_batch,
-)
+from fdikit.design.parity.robust import robust_lpv_parity
 from fdikit.design.parity.state_space import parity_matrix
 from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.lpv import lpv_stacked_matrices

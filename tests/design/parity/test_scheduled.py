@@ -8,13 +8,10 @@ import cvxpy as cp
 import numpy as np
 import pytest
 
-from fdikit.design.parity.polynomial import bar_matrices, dae_form, parity_filter
-from fdikit.design.parity.scheduled import (
-    lpv_bar_matrices,
-    lpv_parity_row,
-    lpv_rank_test,
-    scheduled_parity_filter,
-)
+from fdikit.design.parity.polynomial import dae_form, parity_filter
+from fdikit.design.parity.polynomial_rank import bar_matrices
+from fdikit.design.parity.scheduled import scheduled_parity_filter
+from fdikit.design.parity.scheduled_window import lpv_bar_matrices, lpv_parity_row, lpv_rank_test
 from fdikit.errors import DataError, DesignError, ModelError, ParameterError
 from fdikit.faults import Bias, FaultScenario, Noise, ScaleFactor
 from fdikit.metrics import vaf

@@ -1,7 +1,7 @@
 """Polytopic machinery of the robust LPV parity design (Varrier et al. 2014, §4.5–4.6, (32)–(46)).
 
 The pointwise optimum of 𝒫₂ involves ``Γ_κ(ρ)⁻¹ = adj Γ_κ(ρ) / det Γ_κ(ρ)``
-(:mod:`fdikit.design.parity.robust`); this module holds the steps that turn it into a
+(:mod:`fdikit.design.parity.criteria`); this module holds the steps that turn it into a
 finite set of vertex LMIs:
 
 * (32)–(36): ``adj Γ_κ(ρ) = Σ_j t^j M_j`` is a matrix polynomial (``t = (ρ − ρ_min)/(ρ_max − ρ_min)``),

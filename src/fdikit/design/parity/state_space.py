@@ -13,7 +13,7 @@ at sample ``k`` is causal (uses samples up to ``k`` only); in the frozen mode ρ
 newest sample ``ρ_k``.  :func:`parity_design` builds the LTI residual generator (an FIR
 :class:`~fdikit.residuals.ResidualGenerator`); :func:`lpv_parity_residuals` recomputes ``P(ρ)``
 at every sample of a trace (16).  The robust choice of ``W₂`` is in
-:mod:`fdikit.design.parity.robust`.
+:mod:`fdikit.design.parity.criteria`, :mod:`fdikit.design.parity.lmi` and :mod:`fdikit.design.parity.robust`.
 """
 
 from __future__ import annotations

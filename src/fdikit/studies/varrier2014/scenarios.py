@@ -29,7 +29,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fdikit.design.parity.robust import kappa_max, pointwise_theorem1, robust_criteria, robust_lpv_parity
+from fdikit.design.parity.criteria import kappa_max, pointwise_theorem1, robust_criteria
+from fdikit.design.parity.robust import robust_lpv_parity
 from fdikit.design.parity.state_space import lpv_parity_residuals
 from fdikit.errors import DataError, ParameterError
 from fdikit.faults import NO_FAULT
