@@ -39,6 +39,43 @@ def sensor_fault_map(model: FaultModel, output: str, direction: str = "both", rt
     → ``A F¹`` (the bias direction), ``'rate'`` → ``F¹``.  ``F¹`` is the minimum-norm
     solution; it must solve ``C F¹ = e_i`` exactly (to ``rtol``), otherwise the output is
     not reachable from the states and :class:`DesignError` is raised.
+
+    Parameters
+    ----------
+    model : FaultModel
+        The plant; its ``A`` and ``C`` are used.
+    output : str
+        Name of the output whose sensor fails (an output name, not the fault name).
+    direction : {"both", "magnitude", "rate"}, default "both"
+        Which columns to return (see above).
+    rtol : float, default 1e-9
+        Bound on ``‖C F¹ − e_i‖`` for ``F¹`` to count as a solution.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, 2) ``[F¹, A F¹]``, or the (n, 1) column ``A F¹`` (``'magnitude'``) or ``F¹`` (``'rate'``).
+
+    Raises
+    ------
+    ParameterError
+        If ``model`` is not a :class:`~fdikit.model.FaultModel` or ``direction`` is not one of the three.
+    ModelError
+        If the model has no output ``output``.
+    DesignError
+        If ``e_i`` is not in the range of ``C`` (no ``F¹`` solves ``C F¹ = e_i``).
+
+    References
+    ----------
+    Douglas et al. 1996, §3.1, (3.3)–(3.5); App. A.2, (a.5)–(a.6).
+
+    Examples
+    --------
+    >>> from fdikit.plants import f16xl_longitudinal
+    >>> m = f16xl_longitudinal()  # C = I: F¹ is the unit vector of theta
+    >>> F = sensor_fault_map(m, "y_theta")
+    >>> F.shape, F[:, 0].tolist(), bool(np.allclose(F[:, 1], m.A[:, 3]))
+    ((4, 2), [0.0, 0.0, 0.0, 1.0], True)
     """
     validate.instance("model", model, FaultModel)
     validate.choice("direction", direction, ("both", "magnitude", "rate"))
@@ -76,6 +113,45 @@ def sensor_fault_map_tv(
     ``A B₁ − Ḃ₁`` in (9.38) and of ``A F_i − Ḟ_i`` in App. A.2).
     ``dF1`` gives the derivative; otherwise a central difference with ``step`` (default ``1e-6 · max(1, |t|)``).
     ``A`` and ``C`` are callables ``t -> matrix``; ``output`` is the output's index.
+
+    Parameters
+    ----------
+    A, C : callable
+        ``t -> (n, n)`` state matrix and ``t -> (p, n)`` output matrix.
+    output : int
+        Index (0-based) of the output whose sensor fails.
+    t : float
+        Time [s] at which the map is evaluated.
+    dF1 : callable, optional
+        ``t -> (n,)`` derivative of ``F¹``; default a central difference of the minimum-norm ``F¹``.
+    step : float, optional
+        Step [s] of that difference; default ``1e-6 · max(1, |t|)``.
+    rtol : float, default 1e-9
+        Bound on ``‖C(τ) F¹(τ) − e_i‖`` for ``F¹`` to count as a solution.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, 2) ``[F¹(t), F²(t)]``.
+
+    Raises
+    ------
+    ParameterError
+        If ``A``, ``C`` or ``dF1`` is not callable, ``t`` is not a finite number, or ``output`` is not an
+        index of the outputs of ``C(t)``.
+    DesignError
+        If ``e_i`` is not in the range of ``C(τ)`` at ``t`` (or at ``t ± step``).
+
+    References
+    ----------
+    Douglas et al. 1996, App. A.2 (the time-varying form of (a.5)) and App. A.3, (a.9).
+
+    Examples
+    --------
+    >>> A = lambda t: np.array([[0.0, 1.0], [-1.0, -t]])
+    >>> C = lambda t: np.array([[1.0, t]])
+    >>> np.round(sensor_fault_map_tv(A, C, 0, 1.0), 6).tolist()
+    [[0.5, 1.0], [0.5, -1.0]]
     """
     for nm, fn in (("A", A), ("C", C), ("dF1", dF1)):
         if fn is not None and not callable(fn):
@@ -111,6 +187,38 @@ def actuator_fault_map(model: FaultModel, control: str) -> np.ndarray:
     On a model whose actuator lags are states (e.g. the 14-state PATH model) this is the
     command-side fault; a nonzero ``D`` column means the fault also reaches the outputs
     directly, which the geometric filters here do not model (:class:`DesignError`).
+
+    Parameters
+    ----------
+    model : FaultModel
+        The plant.
+    control : str
+        Name of the control whose actuator fails (a control name, not the fault name).
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, 1) column of ``Bu`` of that control.
+
+    Raises
+    ------
+    ParameterError
+        If ``model`` is not a :class:`~fdikit.model.FaultModel`.
+    ModelError
+        If the model has no control ``control``.
+    DesignError
+        If the control's column of ``Du`` is nonzero.
+
+    References
+    ----------
+    Douglas et al. 1996, §3.2.
+
+    Examples
+    --------
+    >>> from fdikit.plants import f16xl_longitudinal
+    >>> m = f16xl_longitudinal()
+    >>> actuator_fault_map(m, "elevon").shape
+    (4, 1)
     """
     validate.instance("model", model, FaultModel)
     j = model.index("u", control)[0]
@@ -140,6 +248,19 @@ def split_fault_name(model: FaultModel, name: str) -> tuple[str, str, str]:
       (``A F¹`` only, the bias assumption, Douglas et al. 1996, §3.1) or ``':rate'`` (``F¹`` only);
     * ``'<control>_actuator'`` → ``('actuator', control, '')``.
 
+    Parameters
+    ----------
+    model : FaultModel
+        The model whose outputs, controls and fault inputs define the valid names.
+    name : str
+        A fault name, optionally with a ``:magnitude`` / ``:rate`` suffix.
+
+    Returns
+    -------
+    tuple of str
+        ``(kind, signal, suffix)``: kind ``'fault'``, ``'sensor'`` or ``'actuator'``; the fault input's,
+        output's or control's name; the suffix without the colon (``''`` when none).
+
     Raises
     ------
     ParameterError
@@ -148,6 +269,13 @@ def split_fault_name(model: FaultModel, name: str) -> tuple[str, str, str]:
         'theta_sensor'``).
     ModelError
         A name the model does not know, or a suffix on an actuator fault.
+
+    Examples
+    --------
+    >>> from fdikit.plants import f16xl_longitudinal
+    >>> m = f16xl_longitudinal()
+    >>> split_fault_name(m, "y_theta_sensor:magnitude"), split_fault_name(m, "elevon_actuator")
+    (('sensor', 'y_theta', 'magnitude'), ('actuator', 'elevon', ''))
     """
     validate.instance("model", model, FaultModel)
     if not isinstance(name, str):
@@ -183,6 +311,35 @@ def check_fault_inputs(model: FaultModel, names: Sequence[str] | str, what: str 
     For designs that act on the model's fault inputs themselves (:func:`fdikit.design.observers.uio.uio`,
     the gain tables of :mod:`fdikit.analysis`).  Raises :class:`ParameterError` for a signal name (with the
     fault name to use) and :class:`ModelError` for a name that is no fault input of the model.
+
+    Parameters
+    ----------
+    model : FaultModel
+        The model whose fault inputs (group ``f``) are the valid names.
+    names : str or sequence of str
+        One name or several.
+    what : str, default "fault"
+        Word used in the error message for a name that is not a string.
+
+    Returns
+    -------
+    tuple of str
+        The names, unchanged (a single string becomes a 1-tuple).
+
+    Raises
+    ------
+    ParameterError
+        If ``model`` is not a :class:`~fdikit.model.FaultModel`, a name is not a string, or it is a bare
+        output or control name.
+    ModelError
+        If a name is no fault input of the model (for a sensor or actuator fault name, the message
+        names ``with_sensor_faults`` / ``with_actuator_faults``).
+
+    Examples
+    --------
+    >>> from fdikit.plants import msd
+    >>> check_fault_inputs(msd(), "y2_sensor")
+    ('y2_sensor',)
     """
     validate.instance("model", model, FaultModel)
     names = (names,) if isinstance(names, str) else tuple(names)
@@ -218,6 +375,42 @@ def resolve_fault(model: FaultModel, name: str) -> tuple[np.ndarray, str]:
       (``Df = e_i``, ``Bf = 0``).
 
     A bare signal name (``'theta'``, ``'throttle'``) raises :class:`ParameterError` naming the fault.
+
+    Parameters
+    ----------
+    model : FaultModel
+        The plant.
+    name : str
+        A fault name, optionally with a ``:magnitude`` / ``:rate`` suffix.
+
+    Returns
+    -------
+    F : numpy.ndarray
+        (n, k) fault map: k = 2 for a sensor fault, 1 for a suffixed sensor fault, an actuator or a
+        fault input.
+    kind : str
+        ``'sensor'``, ``'sensor:magnitude'``, ``'sensor:rate'``, ``'actuator'`` or ``'fault input'``.
+
+    Raises
+    ------
+    ParameterError
+        As :func:`split_fault_name` (not a string, unknown suffix, bare signal name).
+    ModelError
+        As :func:`split_fault_name`, or a suffix on a fault input that is not a sensor fault.
+    DesignError
+        If a fault input reaches the outputs without being a pure sensor fault, or from
+        :func:`sensor_fault_map` / :func:`actuator_fault_map`.
+
+    References
+    ----------
+    Douglas et al. 1996, §3.1, (3.5) (sensor faults) and §3.2 (actuator faults).
+
+    Examples
+    --------
+    >>> from fdikit.plants import msd
+    >>> m = msd()
+    >>> [(F.shape, kind) for F, kind in (resolve_fault(m, "y2_sensor"), resolve_fault(m, "u1_actuator"))]
+    [((6, 2), 'sensor'), ((6, 1), 'fault input')]
     """
     kind, base, suffix = split_fault_name(model, name)
     if kind == "fault":
@@ -248,6 +441,34 @@ def resolve_faults(model: FaultModel, faults: Mapping[str, np.ndarray] | Sequenc
     ``B[:, j]``, a fault input of the model (group ``f``) its own map.  The keys are the names
     without the suffix.  A bare signal name (``'theta'``) raises :class:`ParameterError` whose
     message gives the fault name (``'theta_sensor'``).
+
+    Parameters
+    ----------
+    model : FaultModel
+        The plant.
+    faults : mapping of str to array_like, sequence of str, or str
+        Explicit maps by name (an (n, k) matrix; a (k, n) one is transposed), or fault names.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        The (n, kᵢ) fault map of each fault, by name (without suffix), in the given order.
+
+    Raises
+    ------
+    ParameterError
+        If ``model`` is not a :class:`~fdikit.model.FaultModel`, or as :func:`resolve_fault`.
+    ModelError
+        If an explicit map is not a finite matrix with n rows (or n columns), or as :func:`resolve_fault`.
+    DesignError
+        As :func:`resolve_fault`.
+
+    Examples
+    --------
+    >>> from fdikit.plants import f16xl_longitudinal
+    >>> maps = resolve_faults(f16xl_longitudinal(), ["y_q_sensor:magnitude", "elevon_actuator"])
+    >>> {name: F.shape for name, F in maps.items()}
+    {'y_q_sensor': (4, 1), 'elevon_actuator': (4, 1)}
     """
     validate.instance("model", model, FaultModel)
     if isinstance(faults, str):
@@ -276,6 +497,34 @@ def resolve_nuisance(
 
     ``()`` (or an empty mapping) means none; the string ``'others'`` means every fault input of the
     model (group ``f``) not named in ``targets``; anything else is resolved by :func:`resolve_faults`.
+
+    Parameters
+    ----------
+    model : FaultModel
+        The plant.
+    nuisance : mapping of str to array_like, sequence of str, or str
+        ``()``, ``'others'``, fault names or explicit maps (as :func:`resolve_faults`).
+    targets : sequence of str, default ()
+        The design's targets, left out of ``'others'`` (suffixes ignored).
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        The (n, kᵢ) fault map of each nuisance fault by name; empty for none.
+
+    Raises
+    ------
+    ParameterError
+        If ``nuisance`` is None, or as :func:`resolve_faults`.
+    ModelError, DesignError
+        As :func:`resolve_faults`.
+
+    Examples
+    --------
+    >>> from fdikit.plants import msd
+    >>> m = msd()
+    >>> list(resolve_nuisance(m, "others", targets=["y2_sensor"])), resolve_nuisance(m, ())
+    (['u1_actuator'], {})
     """
     if nuisance is None:
         raise ParameterError("nuisance=None is not a fault set; use () for none or 'others' for every other fault")
