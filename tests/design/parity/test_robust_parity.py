@@ -37,7 +37,7 @@ from fdikit.design.parity.polytope import (
 )
 from fdikit.design.parity.robust import robust_lpv_parity
 from fdikit.design.parity.state_space import parity_matrix
-from fdikit.errors import DesignError, ModelError, ParameterError
+from fdikit.errors import DesignError, ParameterError
 from fdikit.lpv import lpv_stacked_matrices
 from fdikit.plants.varrier_lateral import varrier_lateral_lpv, varrier_uncertainty
 
