@@ -47,12 +47,44 @@ _GROUP_WORD = {"u": "controls", "d": "disturbances", "f": "faults", "w": "noise"
 
 
 def sensor_fault_name(output: str) -> str:
-    """Name of the fault input that corrupts the sensor measuring ``output``."""
+    """Name of the fault input that corrupts the sensor measuring ``output``.
+
+    Parameters
+    ----------
+    output : str
+        Output name.
+
+    Returns
+    -------
+    str
+        ``"<output>_sensor"`` (docs/ARCHITECTURE.md, "faults in APIs").
+
+    Examples
+    --------
+    >>> sensor_fault_name("yaw_rate")
+    'yaw_rate_sensor'
+    """
     return f"{output}_sensor"
 
 
 def actuator_fault_name(control: str) -> str:
-    """Name of the fault input that corrupts the actuator driven by ``control``."""
+    """Name of the fault input that corrupts the actuator driven by ``control``.
+
+    Parameters
+    ----------
+    control : str
+        Control name.
+
+    Returns
+    -------
+    str
+        ``"<control>_actuator"`` (docs/ARCHITECTURE.md, "faults in APIs").
+
+    Examples
+    --------
+    >>> actuator_fault_name("throttle")
+    'throttle_actuator'
+    """
     return f"{control}_actuator"
 
 
@@ -121,6 +153,13 @@ class FaultModel:
     ModelError
         On a shape mismatch, a duplicate name or a non-finite entry; the message names
         the matrix and the offending row/column.
+
+    Examples
+    --------
+    >>> m = FaultModel(A=[[0.0, 1.0], [0.0, -0.5]], C=[[1.0, 0.0]], Bu=[[0.0], [1.0]],
+    ...                states=["pos", "vel"], outputs=["pos_meas"], controls=["force"])
+    >>> m, m.Bu.shape, m.discretize(0.1).dt
+    (FaultModel(continuous, n=2, p=1, u=1, d=0, f=0, w=0), (2, 1), 0.1)
     """
 
     A: np.ndarray
