@@ -4,7 +4,10 @@ Each helper checks one argument, returns it in canonical form (a float, an int, 
 float array ...) and otherwise raises an :mod:`fdikit.errors` class whose message names the
 argument, says what is wrong and how to fix it.  The class defaults to
 :class:`~fdikit.errors.ParameterError` (a bad argument); model constructors pass
-``error=ModelError`` (a malformed model) and data readers ``error=DataError``.
+``error=ModelError`` (a malformed model) and data readers ``error=DataError``.  The scalar, option
+and type checks (:func:`number`, :func:`positive`, :func:`non_negative`, :func:`integer`,
+:func:`in_range`, :func:`choice`, :func:`instance`) are defined in :mod:`fdikit.validate_scalars`
+and re-exported here; import every check from :mod:`fdikit.validate`.
 
 Examples
 --------
@@ -19,12 +22,19 @@ fdikit.errors.ParameterError: dt must be a positive number, got 0.0
 
 from __future__ import annotations
 
-import numbers
-from collections.abc import Sequence
-
 import numpy as np
 
 from fdikit.errors import ParameterError
+from fdikit.validate_scalars import (  # re-exported: defined there to keep both modules short
+    _show,
+    choice,
+    in_range,
+    instance,
+    integer,
+    non_negative,
+    number,
+    positive,
+)
 
 __all__ = [
     "as_array",
@@ -44,15 +54,41 @@ __all__ = [
 ]
 
 
-def _show(value) -> str:
-    text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
 def as_array(name: str, value, *, error: type[Exception] = ParameterError, finite: bool = True,
              complex_ok: bool = False) -> np.ndarray:
     """``value`` as a float array (any number of dimensions); strings, ragged input and (unless ``complex_ok``,
-    which gives a complex array) complex entries are refused."""
+    which gives a complex array) complex entries are refused.
+
+    Parameters
+    ----------
+    name : str
+        The argument's name, as the messages quote it.
+    value : array_like
+        A number or a (nested) sequence or array of numbers; bools and integers become floats.
+    error : exception class, default ParameterError
+        Raised on failure (``ModelError``, ``DataError`` ... for other callers).
+    finite : bool, default True
+        Refuse NaN and ±inf entries (the message gives the first one's position).
+    complex_ok : bool, default False
+        Accept complex entries (the result is then complex).
+
+    Returns
+    -------
+    ndarray
+        A new float (or complex) array of the input's shape.
+
+    Raises
+    ------
+    ParameterError
+        (or ``error``) For None, a string, ragged or non-numeric input, complex entries (unless
+        ``complex_ok``) or a non-finite entry (when ``finite``).
+
+    Examples
+    --------
+    >>> from fdikit.validate import as_array
+    >>> as_array("x", [[1, 2], [3, 4]]).dtype
+    dtype('float64')
+    """
     if value is None:
         raise error(f"{name} is required (got None); pass an array of numbers")
     if isinstance(value, str | bytes):
@@ -93,6 +129,43 @@ def as_matrix(
     A scalar becomes 1 x 1 (or, with ``scalar_ok`` and a square ``shape``, ``value · I``); with
     ``promote`` a vector becomes one row (``np.atleast_2d``); with ``complex_ok`` complex entries
     give a complex matrix.
+
+    Parameters
+    ----------
+    name : str
+        The argument's name, as the messages quote it.
+    value : array_like
+        A scalar or a 2-D array of numbers (a 1-D one only with ``promote``).
+    shape : (int or None, int or None), optional
+        Required rows and columns; ``None`` (the default, or an entry) leaves that size free.
+    error : exception class, default ParameterError
+        Raised on failure.
+    finite : bool, default True
+        Refuse NaN and ±inf entries.
+    scalar_ok : bool, default False
+        A scalar with a square ``shape`` means ``value · I``.
+    promote : bool, default False
+        A 1-D vector becomes a 1 x k row.
+    complex_ok : bool, default False
+        Accept complex entries.
+
+    Returns
+    -------
+    (rows, cols) ndarray
+
+    Raises
+    ------
+    ParameterError
+        (or ``error``) As :func:`as_array`, and for an array that is not 2-D or has the wrong
+        number of rows or columns (the message gives the shape wanted).
+
+    Examples
+    --------
+    >>> from fdikit.validate import as_matrix
+    >>> as_matrix("Q", 2.0, (2, 2), scalar_ok=True).tolist()
+    [[2.0, 0.0], [0.0, 2.0]]
+    >>> as_matrix("c", [1, 0, 0], (1, 3), promote=True).shape
+    (1, 3)
     """
     out = as_array(name, value, error=error, finite=finite, complex_ok=complex_ok)
     rows, cols = shape if shape is not None else (None, None)
@@ -115,7 +188,34 @@ def as_matrix(
 
 
 def as_square(name: str, value, n: int | None = None, *, error: type[Exception] = ParameterError) -> np.ndarray:
-    """A finite square matrix (``n x n`` when ``n`` is given)."""
+    """A finite square matrix (``n x n`` when ``n`` is given).
+
+    Parameters
+    ----------
+    name : str
+        The argument's name, as the messages quote it.
+    value : array_like
+        A square matrix of numbers (a scalar is 1 x 1).
+    n : int, optional
+        Required size (any when omitted).
+    error : exception class, default ParameterError
+        Raised on failure.
+
+    Returns
+    -------
+    (n, n) ndarray
+
+    Raises
+    ------
+    ParameterError
+        (or ``error``) As :func:`as_matrix`, and for a matrix that is not square or not ``n x n``.
+
+    Examples
+    --------
+    >>> from fdikit.validate import as_square
+    >>> as_square("A", [[0, 1], [-2, -3]], 2).shape
+    (2, 2)
+    """
     out = as_matrix(name, value, error=error)
     if out.shape[0] != out.shape[1]:
         raise error(f"{name} must be square, got shape {out.shape}")
@@ -126,7 +226,36 @@ def as_square(name: str, value, n: int | None = None, *, error: type[Exception] 
 
 def as_vector(name: str, value, size: int | None = None, *, error: type[Exception] = ParameterError,
               finite: bool = True) -> np.ndarray:
-    """A 1-D float vector (a column or row matrix is flattened) of ``size`` entries."""
+    """A 1-D float vector (a column or row matrix is flattened) of ``size`` entries.
+
+    Parameters
+    ----------
+    name : str
+        The argument's name, as the messages quote it.
+    value : array_like
+        A scalar (one entry), a 1-D sequence, or an array with at most one dimension longer than 1.
+    size : int, optional
+        Required number of entries (any when omitted).
+    error : exception class, default ParameterError
+        Raised on failure.
+    finite : bool, default True
+        Refuse NaN and ±inf entries.
+
+    Returns
+    -------
+    (size,) ndarray
+
+    Raises
+    ------
+    ParameterError
+        (or ``error``) As :func:`as_array`, and for a true matrix or the wrong number of entries.
+
+    Examples
+    --------
+    >>> from fdikit.validate import as_vector
+    >>> as_vector("x0", [[1.0], [2.0]], 2).tolist()
+    [1.0, 2.0]
+    """
     out = as_array(name, value, error=error, finite=finite)
     if out.ndim > 1 and sum(d > 1 for d in out.shape) <= 1:
         out = out.reshape(-1)
@@ -141,7 +270,35 @@ def as_vector(name: str, value, size: int | None = None, *, error: type[Exceptio
 
 def as_complex_vector(name: str, value, size: int | None = None, *,
                       error: type[Exception] = ParameterError) -> np.ndarray:
-    """Finite complex numbers (poles, eigenvalues) as a 1-D complex vector of ``size`` entries."""
+    """Finite complex numbers (poles, eigenvalues) as a 1-D complex vector of ``size`` entries.
+
+    Parameters
+    ----------
+    name : str
+        The argument's name, as the messages quote it.
+    value : complex or sequence of complex
+        A number or a 1-D sequence of real or complex numbers.
+    size : int, optional
+        Required number of entries (any when omitted).
+    error : exception class, default ParameterError
+        Raised on failure.
+
+    Returns
+    -------
+    (size,) complex ndarray
+
+    Raises
+    ------
+    ParameterError
+        (or ``error``) For None, a string, non-numbers, more than one dimension, the wrong number
+        of entries or a non-finite entry.
+
+    Examples
+    --------
+    >>> from fdikit.validate import as_complex_vector
+    >>> as_complex_vector("poles", [-1, -2 + 1j, -2 - 1j], 3).tolist()
+    [(-1+0j), (-2+1j), (-2-1j)]
+    """
     if isinstance(value, str | bytes) or value is None:
         raise error(f"{name} must be a sequence of numbers, got {_show(value)}")
     try:
@@ -174,6 +331,48 @@ def as_covariance(
     A scalar means ``value · I``; with ``diagonal_ok`` a vector of ``n`` variances means their
     diagonal matrix.  Symmetry and the eigenvalue test use a tolerance ``rtol`` relative to the
     largest entry (``psd_rtol``, when given, for the eigenvalues).  Returns the symmetric part.
+
+    Parameters
+    ----------
+    name : str
+        The argument's name, as the messages quote it.
+    value : float, (n,) or (n, n) array_like
+        The covariance (a scalar only with ``scalar_ok``, a vector only with ``diagonal_ok``).
+    n : int
+        Size of the covariance.
+    error : exception class, default ParameterError
+        Raised on failure.
+    definite : bool, default False
+        Require the smallest eigenvalue to be > 0.
+    scalar_ok : bool, default True
+        A scalar means ``value · I``.
+    diagonal_ok : bool, default False
+        A vector of ``n`` variances means their diagonal matrix.
+    rtol : float, default 1e-12
+        Tolerance of the symmetry and eigenvalue tests, relative to the largest entry.
+    psd_rtol : float, optional
+        Tolerance of the eigenvalue test alone (``rtol`` when omitted).
+
+    Returns
+    -------
+    (n, n) ndarray
+        The symmetric part ``(M + M.T) / 2``.
+
+    Raises
+    ------
+    ParameterError
+        (or ``error``) As :func:`as_array`, and for the wrong shape, an asymmetric matrix, a
+        negative eigenvalue beyond the tolerance, or (``definite``) one that is not > 0.
+
+    Examples
+    --------
+    >>> from fdikit.validate import as_covariance
+    >>> as_covariance("R", [0.01, 0.04], 2, diagonal_ok=True).tolist()
+    [[0.01, 0.0], [0.0, 0.04]]
+    >>> as_covariance("R", [[1.0, 2.0], [2.0, 1.0]], 2)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    fdikit.errors.ParameterError: R must be positive semidefinite (smallest eigenvalue -1); ...
     """
     raw = as_array(name, value, error=error)
     if scalar_ok and raw.size == 1 and raw.ndim <= 2:
@@ -271,82 +470,6 @@ def noise_covariance(std_name: str, std, cov_name: str, cov, k: int, what: str =
                         f"got {_show(arr.tolist())}")
         return np.diag(np.broadcast_to(arr, (k,)))
     return as_covariance(name, arr, k, error=error, scalar_ok=False)
-
-
-def number(name: str, value, *, error: type[Exception] = ParameterError, finite: bool = True) -> float:
-    """A real number (not a bool, string or array) as float; NaN/inf refused when ``finite``."""
-    if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):
-        if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
-            value = value.item()
-        else:
-            raise error(f"{name} must be a number, got {_show(value)} ({type(value).__name__})")
-    out = float(value)
-    if finite and not np.isfinite(out):
-        raise error(f"{name} must be a finite number, got {out}")
-    return out
-
-
-def positive(name: str, value, *, error: type[Exception] = ParameterError) -> float:
-    """A finite number > 0."""
-    if not isinstance(value, bool | np.bool_) and isinstance(value, numbers.Real) and not np.isfinite(float(value)):
-        raise error(f"{name} must be a positive finite number, got {float(value)}")
-    out = number(name, value, error=error)
-    if not out > 0:
-        raise error(f"{name} must be a positive number, got {out}")
-    return out
-
-
-def non_negative(name: str, value, *, error: type[Exception] = ParameterError) -> float:
-    """A finite number >= 0."""
-    out = number(name, value, error=error)
-    if out < 0:
-        raise error(f"{name} must be a non-negative number (>= 0), got {out}")
-    return out
-
-
-def integer(name: str, value, *, minimum: int | None = None, error: type[Exception] = ParameterError) -> int:
-    """An integer (``int`` or integral numpy integer; not a bool or float) ``>= minimum``."""
-    if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Integral):
-        raise error(f"{name} must be an integer, got {_show(value)} ({type(value).__name__})")
-    out = int(value)
-    if minimum is not None and out < minimum:
-        word = {0: "a non-negative integer", 1: "a positive integer"}.get(minimum, f"an integer >= {minimum}")
-        raise error(f"{name} must be {word}, got {out}")
-    return out
-
-
-def in_range(name: str, value, low: float, high: float, *, closed: str = "both",
-             error: type[Exception] = ParameterError) -> float:
-    """A finite number in ``[low, high]`` (``closed`` = 'both', 'left', 'right' or 'neither')."""
-    out = number(name, value, error=error)
-    lo_ok = out >= low if closed in ("both", "left") else out > low
-    hi_ok = out <= high if closed in ("both", "right") else out < high
-    if not (lo_ok and hi_ok):
-        left = "[" if closed in ("both", "left") else "("
-        right = "]" if closed in ("both", "right") else ")"
-        raise error(f"{name} must lie in {left}{low:g}, {high:g}{right}, got {out}")
-    return out
-
-
-def choice(name: str, value, options: Sequence, *, error: type[Exception] = ParameterError):
-    """``value`` if it is one of ``options``; otherwise an error listing them."""
-    try:
-        ok = value in options
-    except TypeError:
-        ok = False
-    if not ok or isinstance(value, bool) and not any(o is value for o in options):
-        listed = ", ".join(repr(o) for o in options)
-        raise error(f"unknown {name} {_show(value)}; use one of {listed}")
-    return value
-
-
-def instance(name: str, value, cls: type | tuple[type, ...], hint: str = "", *,
-             error: type[Exception] = ParameterError):
-    """``value`` if it is an instance of ``cls``; otherwise an error naming the expected type."""
-    if not isinstance(value, cls):
-        want = cls.__name__ if isinstance(cls, type) else " or ".join(c.__name__ for c in cls)
-        raise error(f"{name} must be a {want}, got {type(value).__name__}" + (f"; {hint}" if hint else ""))
-    return value
 
 
 def psd_part(name: str, M, *, error: type[Exception] = ParameterError) -> np.ndarray:
