@@ -15,12 +15,14 @@ decisions) until the gap transient has decayed below the noise (:class:`Residual
 gives the rule; :mod:`fdikit.gaps` implements it and gives its derivation).
 ``internal_form(model)`` is Varga's internal form ``R``: the interconnection of the plant
 model and the filter, from ``(u, d, f, w)`` to ``r``, so decoupling is a number, not a plot.
+The series type :class:`~fdikit.residual_series.Residuals` lives in :mod:`fdikit.residual_series`
+and is re-exported here.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
@@ -30,114 +32,10 @@ from fdikit.errors import DataError, ModelError, ParameterError
 from fdikit.gaps import GapRule, Recovery, gap_options
 from fdikit.lti import dlsim_blocked
 from fdikit.model import GROUPS, FaultModel
+from fdikit.residual_series import Residuals  # the residual time series, re-exported
 from fdikit.trace import Trace, check_signals  # check_signals: kept importable from here
 
 __all__ = ["ResidualGenerator", "ResidualStepper", "Residuals", "stack_generators", "check_signals"]
-
-
-@dataclass(frozen=True, eq=False)
-class Residuals:
-    """Residual time series.
-
-    Attributes
-    ----------
-    t : (N,) times; r : (N, q) residuals (NaN on invalid samples); names : residual names;
-    isolates : per residual, the fault it is tied to (None = detection only);
-    valid : (N,) bool, True where the residuals may be used for decisions: False on an invalid
-        input sample (``r`` NaN) and on the *recovering* samples after a gap;
-    recovering : (N,) bool, True on the finite samples after a gap whose gap transient has not yet
-        decayed below the noise (see :class:`ResidualStepper`); these are also not ``valid``.
-    """
-
-    t: np.ndarray
-    r: np.ndarray
-    names: tuple[str, ...]
-    isolates: tuple[str | None, ...]
-    valid: np.ndarray | None = None
-    meta: dict = field(default_factory=dict)
-    recovering: np.ndarray | None = None
-
-    def __post_init__(self) -> None:
-        r = np.atleast_2d(np.asarray(self.r, dtype=float))
-        t = np.asarray(self.t, dtype=float).ravel()
-        if r.shape != (t.size, len(self.names)):
-            raise DataError(f"residuals have shape {r.shape}, need ({t.size}, {len(self.names)})")
-        object.__setattr__(self, "t", t)
-        object.__setattr__(self, "r", r)
-        object.__setattr__(self, "names", tuple(self.names))
-        isolates = tuple(self.isolates) if self.isolates else (None,) * len(self.names)
-        if len(isolates) != len(self.names):
-            raise DataError(f"{len(isolates)} 'isolates' entries for {len(self.names)} residuals")
-        object.__setattr__(self, "isolates", isolates)
-        valid = np.ones(t.size, bool) if self.valid is None else np.asarray(self.valid, bool).ravel()
-        rec = np.zeros(t.size, bool) if self.recovering is None else np.asarray(self.recovering, bool).ravel()
-        if valid.shape != t.shape or rec.shape != t.shape:
-            raise DataError(f"residuals 'valid'/'recovering' flags have {valid.size}/{rec.size} entries for "
-                            f"{t.size} samples")
-        object.__setattr__(self, "valid", valid)
-        object.__setattr__(self, "recovering", rec)
-
-    def __len__(self) -> int:
-        return self.t.size
-
-    def slice(self, start: float | None = None, stop: float | None = None) -> Residuals:
-        """The samples with ``start <= t < stop``."""
-        mask = np.ones(self.t.size, bool)
-        if start is not None:
-            mask &= self.t >= start
-        if stop is not None:
-            mask &= self.t < stop
-        return Residuals(self.t[mask], self.r[mask], self.names, self.isolates, self.valid[mask], dict(self.meta),
-                         self.recovering[mask])
-
-    def select(self, names: Sequence[str]) -> Residuals:
-        """The residuals ``names``, in that order (e.g. to match the order an evaluator was fitted on).
-
-        Raises :class:`DataError` naming the residuals that are not in the series.
-        """
-        names = (names,) if isinstance(names, str) else tuple(names)
-        missing = [nm for nm in names if nm not in self.names]
-        if missing:
-            raise DataError(f"residuals {missing} are not in the series (it has {list(self.names)})")
-        idx = [self.names.index(nm) for nm in names]
-        return Residuals(self.t, self.r[:, idx], names, tuple(self.isolates[i] for i in idx), self.valid,
-                         dict(self.meta), self.recovering)
-
-    def to_pandas(self):
-        import pandas as pd
-
-        df = pd.DataFrame(self.r, columns=list(self.names), index=pd.Index(self.t, name="t"))
-        df["valid"] = self.valid
-        df["recovering"] = self.recovering
-        return df
-
-    def plot(self, ax=None, **kwargs):
-        """Draw the residuals, one panel each (:func:`fdikit.plots.plot_residuals`).
-
-        Parameters
-        ----------
-        ax : matplotlib Axes or sequence of Axes, optional
-            One Axes per residual, or one for all; default a new figure.
-        **kwargs
-            ``diagnosis``, ``thresholds``, ``center``, ``onset``, ``names``, ``title`` and ``path``
-            of :func:`~fdikit.plots.plot_residuals`.
-
-        Returns
-        -------
-        matplotlib.figure.Figure or the given ``ax``
-            A new figure when ``ax`` is None, else ``ax``.
-
-        Examples
-        --------
-        >>> import matplotlib.pyplot as plt
-        >>> fig, ax = plt.subplots()
-        >>> Residuals(np.arange(3.0), np.zeros((3, 1)), ("r",), ()).plot(ax=ax, thresholds=1.0) is ax
-        True
-        >>> plt.close(fig)
-        """
-        from fdikit.plots import plot_residuals
-
-        return plot_residuals(self, ax=ax, **kwargs)
 
 
 def _mat(name, value, shape):
@@ -166,6 +64,25 @@ class ResidualGenerator:
         with a zero-order hold at the trace's sample time).
     isolates : sequence of (str or None), optional
         The fault each residual is tied to; None for a residual that only detects.
+
+    Raises
+    ------
+    ModelError
+        If a matrix is not finite or its shape does not match the filter order, the signals and the
+        residuals, ``isolates`` has the wrong length, or ``dt`` is not positive.
+
+    Examples
+    --------
+    An observer of ``x[k+1] = 0.9 x[k] + u[k]``, ``y = x`` with gain 0.5 (``r = y − ẑ``); a sensor bias of 1
+    from sample 3 on:
+
+    >>> from fdikit.trace import Trace
+    >>> g = ResidualGenerator(A=[[0.4]], B=[[1.0, 0.5]], C=[[-1.0]], D=[[0.0, 1.0]],
+    ...                       controls=("u",), outputs=("y",), residuals=("r",), dt=1.0)
+    >>> y = [0.0, 1.0, 1.9, 3.71, 4.439, 5.0951]
+    >>> trace = Trace(np.arange(6.0), np.ones((6, 1)), np.c_[y], ("u",), ("y",))
+    >>> np.round(g.run(trace).r[:, 0], 6).tolist()
+    [0.0, 0.0, 0.0, 1.0, 0.5, 0.3]
     """
 
     A: np.ndarray
@@ -272,6 +189,12 @@ class ResidualGenerator:
             On missing signals or a sample time different from the generator's.
         ParameterError
             On a bad ``x0``, ``residual_cov`` or ``recovery_tol``.
+
+        Returns
+        -------
+        Residuals
+            Residuals at the trace's times, with ``valid`` / ``recovering`` flags and the trace's
+            metadata under ``meta["trace"]``.
         """
         v = self.inputs_from(trace)
         if len(trace) > 1:
@@ -341,6 +264,10 @@ class ResidualGenerator:
 
         A continuous generator needs ``dt`` (it is then ZOH-discretised); a discrete one accepts
         only its own ``dt``.
+
+        Raises :class:`ModelError` for a continuous generator without ``dt``, :class:`ParameterError`
+        for a ``dt`` that is not a positive number (or a bad ``x0``, ``residual_cov``, ``recovery_tol``)
+        and :class:`DataError` for a ``dt`` other than a discrete generator's own.
         """
         if self.dt is None and dt is None:
             raise ModelError("a continuous residual generator needs dt= to run online")
@@ -355,6 +282,9 @@ class ResidualGenerator:
 
         For a continuous model and a discrete generator the model is first ZOH-discretised
         at the generator's ``dt``.  The states are the plant's followed by the filter's.
+
+        Raises :class:`ModelError` if a continuous generator meets a discrete model, the sample times
+        differ, or the model lacks a signal the generator reads.
         """
         if model.is_discrete and self.dt is None:
             raise ModelError("a continuous generator cannot be joined with a discrete model; discretize the generator")
@@ -441,6 +371,36 @@ class ResidualStepper:
 
     ``step`` accepts the values as sequences in the generator's ``controls``/``outputs`` order,
     or as mappings ``{name: value}`` which are checked against those names.
+
+    Parameters
+    ----------
+    generator : ResidualGenerator
+        A discrete generator (:meth:`ResidualGenerator.online` discretises a continuous one).
+    x0 : array_like, optional
+        Initial filter state (default zeros).
+    residual_cov, recovery_tol
+        The recovery rule's options, as in :meth:`ResidualGenerator.run`.
+
+    Attributes
+    ----------
+    x : numpy.ndarray
+        Current filter state.
+    last_valid, last_recovering : bool
+        Flags of the last sample stepped.
+    invalid : int
+        Number of invalid samples since creation or :meth:`reset`.
+
+    Raises
+    ------
+    ParameterError
+        On a bad ``x0``, ``residual_cov`` or ``recovery_tol``.
+
+    Examples
+    --------
+    >>> g = ResidualGenerator([[0.4]], [[1.0, 0.5]], [[-1.0]], [[0.0, 1.0]], ("u",), ("y",), ("r",), dt=1.0)
+    >>> s = g.online()
+    >>> s.step({"u": 1.0}, {"y": float("nan")}), s.last_valid, s.invalid
+    (array([nan]), False, 1)
     """
 
     def __init__(self, generator: ResidualGenerator, x0: np.ndarray | None = None, *,
@@ -490,7 +450,14 @@ class ResidualStepper:
 
         Returns
         -------
-        (q,) array: NaN on an invalid sample; see the class docstring for ``last_valid``.
+        numpy.ndarray
+            (q,) residuals: NaN on an invalid sample; see the class docstring for ``last_valid``.
+
+        Raises
+        ------
+        DataError
+            If ``u`` or ``y`` is None, a string, not numbers, a mapping with other names, or the wrong
+            number of values.
         """
         g = self.generator
         v = np.concatenate([self._vector(u, g.controls, "controls"), self._vector(y, g.outputs, "outputs")])
@@ -542,10 +509,27 @@ def stack_generators(generators: Iterable[ResidualGenerator]) -> ResidualGenerat
     Every generator must read the same controls and outputs in the same order and share
     ``dt``; residual names must be unique across them.
 
+    Parameters
+    ----------
+    generators : iterable of ResidualGenerator
+        The filters of the bank.
+
+    Returns
+    -------
+    ResidualGenerator
+        States, residuals and ``isolates`` of all generators in the given order.
+
     Raises
     ------
     ModelError
         On an empty list, different signals, different ``dt`` or a repeated residual name.
+
+    Examples
+    --------
+    >>> g = ResidualGenerator([[0.4]], [[1.0, 0.5]], [[-1.0]], [[0.0, 1.0]], ("u",), ("y",), ("r",), dt=1.0)
+    >>> bank = stack_generators([g, g.__class__(g.A, g.B, g.C, g.D, ("u",), ("y",), ("r2",), dt=1.0)])
+    >>> bank.n, bank.residuals
+    (2, ('r', 'r2'))
     """
     gens = list(generators)
     if not gens:
