@@ -25,8 +25,8 @@ What the simulators promise (issue 12):
   same seed), a fault that acts on no sample gives an :class:`~fdikit.errors.FdiWarning`, and the
   same seed gives the same trace, bit for bit.
 
-The argument checks, the memory check and the non-finite diagnosis live in
-:mod:`fdikit.simulate_checks`; this module holds the plants' simulators.
+The argument checks and the memory check live in :mod:`fdikit.simulate_checks`, the
+non-finite diagnosis in :mod:`fdikit.simulate_diagnosis`; this module holds the plants' simulators.
 """
 
 from __future__ import annotations
@@ -51,14 +51,12 @@ from fdikit.simulate_checks import (
     check_scenario,
     check_signal,
     check_times,
-    jacobian_text,
-    linear_cause,
-    refuse_non_finite,
     sample_count,
-    scheduled_cause,
     simulation_bytes,
     warn_inactive,
 )
+from fdikit.simulate_diagnosis import jacobian_text, linear_cause, refuse_non_finite, scheduled_cause
+from fdikit.simulate_varying import _frozen_A, _simulate_varying
 from fdikit.trace import Trace
 
 __all__ = ["NonlinearPlant", "simulate", "simulate_scheduled", "time_grid"]
@@ -71,10 +69,29 @@ class NonlinearPlant:
     ``f`` and ``h`` take and return 1-D arrays (``f`` one derivative per state, ``h`` one value
     per output).  ``x0`` is the default initial state (finite).
 
+    Attributes
+    ----------
+    f : callable ``f(t, x, u) -> (n,)``
+        State derivative; ``t`` [s], ``x`` (n,), ``u`` (m,) the held controls.
+    h : callable ``h(t, x, u) -> (p,)``
+        Outputs.
+    states, outputs, controls : tuple of str
+        Signal names (a sequence is stored as a tuple); their lengths fix n, p, m.
+    x0 : (n,) ndarray
+        Default initial state (zeros when omitted).
+
     Raises
     ------
     ModelError
-        When ``f`` or ``h`` is not callable, or ``x0`` is not one finite number per state.
+        When ``f`` or ``h`` is not callable, a name is not a non-empty str, or ``x0`` is not finite, one per state.
+
+    Examples
+    --------
+    >>> plant = NonlinearPlant(f=lambda t, x, u: -x + u, h=lambda t, x, u: x**2,
+    ...                        states=("x",), outputs=("x_squared",), controls=("u",))
+    >>> tr = simulate(plant, duration=1.0, dt=0.1, u=lambda t: [1.0], x0=[2.0])
+    >>> tr.y.shape, round(float(tr.y[-1, 0]), 4)  # (1 + e^-1)^2 = 1.8711
+    ((11, 1), 1.8711)
     """
 
     f: Callable[[float, np.ndarray, np.ndarray], np.ndarray]
@@ -111,11 +128,26 @@ class NonlinearPlant:
 def time_grid(duration: float, dt: float) -> np.ndarray:
     """``0, dt, 2 dt, …`` up to and including ``duration`` (rounded to whole samples).
 
+    Parameters
+    ----------
+    duration, dt : float
+        Length [s] (>= 0) and sample time [s] (> 0).
+
+    Returns
+    -------
+    (N,) ndarray
+        ``N = round(duration / dt) + 1`` sample times [s].
+
     Raises
     ------
     ParameterError
         For a ``dt`` that is not a finite number > 0, a ``duration`` that is not a finite number
         >= 0, or a grid that would not fit in memory.
+
+    Examples
+    --------
+    >>> time_grid(0.5, 0.1).round(6).tolist()
+    [0.0, 0.1, 0.2, 0.3, 0.4, 0.5]
     """
     dt, duration = check_sample_time(dt), check_duration(duration)
     N = sample_count(duration, dt)
@@ -213,11 +245,21 @@ def simulate(
     measurement_noise_std, measurement_noise_cov : optional, at most one of them
         Additive output noise: standard deviations (scalar or one per output) or a covariance
         (p x p matrix, or a scalar/vector of variances), as for the process noise.
-    rng : numpy.random.Generator or int seed (>= 0)
-    method : ``'rk4'`` (fixed step, ``substeps`` per sample) or ``'solve_ivp'`` (RK45), nonlinear plants only.
-    substeps : int >= 1
+    rng : numpy.random.Generator or int seed (>= 0), optional
+        Source of the noise and of random fault signals (None: fresh entropy, not reproducible).
+    method : {'rk4', 'solve_ivp'}, default 'rk4'
+        Nonlinear plants only: fixed-step RK4 (``substeps`` steps per sample) or
+        :func:`scipy.integrate.solve_ivp` (RK45, rtol 1e-8, atol 1e-10) between samples.
+    substeps : int >= 1, default 4
+        RK4 steps per sample.
     meta : dict, optional
         Extra metadata stored in the trace.
+
+    Returns
+    -------
+    Trace
+        ``t`` (N,), commanded ``u`` (N, m), measured ``y`` (N, p) with noise and sensor faults, ``x`` (N, n),
+        ``d``, the fault truth label per sample (``"none"`` before an onset) and ``meta`` (plant, seed, scenario).
 
     Raises
     ------
@@ -228,6 +270,20 @@ def simulate(
     DataError
         For unusable signal data (u, d or t of the wrong shape, non-numeric or non-finite), and
         for a run that would return non-finite samples.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.faults import Bias, FaultScenario
+    >>> from fdikit.plants import msd
+    >>> plant = msd(dt=0.01)  # discrete: dt is the plant's
+    >>> faulty = simulate(plant, FaultScenario([Bias("y1", 0.5, onset=1.0)]), duration=2.0,
+    ...                   measurement_noise_std=0.01, rng=1)
+    >>> clean = simulate(plant, duration=2.0, measurement_noise_std=0.01, rng=1)
+    >>> faulty.y.shape, str(faulty.fault[0]), str(faulty.fault[-1])
+    ((201, 3), 'none', 'y1_sensor')
+    >>> bool(np.array_equal(faulty.y[:100], clean.y[:100])), np.round(faulty.y[-1] - clean.y[-1], 6).tolist()
+    (True, [0.5, 0.0, 0.0])
     """
     if not isinstance(plant, FaultModel | NonlinearPlant):
         raise ParameterError(f"cannot simulate a {type(plant).__name__}; pass a FaultModel or a NonlinearPlant "
@@ -434,6 +490,12 @@ def simulate_scheduled(
     rng : numpy.random.Generator or int seed
         Source of random fault signals.
 
+    Returns
+    -------
+    Trace
+        ``t`` (N,) at the family's ``dt``, commanded ``u``, outputs ``y`` (N, p + 1) with the schedule as the
+        last column ``schedule_name``, states ``x``, ``d`` and the fault truth labels.
+
     Raises
     ------
     ParameterError
@@ -500,44 +562,3 @@ def simulate_scheduled(
                  outputs=m0.outputs + (schedule_name,), x=x, states=m0.states, d=d_arr,
                  disturbances=m0.disturbances, fault=scenario.truth(t),
                  meta={"plant": repr(m0), "scenario": scenario.label, "schedule": schedule_name})
-
-
-def _frozen_A(family, m0: FaultModel, rho: np.ndarray, values: np.ndarray) -> np.ndarray:
-    """The stack of frozen ``A(ρ)`` at the distinct schedule ``values`` (which hold ``rho[0]``, the ρ of ``m0``)."""
-    return _scheduled_matrices(family, m0, values, int(np.searchsorted(values, rho[0])))[0]
-
-
-def _scheduled_matrices(family, m0: FaultModel, values: np.ndarray, i0: int) -> tuple[np.ndarray, ...]:
-    """``(A, B, C, D)`` stacks at the distinct schedule ``values`` (``values[i0]`` gave ``m0``); B, D over [u, d]."""
-    ref = (m0.A, np.hstack([m0.Bu, m0.Bd]), m0.C, np.hstack([m0.Du, m0.Dd]))
-    state_space = getattr(family, "state_space", None)
-    if callable(state_space):
-        mats = tuple(np.asarray(M, dtype=float) for M in state_space(values))
-        ok = len(mats) == 4 and all(M.shape == (values.size,) + R.shape for M, R in zip(mats, ref))
-        if not (ok and all(np.allclose(M[i0], R, rtol=1e-9, atol=1e-12) for M, R in zip(mats, ref))):
-            raise ModelError(f"family.state_space disagrees with family({values[i0]:g}); it must return the stacks "
-                             "(A, [Bu Bd], C, [Du Dd]) of the family's models, one per schedule value")
-        return mats
-    models = [m0 if i == i0 else family(float(r)) for i, r in enumerate(values)]
-    for r, m in zip(values, models):
-        if not isinstance(m, FaultModel) or m.dt != m0.dt or m.inputs != m0.inputs or m.outputs != m0.outputs \
-                or m.n != m0.n:
-            raise ModelError(f"family({r:g}) must be a discrete FaultModel with the names, sizes and dt of "
-                             f"family({values[i0]:g})")
-    return tuple(np.stack(M) for M in zip(*[(m.A, np.hstack([m.Bu, m.Bd]), m.C, np.hstack([m.Du, m.Dd]))
-                                            for m in models]))
-
-
-def _simulate_varying(family, m0: FaultModel, rho: np.ndarray, v: np.ndarray, x0: np.ndarray | None):
-    """Outputs and states with the model of ``rho[k]`` at sample k; ``v`` = [u, d] per sample."""
-    values, idx = np.unique(rho, return_inverse=True)
-    A, B, C, D = _scheduled_matrices(family, m0, values, int(idx[0]))
-    drive = np.einsum("kij,kj->ki", B[idx], v)
-    x = np.empty((rho.size, m0.n))
-    xk = np.zeros(m0.n) if x0 is None else x0
-    with np.errstate(over="ignore", invalid="ignore"):
-        for k in range(rho.size):
-            x[k] = xk
-            xk = A[idx[k]] @ xk + drive[k]
-        y = np.einsum("kij,kj->ki", C[idx], x) + np.einsum("kij,kj->ki", D[idx], v)
-    return y, x

@@ -11,11 +11,15 @@ and :func:`~fdikit.simulate.time_grid` call these helpers; import the simulators
 * the memory check: the bytes a run's arrays need (:func:`simulation_bytes`) against the memory
   available (``MemAvailable`` of ``/proc/meminfo``, else ``os.sysconf``), refused at once with a
   ParameterError that gives both (:func:`check_memory`, :func:`sample_count`);
-* the non-finite-trace diagnosis: the DataError naming the first non-finite sample (index and
-  time) and signal of a run (:func:`refuse_non_finite`), and the likely cause — the unstable
-  eigenvalue (Re λ > 0, or |λ| > 1 when discrete) of the plant (:func:`linear_cause`), of the
-  Jacobian of a nonlinear plant (:func:`jacobian_text`) or of the most unstable frozen model of a
-  schedule (:func:`scheduled_cause`), or inputs too large for the float range.
+* the non-finite-trace diagnosis (:func:`refuse_non_finite`, :func:`linear_cause`,
+  :func:`jacobian_text`, :func:`scheduled_cause`), defined in :mod:`fdikit.simulate_diagnosis`
+  and re-exported here.
+
+Examples
+--------
+>>> from fdikit.simulate_checks import check_sample_time
+>>> check_sample_time(0.01)
+0.01
 """
 
 from __future__ import annotations
@@ -23,14 +27,14 @@ from __future__ import annotations
 import math
 import os
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 
 import numpy as np
 
 from fdikit import validate
 from fdikit.errors import DataError, FdiWarning, ParameterError
 from fdikit.faults import FaultScenario
-from fdikit.model import FaultModel
+from fdikit.simulate_diagnosis import jacobian_text, linear_cause, refuse_non_finite, scheduled_cause  # re-exported
 
 __all__ = [
     "check_noise",
@@ -60,7 +64,27 @@ def _number(name: str, value) -> float:
 
 
 def check_sample_time(dt) -> float:
-    """The sample time ``dt`` as a float: a finite number > 0 (ParameterError otherwise)."""
+    """The sample time ``dt`` as a float: a finite number > 0 (ParameterError otherwise).
+
+    Parameters
+    ----------
+    dt : float
+        Sample time [s].
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    ParameterError
+        For a non-number, NaN, ±inf, zero or a negative ``dt``.
+
+    Examples
+    --------
+    >>> check_sample_time(0.01)
+    0.01
+    """
     dt = _number("dt (the sample time)", dt)
     if not dt > 0:
         raise ParameterError(f"simulate: dt (the sample time) must be > 0, got {dt}")
@@ -68,7 +92,27 @@ def check_sample_time(dt) -> float:
 
 
 def check_duration(duration) -> float:
-    """The ``duration`` of a run as a float: a finite number >= 0 (ParameterError otherwise)."""
+    """The ``duration`` of a run as a float: a finite number >= 0 (ParameterError otherwise).
+
+    Parameters
+    ----------
+    duration : float
+        Length of the run [s] (0 gives one sample).
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    ParameterError
+        For a non-number, NaN, ±inf or a negative ``duration``.
+
+    Examples
+    --------
+    >>> check_duration(2)
+    2.0
+    """
     duration = _number("duration", duration)
     if not duration >= 0:
         raise ParameterError(f"simulate: duration must be >= 0, got {duration}")
@@ -76,7 +120,28 @@ def check_duration(duration) -> float:
 
 
 def check_times(t) -> np.ndarray:
-    """Given sample times: 1-D, non-empty, finite, strictly increasing and uniformly spaced (DataError)."""
+    """Given sample times: 1-D, non-empty, finite, strictly increasing and uniformly spaced (DataError).
+
+    Parameters
+    ----------
+    t : (N,) array_like
+        Sample times [s]; steps equal to a relative 1e-9.
+
+    Returns
+    -------
+    (N,) ndarray
+
+    Raises
+    ------
+    DataError
+        For non-numbers, an array that is not 1-D, an empty one, a non-finite time, or times that
+        are not strictly increasing or not uniformly spaced.
+
+    Examples
+    --------
+    >>> check_times([0, 0.1, 0.2]).tolist()
+    [0.0, 0.1, 0.2]
+    """
     try:
         t = np.asarray(t, dtype=float)
     except (TypeError, ValueError):
@@ -99,7 +164,30 @@ def check_times(t) -> np.ndarray:
 
 
 def check_rng(rng) -> tuple[np.random.Generator, int | None]:
-    """``numpy.random.default_rng(rng)`` and the integer seed (when one was given)."""
+    """``numpy.random.default_rng(rng)`` and the integer seed (when one was given).
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator, int or None
+        A generator (used as is), a seed >= 0, or None (fresh entropy).
+
+    Returns
+    -------
+    generator : numpy.random.Generator
+    seed : int or None
+        The seed, or None when ``rng`` was not an integer (stored in the trace's metadata).
+
+    Raises
+    ------
+    ParameterError
+        For a bool, str, bytes, float, a negative seed or anything ``default_rng`` refuses.
+
+    Examples
+    --------
+    >>> gen, seed = check_rng(7)
+    >>> type(gen).__name__, seed
+    ('Generator', 7)
+    """
     if isinstance(rng, bool) or isinstance(rng, str | bytes | float):
         raise ParameterError(f"simulate: rng must be a seed (an int >= 0) or a numpy.random.Generator, got {rng!r}")
     if isinstance(rng, int | np.integer) and rng < 0:
@@ -113,7 +201,27 @@ def check_rng(rng) -> tuple[np.random.Generator, int | None]:
 
 
 def check_scenario(scenario) -> FaultScenario:
-    """The scenario, an empty :class:`FaultScenario` for None (ParameterError for another type)."""
+    """The scenario, an empty :class:`~fdikit.faults.FaultScenario` for None (ParameterError for another type).
+
+    Parameters
+    ----------
+    scenario : FaultScenario or None
+        The faults of a run.
+
+    Returns
+    -------
+    FaultScenario
+
+    Raises
+    ------
+    ParameterError
+        When ``scenario`` is neither a FaultScenario nor None.
+
+    Examples
+    --------
+    >>> check_scenario(None)
+    FaultScenario([], label='none')
+    """
     if scenario is None:
         return FaultScenario()
     if not isinstance(scenario, FaultScenario):
@@ -123,7 +231,35 @@ def check_scenario(scenario) -> FaultScenario:
 
 
 def check_signal(name: str, value, t: np.ndarray, names: Sequence[str]) -> np.ndarray:
-    """(N, k) block from None (zeros), an array, or a callable ``t -> (k,)`` (DataError when unusable)."""
+    """(N, k) block from None (zeros), an array, or a callable ``t -> (k,)`` (DataError when unusable).
+
+    Parameters
+    ----------
+    name : str
+        The argument's name (``"u"``, ``"d"``), as the messages quote it.
+    value : None, (N, k) array_like or callable ``t -> (k,)``
+        The signal; with ``k == 1`` a 1-D array of N samples is accepted too.
+    t : (N,) ndarray
+        Sample times [s] (the callable is evaluated at each).
+    names : sequence of str
+        The ``k`` signal names (one column each).
+
+    Returns
+    -------
+    (N, k) ndarray
+
+    Raises
+    ------
+    DataError
+        When the callable raises or returns the wrong shape, the array holds non-numbers or has
+        the wrong shape, or an entry is not finite (the message gives signal, sample and time).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> check_signal("u", lambda t: [t, 1.0], np.arange(3) * 0.5, ("a", "b")).tolist()
+    [[0.0, 1.0], [0.5, 1.0], [1.0, 1.0]]
+    """
     k, N = len(names), t.size
     if value is None:
         return np.zeros((N, k))
@@ -189,7 +325,29 @@ def check_noise(std_name: str, std, cov_name: str, cov, k: int, what: str) -> np
 
 
 def check_initial_state(x0, states: Sequence[str]) -> np.ndarray | None:
-    """``x0`` as one finite float per state, or None when not given (ParameterError otherwise)."""
+    """``x0`` as one finite float per state, or None when not given (ParameterError otherwise).
+
+    Parameters
+    ----------
+    x0 : (n,) array_like or None
+        Initial state.
+    states : sequence of str
+        The plant's ``n`` state names.
+
+    Returns
+    -------
+    (n,) ndarray or None
+
+    Raises
+    ------
+    ParameterError
+        For non-numbers, the wrong shape or a non-finite entry.
+
+    Examples
+    --------
+    >>> check_initial_state([1, 2], ("pos", "vel")).tolist()
+    [1.0, 2.0]
+    """
     if x0 is None:
         return None
     try:
@@ -204,7 +362,26 @@ def check_initial_state(x0, states: Sequence[str]) -> np.ndarray | None:
 
 
 def warn_inactive(scenario: FaultScenario, t: np.ndarray) -> None:
-    """An FdiWarning for each fault that acts on no sample of the run (its onset after the end, say)."""
+    """An FdiWarning for each fault that acts on no sample of the run (its onset after the end, say).
+
+    Parameters
+    ----------
+    scenario : FaultScenario
+        The run's faults.
+    t : (N,) ndarray
+        Sample times [s].
+
+    Examples
+    --------
+    >>> import warnings
+    >>> import numpy as np
+    >>> from fdikit.faults import Bias, FaultScenario
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     warn_inactive(FaultScenario([Bias("y", 1.0, onset=5.0)]), np.arange(3.0))
+    >>> caught[0].category.__name__
+    'FdiWarning'
+    """
     for f in scenario:
         if t.size and not f.active(t).any():
             if f.onset > t[-1]:
@@ -246,7 +423,28 @@ def _available_memory(meminfo: str = "/proc/meminfo") -> tuple[float, str]:
 
 
 def check_memory(nbytes: float, what: str) -> None:
-    """Refuse (ParameterError) a run whose arrays need more than the available memory."""
+    """Refuse (ParameterError) a run whose arrays need more than the available memory.
+
+    Parameters
+    ----------
+    nbytes : float
+        Bytes the run's arrays need (:func:`simulation_bytes`).
+    what : str
+        The run, as the message names it.
+
+    Raises
+    ------
+    ParameterError
+        When ``nbytes`` exceeds the memory available (``MemAvailable`` of ``/proc/meminfo``, else
+        ``os.sysconf``); the message gives both and how to shorten the run.
+
+    Examples
+    --------
+    >>> check_memory(2.0**70, "a test run")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    fdikit.errors.ParameterError: a test run needs about 1.18e+21 bytes (1.02e+03 EiB) of memory ...
+    """
     available, source = _available_memory()
     if nbytes > available:
         raise ParameterError(
@@ -257,7 +455,24 @@ def check_memory(nbytes: float, what: str) -> None:
 
 
 def sample_count(duration: float, dt: float) -> int:
-    """``round(duration / dt) + 1`` samples, refusing counts that no memory holds before computing them."""
+    """``round(duration / dt) + 1`` samples, refusing counts that no memory holds before computing them.
+
+    Parameters
+    ----------
+    duration : float
+        Length of the run [s], checked (:func:`check_duration`).
+    dt : float
+        Sample time [s], checked (:func:`check_sample_time`).
+
+    Returns
+    -------
+    int
+
+    Examples
+    --------
+    >>> sample_count(1.0, 0.01)
+    101
+    """
     ratio = duration / dt
     if not math.isfinite(ratio) or ratio > 2.0**62:
         check_memory(math.inf if not math.isfinite(ratio) else 8.0 * ratio,
@@ -272,113 +487,25 @@ def simulation_bytes(N: int, n: int, p: int, m: int, nd: int, nv: int, label_cha
     the stacked and block-padded solver input (2 nv), states from the block solver and the trace
     (3 n), outputs with noise, faults and the trace copy (6 p), all float64; plus the truth labels
     (an object array and a str array of ``label_chars`` characters).
+
+    Parameters
+    ----------
+    N : int
+        Number of samples.
+    n, p, m, nd, nv : int
+        Numbers of states, outputs, controls, disturbances and stacked solver inputs.
+    label_chars : int
+        Characters of one sample's fault-truth label.
+
+    Returns
+    -------
+    float
+        Bytes.
+
+    Examples
+    --------
+    >>> simulation_bytes(101, 2, 1, 1, 0, 1, 0)
+    16968.0
     """
     floats = 1 + 3 * m + 2 * nd + 2 * nv + 3 * n + 6 * p
     return float(N) * (8.0 * floats + 8.0 + 4.0 * max(label_chars, 4))
-
-
-# ---------------------------------------------------------------------------------------------- non-finite results
-
-_FLOAT_RANGE_LOG = math.log(np.finfo(float).max)  # ln(1.8e308): a state growing like e^{at} overflows at a t ≈ 709.8
-
-
-def _eig_text(lam: complex) -> str:
-    """An eigenvalue as text: the real part alone when it is real."""
-    return f"{lam.real:.6g}" if lam.imag == 0 else f"{lam.real:.6g}{lam.imag:+.6g}j"
-
-
-def _instability(A: np.ndarray, discrete: bool, what: str = "A") -> str | None:
-    """The sentence naming the unstable eigenvalue of ``A``, or None when ``A`` is stable."""
-    A = np.asarray(A, dtype=float)
-    if A.size == 0 or not np.all(np.isfinite(A)):
-        return None
-    lam = np.linalg.eigvals(A)
-    if discrete:
-        i = int(np.argmax(np.abs(lam)))
-        r = float(abs(lam[i]))
-        if r <= 1.0:
-            return None
-        return (f"the plant is unstable: {what} has the eigenvalue λ = {_eig_text(lam[i])} with |λ| = {r:.6g} > 1, "
-                f"so its state grows like |λ|^k and leaves the float range after about "
-                f"{_FLOAT_RANGE_LOG / math.log(r):.4g} samples")
-    i = int(np.argmax(lam.real))
-    a = float(lam[i].real)
-    if a <= 0.0:
-        return None
-    return (f"the plant is unstable: {what} has the eigenvalue λ = {_eig_text(lam[i])} with Re λ = {a:.6g} > 0, "
-            f"so its state grows like exp({a:.3g} t) and leaves the float range after about "
-            f"{_FLOAT_RANGE_LOG / a:.4g} s")
-
-
-def _first_bad(t: np.ndarray, blocks: Sequence[tuple[str, np.ndarray, Sequence[str]]]) -> tuple[int, str] | None:
-    """Earliest non-finite sample over the (kind, array, names) blocks: (index, description)."""
-    best = None
-    for kind, arr, names in blocks:
-        if arr.size == 0:
-            continue
-        bad_rows = np.flatnonzero(~np.all(np.isfinite(arr), axis=1))
-        if bad_rows.size and (best is None or bad_rows[0] < best[0]):
-            k = int(bad_rows[0])
-            j = int(np.flatnonzero(~np.isfinite(arr[k]))[0])
-            best = (k, f"{kind} {names[j]!r} is {arr[k, j]}")
-    return best
-
-
-def refuse_non_finite(t, blocks, cause: Callable[[], str]) -> None:
-    """DataError naming the first non-finite sample and signal of the blocks and the likely cause."""
-    hit = _first_bad(t, blocks)
-    if hit is None:
-        return
-    k, what = hit
-    raise DataError(f"simulate would return a non-finite trace: {what} at sample {k} (t={t[k]:g} s) and after. "
-                    f"Likely cause: {cause()}")
-
-
-def linear_cause(model: FaultModel, v: np.ndarray) -> str:
-    """Why a linear run overflowed: the unstable eigenvalue, or inputs too large for the float range."""
-    text = _instability(model.A, model.is_discrete, "A" if not model.is_discrete else "the discrete A")
-    if text is not None:
-        return text + "; stabilise the plant (close a loop) or simulate a shorter run"
-    big = float(np.abs(v).max()) if v.size else 0.0
-    return (f"the plant is stable, so its inputs are too large for the float range (largest |input| = {big:.3g}, "
-            "faults included); scale the inputs or fault sizes down")
-
-
-def jacobian_text(f, tk: float, xk: np.ndarray, uk: np.ndarray) -> str:
-    """The largest-real-part eigenvalue of a central-difference Jacobian of ``f`` at ``xk`` (best effort)."""
-    try:
-        n = xk.size
-        J = np.empty((n, n))
-        with np.errstate(all="ignore"):
-            for i in range(n):
-                step = 1e-6 * max(1.0, abs(xk[i]))
-                e = np.zeros(n)
-                e[i] = step
-                J[:, i] = (np.asarray(f(tk, xk + e, uk), dtype=float) - np.asarray(f(tk, xk - e, uk), dtype=float)) \
-                    / (2 * step)
-        text = _instability(J, False, "the Jacobian of f at the last finite state")
-    except Exception:  # noqa: BLE001 - only a diagnosis
-        return ""
-    return f"; {text}" if text else ""
-
-
-def scheduled_cause(frozen_A: Callable[[np.ndarray], np.ndarray], rho: np.ndarray, x: np.ndarray) -> str:
-    """Why a scheduled run overflowed: the most unstable frozen model ``A(ρ)`` on the schedule before it did.
-
-    ``frozen_A(values)`` is the stack of the frozen ``A(ρ)`` at the distinct schedule ``values``
-    (sorted); ``x`` holds the run's states, one row per sample of ``rho``.
-    """
-    bad = np.flatnonzero(~np.all(np.isfinite(x), axis=1))
-    upto = rho[: int(bad[0])] if bad.size and bad[0] > 0 else rho
-    values = np.unique(upto)
-    try:
-        A = frozen_A(values)
-        radius = np.abs(np.linalg.eigvals(A)).max(axis=1)
-    except Exception:  # noqa: BLE001 - only a diagnosis
-        return "the inputs or the frozen models; check the family"
-    i = int(np.argmax(radius))
-    text = _instability(A[i], True, f"the frozen model A(ρ = {values[i]:g})")
-    if text is None:
-        return (f"every frozen model on the schedule is stable (largest |λ| = {radius[i]:.6g}), so the schedule's "
-                "variation or the inputs drive the growth; check the schedule rate and the inputs")
-    return text + "; stabilise the plant or simulate a shorter schedule"
