@@ -245,22 +245,27 @@ class FaultModel:
 
     @property
     def is_discrete(self) -> bool:
+        """Whether the model is discrete (``dt`` is a sample time)."""
         return self.dt is not None
 
     @property
     def controls(self) -> tuple[str, ...]:
+        """Control input names (group ``u``)."""
         return self.inputs["u"]
 
     @property
     def disturbances(self) -> tuple[str, ...]:
+        """Disturbance input names (group ``d``)."""
         return self.inputs["d"]
 
     @property
     def faults(self) -> tuple[str, ...]:
+        """Fault input names (group ``f``)."""
         return self.inputs["f"]
 
     @property
     def noise(self) -> tuple[str, ...]:
+        """Noise input names (group ``w``)."""
         return self.inputs["w"]
 
     def _slice(self, group: str) -> slice:
@@ -293,7 +298,10 @@ class FaultModel:
         return {_GROUP_WORD[g]: self.inputs[g] for g in GROUPS} | {"states": self.states, "outputs": self.outputs}
 
     def replace(self, **changes) -> FaultModel:
-        """A copy with some constructor arguments changed (e.g. ``Bf=..., faults=...``)."""
+        """A copy with some constructor arguments changed (e.g. ``Bf=..., faults=...``).
+
+        Raises :class:`ModelError` for an unknown argument name, or as the constructor does.
+        """
         kw = {"A": self.A, "C": self.C, "dt": self.dt} | self._blocks() | self._names_kw()
         unknown = set(changes) - set(kw)
         if unknown:
@@ -302,7 +310,27 @@ class FaultModel:
         return FaultModel(**kw)
 
     def index(self, kind: str, names: Sequence[str] | str) -> list[int]:
-        """Positions of named ``'states'``, ``'outputs'`` or inputs of a group (``'u'``, ``'d'``, ``'f'``, ``'w'``)."""
+        """Positions of named ``'states'``, ``'outputs'`` or inputs of a group (``'u'``, ``'d'``, ``'f'``, ``'w'``).
+
+        Parameters
+        ----------
+        kind : str
+            ``'states'``, ``'outputs'`` or a group.
+        names : str or sequence of str
+            The names to look up.
+
+        Returns
+        -------
+        list of int
+            Their 0-based positions, in the order given.
+
+        Raises
+        ------
+        ParameterError
+            If ``kind`` is not one of those.
+        ModelError
+            If a name is not in the model (the message lists the names it has).
+        """
         if isinstance(names, str):
             names = [names]
         if not isinstance(kind, str):
@@ -321,7 +349,10 @@ class FaultModel:
 
     # ------------------------------------------------------------------ fault channels
     def add_faults(self, names: Sequence[str], Bf, Df=None) -> FaultModel:
-        """Append fault inputs with given directions (``Bf`` n x k, ``Df`` p x k)."""
+        """Append fault inputs with given directions (``Bf`` n x k, ``Df`` p x k; ``Df`` default zero).
+
+        Raises :class:`ModelError` for a single string as ``names``, a wrong shape or a duplicate name.
+        """
         if isinstance(names, str):
             raise ModelError(
                 f"fault names must be a sequence of strings, got the single string {names!r}; use [{names!r}]"
@@ -339,6 +370,23 @@ class FaultModel:
 
         ``y = C x + ... + E_i μ_i`` with ``E_i`` the unit vector of output ``i``
         (Douglas et al. 1996, eq. (3.3)).  Fault names are ``"<output>_sensor"``.
+
+        Parameters
+        ----------
+        outputs : str or sequence of str
+            Output names.
+
+        Returns
+        -------
+        FaultModel
+            A copy with the new fault inputs appended to group ``f``.
+
+        Raises
+        ------
+        ParameterError
+            If ``outputs`` is empty.
+        ModelError
+            If an output is unknown or its fault input already exists.
         """
         if not isinstance(outputs, str) and len(outputs) == 0:
             raise ParameterError("outputs is empty; name at least one output whose sensor can fail")
@@ -353,6 +401,23 @@ class FaultModel:
         The fault direction is the control's column of ``Bu`` and ``Du`` (Douglas et al.
         1996, §3.2: "the direction of an engine throttle control fault is the first
         column of the B matrix").  Fault names are ``"<control>_actuator"``.
+
+        Parameters
+        ----------
+        controls : str or sequence of str
+            Control names.
+
+        Returns
+        -------
+        FaultModel
+            A copy with the new fault inputs appended to group ``f``.
+
+        Raises
+        ------
+        ParameterError
+            If ``controls`` is empty.
+        ModelError
+            If a control is unknown or its fault input already exists.
         """
         if not isinstance(controls, str) and len(controls) == 0:
             raise ParameterError("controls is empty; name at least one control whose actuator can fail")
@@ -361,7 +426,10 @@ class FaultModel:
 
     # ------------------------------------------------------------------ transformations
     def submodel(self, outputs: Sequence[str] | None = None, inputs: Sequence[str] | None = None) -> FaultModel:
-        """Keep only the named outputs and/or inputs (inputs of any group, by name)."""
+        """Keep only the named outputs and/or inputs (inputs of any group, by name).
+
+        ``None`` keeps all; the states are kept.  Raises :class:`ModelError` for an unknown name.
+        """
         C, D, kw = self.C, self.D, self._names_kw()
         if outputs is not None:
             rows = self.index("outputs", outputs)
@@ -386,6 +454,25 @@ class FaultModel:
 
         ``method`` is any of :func:`scipy.signal.cont2discrete`'s (``'zoh'`` is exact
         for piecewise-constant inputs).
+
+        Parameters
+        ----------
+        dt : float
+            Sample time [s], positive.
+        method : str, default "zoh"
+            ``'zoh'``, ``'foh'``, ``'bilinear'``, ``'euler'``, ``'backward_diff'`` or ``'impulse'``.
+
+        Returns
+        -------
+        FaultModel
+            The discrete model.
+
+        Raises
+        ------
+        ModelError
+            If the model is already discrete.
+        ParameterError
+            If ``dt`` is not positive or ``method`` is unknown.
         """
         import scipy.signal
 
@@ -412,6 +499,18 @@ class FaultModel:
 
         ``z = jω`` in continuous time and ``e^{jω dt}`` in discrete time; ``group``
         restricts the inputs to one group (``'u'``, ``'d'``, ``'f'``, ``'w'``).
+
+        Parameters
+        ----------
+        omega : array_like
+            Frequencies [rad/s].
+        group : str, optional
+            One input group; default all inputs.
+
+        Returns
+        -------
+        numpy.ndarray
+            Complex (len(omega), p, k) array.
         """
         omega = validate.as_vector("omega (rad/s)", omega)
         B, D = (self.B, self.D) if group is None else (self.b(group), self.d(group))
@@ -444,6 +543,9 @@ class FaultModel:
 
         Inputs named in ``disturbances``, ``faults`` or ``noise`` go to those groups;
         ``controls`` defaults to every remaining input, in the system's order.
+
+        Raises :class:`ModelError` if ``sys`` is no :class:`control.StateSpace`, a named input does not
+        exist, or the sample time is unspecified (``dt=True``).
         """
         import control
 
