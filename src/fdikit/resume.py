@@ -67,7 +67,23 @@ _KEY = re.compile(r"^[A-Za-z0-9_.-]{1,100}$")
 
 
 def option_name(name: str) -> str:
-    """``'runs_per_fault'`` → ``"runs_per_fault (--runs-per-fault)"``: how messages name an argument."""
+    """``'runs_per_fault'`` → ``"runs_per_fault (--runs-per-fault)"``: how messages name an argument.
+
+    Parameters
+    ----------
+    name : str
+        The Python parameter name.
+
+    Returns
+    -------
+    str
+        The name followed by its command-line option in parentheses.
+
+    Examples
+    --------
+    >>> option_name("runs_per_fault")
+    'runs_per_fault (--runs-per-fault)'
+    """
     return f"{name} (--{name.replace('_', '-')})"
 
 
@@ -83,6 +99,33 @@ def check_count(value, name: str, minimum: int = 1) -> int:
 
     :func:`fdikit.validate.integer` does the check; the message keeps the command-line wording
     (the argument both as parameter and as option, and the accepted range).
+
+    Parameters
+    ----------
+    value : int
+        The count (an ``int`` or numpy integer; a bool or float is refused).
+    name : str
+        The parameter name, as the message quotes it (with its option, :func:`option_name`).
+    minimum : int, default 1
+        Smallest accepted value.
+
+    Returns
+    -------
+    int
+
+    Raises
+    ------
+    ParameterError
+        When ``value`` is not an integer or is below ``minimum``.
+
+    Examples
+    --------
+    >>> check_count(3, "runs_per_fault")
+    3
+    >>> check_count(0, "runs_per_fault")
+    Traceback (most recent call last):
+    ...
+    fdikit.errors.ParameterError: runs_per_fault (--runs-per-fault) must be an integer >= 1, got 0
     """
     try:
         return validate.integer(name, value, minimum=minimum)
@@ -91,13 +134,60 @@ def check_count(value, name: str, minimum: int = 1) -> int:
 
 
 def check_seed(value, name: str = "seed") -> int:
-    """A seed: an integer ``>= 0`` (what :func:`numpy.random.default_rng` accepts)."""
+    """A seed: an integer ``>= 0`` (what :func:`numpy.random.default_rng` accepts).
+
+    Parameters
+    ----------
+    value : int
+        The seed.
+    name : str, default "seed"
+        The parameter name, as the message quotes it.
+
+    Returns
+    -------
+    int
+
+    Examples
+    --------
+    >>> check_seed(0)
+    0
+    """
     return check_count(value, name, minimum=0)
 
 
 def check_positive(value, name: str, *, maximum: float | None = None, hint: str = "") -> float:
     """``value`` as a finite float ``> 0`` (and ``<= maximum`` when given): :func:`fdikit.validate.positive`
-    with the command-line wording."""
+    with the command-line wording.
+
+    Parameters
+    ----------
+    value : float
+        The number to check.
+    name : str
+        The parameter name, as the message quotes it (with its option).
+    maximum : float, optional
+        Largest accepted value (no bound when omitted).
+    hint : str, optional
+        Appended to the message (what the argument is, what is usual).
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    ParameterError
+        When ``value`` is not a finite number > 0, or exceeds ``maximum``.
+
+    Examples
+    --------
+    >>> check_positive(0.05, "alpha", maximum=1)
+    0.05
+    >>> check_positive(2.0, "alpha", maximum=1)
+    Traceback (most recent call last):
+    ...
+    fdikit.errors.ParameterError: alpha (--alpha) must be at most 1, got 2
+    """
     try:
         value = validate.positive(name, value)
     except ParameterError:
@@ -108,7 +198,29 @@ def check_positive(value, name: str, *, maximum: float | None = None, hint: str 
 
 
 def check_nonnegative(value, name: str) -> float:
-    """``value`` as a finite float ``>= 0``: :func:`fdikit.validate.non_negative` with the command-line wording."""
+    """``value`` as a finite float ``>= 0``: :func:`fdikit.validate.non_negative` with the command-line wording.
+
+    Parameters
+    ----------
+    value : float
+        The number to check.
+    name : str
+        The parameter name, as the message quotes it (with its option).
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    ParameterError
+        When ``value`` is not a finite number >= 0.
+
+    Examples
+    --------
+    >>> check_nonnegative(0, "onset")
+    0.0
+    """
     try:
         return validate.non_negative(name, value)
     except ParameterError:
@@ -118,10 +230,31 @@ def check_nonnegative(value, name: str) -> float:
 def check_output_file(path, name: str = "out") -> Path:
     """Check that the file ``path`` can be written (its folder is created); it is not written here.
 
+    Parameters
+    ----------
+    path : str or PathLike
+        The file to be written.
+    name : str, default "out"
+        The parameter name, as the messages quote it (with its option).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+
     Raises
     ------
     ParameterError
-        When ``path`` is a folder, or its folder cannot be created or written into.
+        When ``path`` is not a path, is a folder, or its folder cannot be created or written into.
+
+    Examples
+    --------
+    >>> import pathlib
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     out = check_output_file(pathlib.Path(tmp) / "new" / "trace.parquet")
+    ...     out.name, out.parent.is_dir(), out.exists()
+    ('trace.parquet', True, False)
     """
     if not isinstance(path, (str, os.PathLike)) or str(path) == "":
         raise ParameterError(f"{option_name(name)} must be a file path, got {path!r}")
@@ -139,10 +272,30 @@ def check_output_file(path, name: str = "out") -> Path:
 def check_output_folder(out, name: str = "out") -> Path:
     """Create the output folder ``out`` if needed and check that files can be written into it.
 
+    Parameters
+    ----------
+    out : str or PathLike
+        The output folder (parents are created too).
+    name : str, default "out"
+        The parameter name, as the messages quote it (with its option).
+
+    Returns
+    -------
+    pathlib.Path
+        ``out``, which now exists.
+
     Raises
     ------
     ParameterError
-        When ``out`` is an existing file, cannot be created, or is not writable.
+        When ``out`` is not a path, is an existing file, cannot be created, or is not writable.
+
+    Examples
+    --------
+    >>> import pathlib
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     check_output_folder(pathlib.Path(tmp) / "runs").is_dir()
+    True
     """
     if not isinstance(out, (str, os.PathLike)) or str(out) == "":
         raise ParameterError(f"{option_name(name)} must be a folder path, got {out!r}")
@@ -196,14 +349,40 @@ class RunStore:
         The command name, e.g. ``"multiple-model"``.
     arguments : mapping
         Every argument that changes a result (JSON-serialisable).
-    fresh : bool
+    fresh : bool, default False
         Start over in a new parts folder even when ``out`` holds a resumable run.
+    out_name : str, default "out"
+        The name of ``out`` in the messages (with its option).
+
+    Attributes
+    ----------
+    out : pathlib.Path
+        The output folder.
+    parts : pathlib.Path
+        The parts folder of this run, ``out/parts-<token>``.
+    fingerprint : str
+        SHA-256 of command, arguments and fdikit version.
+    resumed : bool
+        Whether an earlier run of the same arguments is resumed.
+    rejected : list of str
+        Keys of parts that existed but failed a check (recomputed).
 
     Raises
     ------
     ParameterError
         When ``out`` is unusable, its ``run.json`` is unreadable, or it holds a run of other arguments
         and ``fresh`` is false.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     store = RunStore(tmp, "demo", {"seed": 1})
+    ...     store.save("a", {"x": (1, 2)})
+    ...     again = RunStore(tmp, "demo", {"seed": 1})
+    ...     again.resumed, again.load("a"), again.load("b")
+    {'x': [1, 2]}
+    (True, {'x': [1, 2]}, None)
     """
 
     def __init__(self, out, command: str, arguments: Mapping, *, fresh: bool = False, out_name: str = "out"):
