@@ -158,8 +158,8 @@ class FaultModel:
     --------
     >>> m = FaultModel(A=[[0.0, 1.0], [0.0, -0.5]], C=[[1.0, 0.0]], Bu=[[0.0], [1.0]],
     ...                states=["pos", "vel"], outputs=["pos_meas"], controls=["force"])
-    >>> m, m.Bu.shape, m.discretize(0.1).dt
-    (FaultModel(continuous, n=2, p=1, u=1, d=0, f=0, w=0), (2, 1), 0.1)
+    >>> m, m.Bu.shape, m.with_sensor_faults(["pos_meas"]).faults
+    (FaultModel(continuous, n=2, p=1, u=1, d=0, f=0, w=0), (2, 1), ('pos_meas_sensor',))
     """
 
     A: np.ndarray

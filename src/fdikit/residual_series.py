@@ -154,12 +154,7 @@ class Residuals:
         Returns
         -------
         pandas.DataFrame
-            Indexed by ``t`` (index name ``"t"``).
-
-        Examples
-        --------
-        >>> list(Residuals(np.arange(2.0), np.zeros((2, 1)), ("r",), ()).to_pandas().columns)
-        ['r', 'valid', 'recovering']
+            Indexed by ``t`` (index name ``"t"``); columns the residual names, ``valid``, ``recovering``.
         """
         import pandas as pd
 
