@@ -12,7 +12,8 @@ import pytest
 
 from fdikit import FaultModel
 from fdikit import fault_maps as fmaps
-from fdikit.analysis.gains import fault_to_residual_gain, fdi_report
+from fdikit.analysis.gains import fault_to_residual_gain
+from fdikit.analysis.geometry import fdi_report
 from fdikit.design.game.multi_fault import game_filter
 from fdikit.design.game.reduced_order import goh_detector
 from fdikit.design.game.setup import game_problem

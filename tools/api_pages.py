@@ -18,6 +18,9 @@ API = ROOT / "docs" / "api"
 #: Package pages in site order: (page file stem, package dotted name, title).
 PAGES = [
     ("core", "fdikit", "Core: models, faults, simulation, traces, residuals, diagnoses"),
+    ("linalg", "fdikit.linalg", "Linear algebra: subspaces and detection geometry"),
+    ("validate", "fdikit.validate", "Argument validation"),
+    ("residuals", "fdikit.residuals", "Residual generation"),
     ("plants", "fdikit.plants", "Plants"),
     ("design-observers", "fdikit.design.observers", "Design: observer-type filters"),
     ("design-game", "fdikit.design.game", "Design: game-theoretic filters"),

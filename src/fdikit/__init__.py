@@ -9,7 +9,7 @@ The layers, from data to decisions (``docs/ARCHITECTURE.md``):
 * residual generation — :mod:`fdikit.design` (observers, game, parity families), :mod:`fdikit.residuals`;
 * decisions — :mod:`fdikit.decision` (evaluators), :mod:`fdikit.multimodel` (banks of estimators),
   :mod:`fdikit.estimate` (fault sizes), :mod:`fdikit.diagnosis`, :mod:`fdikit.metrics`, :mod:`fdikit.compare`;
-* analysis and plots — :mod:`fdikit.analysis`, :mod:`fdikit.linalg` (+ :mod:`fdikit.subspaces`,
+* analysis and plots — :mod:`fdikit.analysis`, :mod:`fdikit.linalg` (+ :mod:`fdikit.linalg.subspaces`,
   :mod:`fdikit.fault_maps`), :mod:`fdikit.plots`;
 * infrastructure — :mod:`fdikit.errors`, :mod:`fdikit.validate`, :mod:`fdikit.atomic`, :mod:`fdikit.resume`,
   :mod:`fdikit.protocols`;

@@ -56,7 +56,7 @@ from fdikit.simulate_checks import (
     warn_inactive,
 )
 from fdikit.simulate_diagnosis import jacobian_text, linear_cause, refuse_non_finite, scheduled_cause
-from fdikit.simulate_varying import _frozen_A, _simulate_varying
+from fdikit.simulate_varying import frozen_A, simulate_varying
 from fdikit.trace import Trace
 
 __all__ = ["NonlinearPlant", "simulate", "simulate_scheduled", "time_grid"]
@@ -537,7 +537,7 @@ def simulate_scheduled(
     N, n, p = rho.size, m0.n, len(m0.outputs)
     scenario = scenario.resolve(m0.outputs, m0.controls)
     nv = len(m0.controls) + len(m0.disturbances)
-    # the per-sample matrix gathers of _simulate_varying: B, C, D (A is indexed sample by sample)
+    # the per-sample matrix gathers of simulate_varying: B, C, D (A is indexed sample by sample)
     need = simulation_bytes(N, n, p + 1, len(m0.controls), len(m0.disturbances), nv,
                              sum(len(f.name) + 1 for f in scenario)) + 8.0 * N * (n * nv + p * n + p * nv)
     check_memory(need, f"simulate_scheduled of {N} samples")
@@ -551,10 +551,10 @@ def simulate_scheduled(
     if np.all(rho == rho[0]):
         y, x = _simulate_linear(m0, m0.dt, t, u_act, d_arr, x0, None, None)
     else:
-        y, x = _simulate_varying(family, m0, rho, np.hstack([u_act, d_arr]), x0)
+        y, x = simulate_varying(family, m0, rho, np.hstack([u_act, d_arr]), x0)
         with np.errstate(over="ignore", invalid="ignore"):
             refuse_non_finite(t, [("state", x, m0.states), ("output", y, m0.outputs)],
-                              lambda: scheduled_cause(lambda values: _frozen_A(family, m0, rho, values), rho, x))
+                              lambda: scheduled_cause(lambda values: frozen_A(family, m0, rho, values), rho, x))
         np.add(y, 0.0, out=y)
         np.add(x, 0.0, out=x)
     y = _apply_faults(scenario, "sensor", t, y, m0.outputs, rng_f)

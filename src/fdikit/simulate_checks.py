@@ -1,4 +1,4 @@
-"""Argument checks, the memory check and the non-finite-trace diagnosis of :mod:`fdikit.simulate`.
+"""Argument checks and the memory check of :mod:`fdikit.simulate`.
 
 An internal module: :func:`fdikit.simulate.simulate`, :func:`~fdikit.simulate.simulate_scheduled`
 and :func:`~fdikit.simulate.time_grid` call these helpers; import the simulators from
@@ -11,9 +11,7 @@ and :func:`~fdikit.simulate.time_grid` call these helpers; import the simulators
 * the memory check: the bytes a run's arrays need (:func:`simulation_bytes`) against the memory
   available (``MemAvailable`` of ``/proc/meminfo``, else ``os.sysconf``), refused at once with a
   ParameterError that gives both (:func:`check_memory`, :func:`sample_count`);
-* the non-finite-trace diagnosis (:func:`refuse_non_finite`, :func:`linear_cause`,
-  :func:`jacobian_text`, :func:`scheduled_cause`), defined in :mod:`fdikit.simulate_diagnosis`
-  and re-exported here.
+* (the non-finite-trace diagnosis is :mod:`fdikit.simulate_diagnosis`).
 
 Examples
 --------
@@ -34,7 +32,6 @@ import numpy as np
 from fdikit import validate
 from fdikit.errors import DataError, FdiWarning, ParameterError
 from fdikit.faults import FaultScenario
-from fdikit.simulate_diagnosis import jacobian_text, linear_cause, refuse_non_finite, scheduled_cause  # re-exported
 
 __all__ = [
     "check_noise",
@@ -46,11 +43,7 @@ __all__ = [
     "check_scenario",
     "check_signal",
     "check_times",
-    "jacobian_text",
-    "linear_cause",
-    "refuse_non_finite",
     "sample_count",
-    "scheduled_cause",
     "simulation_bytes",
     "warn_inactive",
 ]

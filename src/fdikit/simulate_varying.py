@@ -13,11 +13,41 @@ import numpy as np
 from fdikit.errors import ModelError
 from fdikit.model import FaultModel
 
-__all__: list[str] = []
+__all__ = ["frozen_A", "simulate_varying"]
 
 
-def _frozen_A(family, m0: FaultModel, rho: np.ndarray, values: np.ndarray) -> np.ndarray:
-    """The stack of frozen ``A(ρ)`` at the distinct schedule ``values`` (which hold ``rho[0]``, the ρ of ``m0``)."""
+def frozen_A(family, m0: FaultModel, rho: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """The stack of frozen ``A(ρ)`` at the distinct schedule ``values`` (which hold ``rho[0]``, the ρ of ``m0``).
+
+    Parameters
+    ----------
+    family : callable
+        ``ρ -> FaultModel`` (discrete), optionally with a vectorised ``family.state_space(values)``.
+    m0 : FaultModel
+        ``family(rho[0])``.
+    rho : (N,) array
+        The schedule of the run.
+    values : (K,) array
+        Sorted distinct schedule values.
+
+    Returns
+    -------
+    (K, n, n) array
+        ``A(values[i])``.
+
+    Raises
+    ------
+    ModelError
+        When the family's models disagree with ``m0`` in names, sizes or ``dt``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit import FaultModel
+    >>> fam = lambda r: FaultModel(A=[[r]], C=[[1.0]], Bu=[[1.0]], dt=0.1)
+    >>> frozen_A(fam, fam(0.5), np.array([0.5, 0.8]), np.array([0.5, 0.8])).ravel().tolist()
+    [0.5, 0.8]
+    """
     return _scheduled_matrices(family, m0, values, int(np.searchsorted(values, rho[0])))[0]
 
 
@@ -42,8 +72,39 @@ def _scheduled_matrices(family, m0: FaultModel, values: np.ndarray, i0: int) -> 
                                             for m in models]))
 
 
-def _simulate_varying(family, m0: FaultModel, rho: np.ndarray, v: np.ndarray, x0: np.ndarray | None):
-    """Outputs and states with the model of ``rho[k]`` at sample k; ``v`` = [u, d] per sample."""
+def simulate_varying(family, m0: FaultModel, rho: np.ndarray, v: np.ndarray, x0: np.ndarray | None):
+    """Outputs and states with the model of ``rho[k]`` at sample k; ``v`` = [u, d] per sample.
+
+    Parameters
+    ----------
+    family, m0, rho :
+        As :func:`frozen_A`.
+    v : (N, m + nd) array
+        Controls and disturbances per sample.
+    x0 : (n,) array or None
+        Initial state (zero when None).
+
+    Returns
+    -------
+    y : (N, p) array
+        Outputs.
+    x : (N, n) array
+        States, ``x[0] = x0``.
+
+    Raises
+    ------
+    ModelError
+        As :func:`frozen_A`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit import FaultModel
+    >>> fam = lambda r: FaultModel(A=[[r]], C=[[1.0]], Bu=[[1.0]], dt=0.1)
+    >>> y, x = simulate_varying(fam, fam(0.5), np.array([0.5, 0.5, 0.8]), np.ones((3, 1)), None)
+    >>> y.ravel().tolist()
+    [0.0, 1.0, 1.5]
+    """
     values, idx = np.unique(rho, return_inverse=True)
     A, B, C, D = _scheduled_matrices(family, m0, values, int(idx[0]))
     drive = np.einsum("kij,kj->ki", B[idx], v)

@@ -14,16 +14,11 @@ import pytest
 
 from fdikit import FaultModel, ModelError
 from fdikit import fault_maps as fm
-from fdikit.analysis.gains import (
-    GainTable,
-    default_freqs,
-    fault_to_residual_gain,
-    fdi_report,
-    resolve_fault,
-    structure_matrix,
-)
+from fdikit.analysis.gains import GainTable, default_freqs, fault_to_residual_gain, structure_matrix
+from fdikit.analysis.geometry import fdi_report
 from fdikit.design import observer_generator
 from fdikit.errors import DesignError, ParameterError
+from fdikit.fault_maps import resolve_fault
 from fdikit.plants.path_vehicle import path_vehicle_12, path_vehicle_14
 
 a = np.array([-1.0, -2.0, -3.0])

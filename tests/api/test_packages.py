@@ -71,3 +71,30 @@ def test_package_import_is_light(package):
     code = f"import sys, {package}; print(','.join(m for m in {HEAVY!r} if m in sys.modules))"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip()
     assert out == "", f"import {package} loads {out}; import them inside the functions that need them"
+
+
+def test_no_module_imports_another_modules_private_names():
+    import ast
+
+    found = []
+    for path in sorted(SRC.rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("fdikit"):
+                private = [a.name for a in node.names if a.name.startswith("_") and a.name != "__version__"]
+                if private:
+                    found.append(f"{path.relative_to(SRC.parent)}: from {node.module} import {', '.join(private)}")
+    assert not found, "private names imported across modules (make them public or move them):\n" + "\n".join(found)
+
+
+def test_no_module_re_exports_another_modules_names_in_its_all():
+    # A name belongs to the module that defines it; only package __init__ files collect names of their modules.
+    found = []
+    for module in MODULES:
+        if module == "fdikit.cli":
+            continue
+        mod = importlib.import_module(module)
+        for n in mod.__all__:
+            home = getattr(getattr(mod, n), "__module__", module)
+            if callable(getattr(mod, n)) and home != module and home.startswith("fdikit"):
+                found.append(f"{module}.{n} is defined in {home}")
+    assert not found, "\n".join(found)

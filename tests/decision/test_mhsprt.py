@@ -8,15 +8,9 @@ from scipy import integrate
 from scipy.special import erf, logsumexp
 from scipy.stats import multivariate_normal, norm
 
-from fdikit.decision.mhsprt import (
-    GaussianDensity,
-    MhsprtEvaluator,
-    UniformMeanDensity,
-    gaussian_mean_density,
-    magnitude_blocks,
-    shiryayev_dp,
-    shiryayev_threshold,
-)
+from fdikit.decision.densities import GaussianDensity, UniformMeanDensity, gaussian_mean_density
+from fdikit.decision.mhsprt import MhsprtEvaluator, magnitude_blocks
+from fdikit.decision.shiryayev import shiryayev_dp, shiryayev_threshold
 from fdikit.errors import DataError, ParameterError
 from fdikit.residuals import Residuals
 

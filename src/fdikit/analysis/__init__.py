@@ -13,8 +13,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
     __name__,
     submod_attrs={
         "gains": [
-            "FaultGeometry", "FdiReport", "GainTable", "default_freqs", "fault_to_residual_gain", "fdi_report",
-            "resolve_fault", "structure_matrix",
+            "GainTable", "default_freqs", "fault_to_residual_gain", "structure_matrix",
         ],
         "geometry": [
             "FaultGeometry", "FdiReport", "fdi_report",

@@ -28,9 +28,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from fdikit import validate
-from fdikit.analysis.geometry import FaultGeometry, FdiReport, fdi_report
 from fdikit.errors import ModelError, ParameterError
-from fdikit.fault_maps import check_fault_inputs, resolve_fault
+from fdikit.fault_maps import check_fault_inputs
 from fdikit.model import FaultModel
 from fdikit.residuals import ResidualGenerator
 
@@ -38,10 +37,6 @@ __all__ = [
     "GainTable",
     "fault_to_residual_gain",
     "structure_matrix",
-    "FaultGeometry",
-    "FdiReport",
-    "fdi_report",
-    "resolve_fault",
     "default_freqs",
 ]
 

@@ -56,8 +56,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
             "SprtEvaluator", "sprt_asn", "sprt_thresholds",
         ],
         "mhsprt": [
-            "GaussianDensity", "MhsprtEvaluator", "ShiryayevDP", "UniformMeanDensity", "gaussian_mean_density",
-            "magnitude_blocks", "shiryayev_dp", "shiryayev_threshold",
+            "MhsprtEvaluator", "magnitude_blocks",
         ],
         "shiryayev": [
             "ShiryayevDP", "shiryayev_dp", "shiryayev_threshold",

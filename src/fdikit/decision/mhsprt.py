@@ -36,21 +36,14 @@ from fdikit.decision.densities import (
     UniformMeanDensity,
     gaussian_mean_density,
 )
-from fdikit.decision.shiryayev import ShiryayevDP, shiryayev_dp, shiryayev_threshold
 from fdikit.diagnosis import UNKNOWN_FAULT, Diagnosis, StepDecision
 from fdikit.errors import DataError, ParameterError
 from fdikit.faults import NO_FAULT
 from fdikit.residuals import Residuals
 
 __all__ = [
-    "GaussianDensity",
     "MhsprtEvaluator",
-    "ShiryayevDP",
-    "UniformMeanDensity",
-    "gaussian_mean_density",
     "magnitude_blocks",
-    "shiryayev_dp",
-    "shiryayev_threshold",
 ]
 
 _LOG2PI = np.log(2.0 * np.pi)

@@ -70,7 +70,8 @@ __getattr__, __dir__, __all__ = lazy.attach(
             "ConvexModelSet", "convex_model_set", "limit_value_convex_set",
         ],
         "convex_filter": [
-            "ConvexFilterResult", "dual_convex_filter", "innovation_regressors", "rls_weight_step", "weight_regressors",
+            "ConvexFilterResult", "dual_convex_filter", "innovation_regressors", "rls_weight_step",
+            "weight_regressors",
         ],
         "reconstruction": [
             "estimated_model_vector", "fault_size_from_weights", "lv_parameter", "lv_reciprocal_parameter",

@@ -14,13 +14,10 @@ from scipy.special import zeta
 from scipy.stats import multivariate_normal, norm
 
 import fdikit.decision.learned.bnn as bnn_module
-from fdikit.decision.learned.bnn import (
-    BnnEvaluator,
-    BnnNetwork,
-    quasi_newton,
-    robbins_monro_steps,
-)
+from fdikit.decision.learned.bnn import BnnEvaluator
 from fdikit.decision.learned.gaussian_ml import GaussianMlEvaluator
+from fdikit.decision.learned.network import BnnNetwork
+from fdikit.decision.learned.quasi_newton import quasi_newton, robbins_monro_steps
 from fdikit.errors import DataError, ParameterError
 from fdikit.residuals import Residuals
 

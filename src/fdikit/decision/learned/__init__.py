@@ -20,8 +20,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
     __name__,
     submod_attrs={
         "bnn": [
-            "BnnEvaluator", "BnnNetwork", "QuasiNewtonResult", "TrainingReport", "quasi_newton",
-            "robbins_monro_steps",
+            "BnnEvaluator", "TrainingReport",
         ],
         "network": [
             "BnnNetwork",

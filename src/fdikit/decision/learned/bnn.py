@@ -69,7 +69,7 @@ from scipy.special import expit
 from fdikit.decision.common import checked_residuals, step_vector
 from fdikit.decision.learned.labelled_runs import LabelledInputs, as_runs, one_hot_targets, posterior_decisions
 from fdikit.decision.learned.network import BnnNetwork
-from fdikit.decision.learned.quasi_newton import QuasiNewtonResult, quasi_newton, robbins_monro_steps
+from fdikit.decision.learned.quasi_newton import quasi_newton, robbins_monro_steps
 from fdikit.diagnosis import Diagnosis, StepDecision
 from fdikit.errors import DataError, ParameterError
 from fdikit.faults import NO_FAULT
@@ -77,11 +77,7 @@ from fdikit.residuals import Residuals
 
 __all__ = [
     "BnnEvaluator",
-    "BnnNetwork",
-    "QuasiNewtonResult",
     "TrainingReport",
-    "quasi_newton",
-    "robbins_monro_steps",
 ]
 
 

@@ -29,7 +29,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
     __name__,
     submod_attrs={
         "setup": [
-            "GameProblem", "game_problem", "weight",
+            "GameProblem", "game_problem", "per_target", "weight",
         ],
         "riccati": [
             "RiccatiSolution", "game_cost", "game_riccati", "hamiltonian_margin", "solve_game_are",

@@ -23,7 +23,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
             "ObserverDesign", "kalman", "observer", "observer_generator", "unobservable_modes",
         ],
         "beard_jones": [
-            "BeardJonesDesign", "RestrictedDiagonalDesign", "beard_jones", "resolve_faults", "restricted_diagonal",
+            "BeardJonesDesign", "RestrictedDiagonalDesign", "beard_jones", "restricted_diagonal",
         ],
         "uio": [
             "UIODesign", "uio", "uio_bank", "unknown_input_matrix",

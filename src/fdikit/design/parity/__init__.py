@@ -34,7 +34,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
         "polynomial": ["PolynomialParityDesign", "parity_filter"],
         "polynomial_rank": [
             "RankTest", "bar", "bar_matrices", "detectability", "isolability", "left_null_space", "minimal_degree",
-            "normal_rank", "time_varying_bar",
+            "normal_rank", "target_fault", "time_varying_bar",
         ],
         "scheduled": ["scheduled_parity_filter"],
         "scheduled_window": ["lpv_bar_matrices", "lpv_parity_row", "lpv_rank_test"],

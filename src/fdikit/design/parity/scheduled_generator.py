@@ -31,8 +31,8 @@ from fdikit.design.parity.scheduled_window import lpv_parity_row
 from fdikit.errors import DataError, DesignError, ModelError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import no_internal_form
-from fdikit.residuals import Residuals, check_signals
-from fdikit.trace import Trace
+from fdikit.residuals import Residuals
+from fdikit.trace import Trace, check_signals
 
 __all__ = [
     "ScheduledResidualGenerator",

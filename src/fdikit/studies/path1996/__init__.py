@@ -22,7 +22,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
         ],
         "demo": [
             "ACTUATOR_NOISE_STD", "BankDemoResult", "DemoResult", "SENSOR_NOISE_STD", "check_demo_arguments",
-            "demo_model", "run_demo", "run_kalman_demo",
+            "demo_model", "plot_bank_report", "run_demo", "run_kalman_demo",
         ],
     },
 )

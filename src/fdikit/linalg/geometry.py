@@ -1,9 +1,7 @@
-"""Subspaces and the geometry of detection filters.
+"""The geometry of detection filters: CAISA, invariant zeros, detection spaces, separability, projectors.
 
-Orthonormal bases and SVD rank decisions throughout; every tolerance scales with the
+Built on the subspace primitives of :mod:`fdikit.linalg.subspaces`; every tolerance scales with the
 data (``1e3 · max(shape) · eps · σ_max`` by default, or a caller's relative tolerance).
-The subspace primitives (``rank``, ``orth``, ``null``, ``intersect``, ``span_sum``,
-``contains``) are defined in :mod:`fdikit.subspaces` and re-exported here.
 The fault maps ``F`` these functions take are built by :mod:`fdikit.fault_maps`.
 
 * the minimal (C, A)-invariant subspace containing ``F`` by CAISA (App. A, Theorem A.1,
@@ -23,16 +21,10 @@ import scipy.linalg
 
 from fdikit import validate
 from fdikit.errors import ParameterError
-from fdikit.subspaces import _EPS, _mat, _rtol, contains, intersect, null, orth, rank, span_sum  # re-exported
+from fdikit.linalg.subspaces import EPS, as_2d, checked_rtol, intersect, null, orth, rank, span_sum
 
 __all__ = [
     "output_projector",
-    "rank",
-    "orth",
-    "null",
-    "intersect",
-    "span_sum",
-    "contains",
     "caisa",
     "invariant_zeros",
     "detection_space",
@@ -95,7 +87,7 @@ def caisa(A: np.ndarray, C: np.ndarray, F: np.ndarray, rtol: float | None = None
     ((3, 1), True)
     """
     A, C, F = _system(A, C, F)
-    rtol = _rtol(rtol)
+    rtol = checked_rtol(rtol)
     kerC = null(C, rtol)
     W = orth(F, rtol)
     for _ in range(A.shape[0] + 1):
@@ -170,11 +162,11 @@ def invariant_zeros(
     from slycot import ab08nd
 
     A, C, F = _system(A, C, F)
-    rtol = _rtol(rtol)
+    rtol = checked_rtol(rtol)
     n, k, p = A.shape[0], F.shape[1], C.shape[0]
     if n == 0:
         return np.zeros(0, dtype=complex), []
-    tol = rtol if rtol is not None else 1e5 * (n + max(p, k)) * _EPS
+    tol = rtol if rtol is not None else 1e5 * (n + max(p, k)) * EPS
     out = ab08nd(n, k, p, A, F, C, np.zeros((p, k)), equil="N", tol=tol)
     nu = out[0]
     if nu == 0:
@@ -189,7 +181,7 @@ def invariant_zeros(
 def _null_direction(M: np.ndarray, E: np.ndarray, z: complex, n: int) -> np.ndarray:
     """State part of the right singular vector of ``M − zE`` for its smallest singular value."""
     x = np.linalg.svd(M - z * E)[2][-1].conj()[:n]
-    return x / max(np.linalg.norm(x), _EPS)
+    return x / max(np.linalg.norm(x), EPS)
 
 
 def _zero_directions(A: np.ndarray, C: np.ndarray, F: np.ndarray, zeros: np.ndarray) -> list[np.ndarray]:
@@ -223,19 +215,19 @@ def _zero_directions(A: np.ndarray, C: np.ndarray, F: np.ndarray, zeros: np.ndar
         # eigen-directions first: null vectors of P(z) (at least one, at most m)
         _, s, Vh = np.linalg.svd(P)
         s = np.concatenate([s, np.zeros(Vh.shape[0] - s.size)])
-        r1 = int(np.clip((s <= 1e-8 * max(s[0], _EPS)).sum(), 1, m))
+        r1 = int(np.clip((s <= 1e-8 * max(s[0], EPS)).sum(), 1, m))
         U = np.linalg.svd(Vh[-r1:, :n].conj().T, full_matrices=False)[0][:, :r1]
         if r1 < m:  # defective: complete with chain vectors, P v1 = 0, P v2 = E v1, …, stacked block-bidiagonally
             K = np.kron(np.eye(m), P) - np.kron(np.eye(m, k=-1), E)
             _, s, Vh = np.linalg.svd(K)
             s = np.concatenate([s, np.zeros(Vh.shape[0] - s.size)])
-            keep = np.union1d(np.flatnonzero(s <= 1e-8 * max(s[0], _EPS)), np.arange(Vh.shape[0] - m, Vh.shape[0]))
+            keep = np.union1d(np.flatnonzero(s <= 1e-8 * max(s[0], EPS)), np.arange(Vh.shape[0] - m, Vh.shape[0]))
             N = Vh[keep].conj().T
             X = np.hstack([N[b * (n + k) : b * (n + k) + n] for b in range(m)])
             X = X - U @ (U.conj().T @ X)
             U = np.hstack([U, np.linalg.svd(X)[0][:, : m - r1]])
         for j, col in zip(members, U.T):
-            dirs[j] = col / max(np.linalg.norm(col), _EPS)
+            dirs[j] = col / max(np.linalg.norm(col), EPS)
     return dirs
 
 
@@ -337,8 +329,8 @@ def output_separable(
     >>> output_separable(m.C, T)
     (True, [])
     """
-    C = _mat("C", C)
-    spaces = [_mat(f"space {i}", T) for i, T in enumerate(spaces)]
+    C = as_2d("C", C)
+    spaces = [as_2d(f"space {i}", T) for i, T in enumerate(spaces)]
     for i, T in enumerate(spaces):
         if T.shape[0] != C.shape[1]:
             raise ParameterError(f"space {i} has {T.shape[0]} rows but C has {C.shape[1]} columns (states)")

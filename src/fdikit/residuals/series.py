@@ -1,8 +1,8 @@
 """Residual time series: :class:`Residuals`, what a residual generator's ``run`` returns.
 
 The series, the residual names, the fault each residual is tied to and the validity of every sample
-(invalid input samples and the *recovering* samples after a gap, :mod:`fdikit.gaps`).  Re-exported by
-:mod:`fdikit.residuals`, where the generators that produce it live.
+(invalid input samples and the *recovering* samples after a gap, :mod:`fdikit.gaps`).  Part of the package
+:mod:`fdikit.residuals`, with the generators that produce it (:mod:`fdikit.residuals.generator`).
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Scalar, option and type checks of :mod:`fdikit.validate` (numbers, integers, ranges, choices, instances).
 
-Defined here and re-exported by :mod:`fdikit.validate`, the import path to use.  Each helper
+Part of the package :mod:`fdikit.validate`, the import path to use (``validate.integer(...)``).  Each helper
 checks one argument, returns it in canonical form (a float, an int, the value itself) and
 otherwise raises ``error`` (default :class:`~fdikit.errors.ParameterError`) with a message that
 names the argument and says what is wrong.
@@ -21,10 +21,27 @@ import numpy as np
 
 from fdikit.errors import ParameterError
 
-__all__ = ["number", "positive", "non_negative", "integer", "in_range", "choice", "instance"]
+__all__ = ["number", "positive", "non_negative", "integer", "in_range", "choice", "instance", "shown"]
 
 
-def _show(value) -> str:
+def shown(value) -> str:
+    """``repr(value)``, cut to 60 characters: how an error message quotes a bad argument.
+
+    Parameters
+    ----------
+    value : object
+        The argument to quote.
+
+    Returns
+    -------
+    str
+        Its ``repr``, ending in ``...`` when longer than 60 characters.
+
+    Examples
+    --------
+    >>> shown("x" * 100)[-5:]
+    'xx...'
+    """
     text = repr(value)
     return text if len(text) <= 60 else text[:57] + "..."
 
@@ -62,7 +79,7 @@ def number(name: str, value, *, error: type[Exception] = ParameterError, finite:
         if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
             value = value.item()
         else:
-            raise error(f"{name} must be a number, got {_show(value)} ({type(value).__name__})")
+            raise error(f"{name} must be a number, got {shown(value)} ({type(value).__name__})")
     out = float(value)
     if finite and not np.isfinite(out):
         raise error(f"{name} must be a finite number, got {out}")
@@ -168,7 +185,7 @@ def integer(name: str, value, *, minimum: int | None = None, error: type[Excepti
     5
     """
     if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Integral):
-        raise error(f"{name} must be an integer, got {_show(value)} ({type(value).__name__})")
+        raise error(f"{name} must be an integer, got {shown(value)} ({type(value).__name__})")
     out = int(value)
     if minimum is not None and out < minimum:
         word = {0: "a non-negative integer", 1: "a positive integer"}.get(minimum, f"an integer >= {minimum}")
@@ -254,7 +271,7 @@ def choice(name: str, value, options: Sequence, *, error: type[Exception] = Para
         ok = False
     if not ok or isinstance(value, bool) and not any(o is value for o in options):
         listed = ", ".join(repr(o) for o in options)
-        raise error(f"unknown {name} {_show(value)}; use one of {listed}")
+        raise error(f"unknown {name} {shown(value)}; use one of {listed}")
     return value
 
 

@@ -1,13 +1,12 @@
-"""Argument validation shared by the public entry points.
+"""Array, matrix and covariance checks of :mod:`fdikit.validate`.
 
 Each helper checks one argument, returns it in canonical form (a float, an int, a read-only
 float array ...) and otherwise raises an :mod:`fdikit.errors` class whose message names the
 argument, says what is wrong and how to fix it.  The class defaults to
 :class:`~fdikit.errors.ParameterError` (a bad argument); model constructors pass
 ``error=ModelError`` (a malformed model) and data readers ``error=DataError``.  The scalar, option
-and type checks (:func:`number`, :func:`positive`, :func:`non_negative`, :func:`integer`,
-:func:`in_range`, :func:`choice`, :func:`instance`) are defined in :mod:`fdikit.validate_scalars`
-and re-exported here; import every check from :mod:`fdikit.validate`.
+and type checks are in :mod:`fdikit.validate.scalars`; import every check from the package
+:mod:`fdikit.validate`.
 
 Examples
 --------
@@ -25,16 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from fdikit.errors import ParameterError
-from fdikit.validate_scalars import (  # re-exported: defined there to keep both modules short
-    _show,
-    choice,
-    in_range,
-    instance,
-    integer,
-    non_negative,
-    number,
-    positive,
-)
+from fdikit.validate.scalars import shown
 
 __all__ = [
     "as_array",
@@ -44,13 +34,6 @@ __all__ = [
     "as_complex_vector",
     "as_covariance",
     "noise_covariance",
-    "number",
-    "positive",
-    "non_negative",
-    "integer",
-    "in_range",
-    "choice",
-    "instance",
 ]
 
 
@@ -92,17 +75,17 @@ def as_array(name: str, value, *, error: type[Exception] = ParameterError, finit
     if value is None:
         raise error(f"{name} is required (got None); pass an array of numbers")
     if isinstance(value, str | bytes):
-        raise error(f"{name} must be a number or an array of numbers, got the string {_show(value)}")
+        raise error(f"{name} must be a number or an array of numbers, got the string {shown(value)}")
     try:
         raw = np.asarray(value)
     except (ValueError, TypeError) as exc:
-        raise error(f"{name} must be a rectangular array of numbers (got {_show(value)}: {exc})") from None
+        raise error(f"{name} must be a rectangular array of numbers (got {shown(value)}: {exc})") from None
     if raw.dtype == object:
-        raise error(f"{name} must be a rectangular array of numbers, got {_show(value)} (ragged rows or objects)")
+        raise error(f"{name} must be a rectangular array of numbers, got {shown(value)} (ragged rows or objects)")
     if np.iscomplexobj(raw) and not complex_ok:
-        raise error(f"{name} must be real; it has complex entries ({_show(value)})")
+        raise error(f"{name} must be real; it has complex entries ({shown(value)})")
     if raw.dtype.kind not in "biufc":
-        raise error(f"{name} must be an array of numbers, got entries of type {raw.dtype} ({_show(value)})")
+        raise error(f"{name} must be an array of numbers, got entries of type {raw.dtype} ({shown(value)})")
     out = raw.astype(complex if np.iscomplexobj(raw) else float, copy=True)
     if finite:
         bad = np.argwhere(~np.isfinite(out))
@@ -300,7 +283,7 @@ def as_complex_vector(name: str, value, size: int | None = None, *,
     [(-1+0j), (-2+1j), (-2-1j)]
     """
     if isinstance(value, str | bytes) or value is None:
-        raise error(f"{name} must be a sequence of numbers, got {_show(value)}")
+        raise error(f"{name} must be a sequence of numbers, got {shown(value)}")
     try:
         out = np.atleast_1d(np.asarray(value, dtype=complex))
     except (TypeError, ValueError) as exc:
@@ -451,7 +434,7 @@ def noise_covariance(std_name: str, std, cov_name: str, cov, k: int, what: str =
     name, value = (std_name, std) if std is not None else (cov_name, cov)
     arr = as_array(name, value, error=error, finite=False)
     if not np.all(np.isfinite(arr)):
-        raise error(f"{name} must be finite, got {_show(arr.tolist())}")
+        raise error(f"{name} must be finite, got {shown(arr.tolist())}")
     if std is not None:
         if arr.ndim > 1:
             raise error(f"{name} is a standard deviation: a scalar or one per {what} ({k}), got an array of shape "
@@ -459,7 +442,7 @@ def noise_covariance(std_name: str, std, cov_name: str, cov, k: int, what: str =
         if arr.size not in (1, k):
             raise error(f"{name} has {arr.size} standard deviations; need 1 or {k} (one per {what})")
         if np.any(arr < 0):
-            raise error(f"{name} holds standard deviations, which must be >= 0; got {_show(arr.tolist())}")
+            raise error(f"{name} holds standard deviations, which must be >= 0; got {shown(arr.tolist())}")
         return np.diag(np.broadcast_to(arr, (k,)) ** 2)
     if arr.ndim <= 1:
         if arr.size not in (1, k):
@@ -467,7 +450,7 @@ def noise_covariance(std_name: str, std, cov_name: str, cov, k: int, what: str =
                         "covariance matrix")
         if np.any(arr < 0):
             raise error(f"{name} holds variances σ² (a scalar or vector means σ² I / diag), which must be >= 0; "
-                        f"got {_show(arr.tolist())}")
+                        f"got {shown(arr.tolist())}")
         return np.diag(np.broadcast_to(arr, (k,)))
     return as_covariance(name, arr, k, error=error, scalar_ok=False)
 

@@ -1,4 +1,4 @@
-"""Residual generators (the implementation form ``r = Q(y, u)``) and residual time series.
+"""Residual generators: the implementation form ``r = Q(y, u)``, its online stepper and banks.
 
 A :class:`ResidualGenerator` is an LTI filter in state-space form driven by the
 controls ``u`` and the measurements ``y`` named in its ``controls`` and ``outputs``::
@@ -15,8 +15,7 @@ decisions) until the gap transient has decayed below the noise (:class:`Residual
 gives the rule; :mod:`fdikit.gaps` implements it and gives its derivation).
 ``internal_form(model)`` is Varga's internal form ``R``: the interconnection of the plant
 model and the filter, from ``(u, d, f, w)`` to ``r``, so decoupling is a number, not a plot.
-The series type :class:`~fdikit.residual_series.Residuals` lives in :mod:`fdikit.residual_series`
-and is re-exported here.
+The series they return, :class:`~fdikit.residuals.series.Residuals`, is :mod:`fdikit.residuals.series`.
 """
 
 from __future__ import annotations
@@ -32,10 +31,10 @@ from fdikit.errors import DataError, ModelError, ParameterError
 from fdikit.gaps import GapRule, Recovery, gap_options
 from fdikit.lti import dlsim_blocked
 from fdikit.model import GROUPS, FaultModel
-from fdikit.residual_series import Residuals  # the residual time series, re-exported
-from fdikit.trace import Trace, check_signals  # check_signals: kept importable from here
+from fdikit.residuals.series import Residuals
+from fdikit.trace import Trace, check_signals
 
-__all__ = ["ResidualGenerator", "ResidualStepper", "Residuals", "stack_generators", "check_signals"]
+__all__ = ["ResidualGenerator", "ResidualStepper", "stack_generators"]
 
 
 def _mat(name, value, shape):

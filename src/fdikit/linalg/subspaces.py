@@ -3,7 +3,7 @@
 Orthonormal bases and SVD rank decisions throughout; every tolerance scales with the data
 (``1e3 · max(shape) · eps · σ_max`` by default, or a caller's relative tolerance ``rtol · σ_max``).
 The geometry of detection filters built on them (CAISA, invariant zeros, detection spaces) is
-:mod:`fdikit.linalg`, which re-exports these functions.
+:mod:`fdikit.linalg.geometry`.
 """
 
 from __future__ import annotations
@@ -13,17 +13,63 @@ import numpy as np
 from fdikit import validate
 from fdikit.errors import ParameterError
 
-__all__ = ["rank", "orth", "null", "intersect", "span_sum", "contains"]
+__all__ = ["rank", "orth", "null", "intersect", "span_sum", "contains", "as_2d", "checked_rtol", "EPS"]
 
-_EPS = np.finfo(float).eps
+#: Double-precision machine epsilon, the unit of the default rank tolerances.
+EPS = np.finfo(float).eps
 
 
-def _mat(name: str, M) -> np.ndarray:
-    """``M`` as a finite real or complex 2-D array (a vector is one row); ParameterError otherwise."""
+def as_2d(name: str, M) -> np.ndarray:
+    """``M`` as a finite real or complex 2-D array (a vector is one row); ParameterError otherwise.
+
+    Parameters
+    ----------
+    name : str
+        The argument's name, as the error message quotes it.
+    M : array_like
+        A matrix, or a vector (read as one row).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``M`` as a 2-D float or complex array.
+
+    Raises
+    ------
+    ParameterError
+        For a non-numeric or non-finite ``M`` or one with more than two dimensions.
+
+    Examples
+    --------
+    >>> as_2d("W", [1.0, 2.0]).shape
+    (1, 2)
+    """
     return validate.as_matrix(name, M, promote=True, complex_ok=True)
 
 
-def _rtol(rtol):
+def checked_rtol(rtol: float | None) -> float | None:
+    """A relative rank tolerance: ``None`` (the default of :func:`rank`) or a number >= 0.
+
+    Parameters
+    ----------
+    rtol : float or None
+        The tolerance to check.
+
+    Returns
+    -------
+    float or None
+        ``rtol`` as a float, or None.
+
+    Raises
+    ------
+    ParameterError
+        For a negative or non-numeric ``rtol``.
+
+    Examples
+    --------
+    >>> checked_rtol(1e-9), checked_rtol(None)
+    (1e-09, None)
+    """
     if rtol is None:
         return None
     return validate.non_negative("rtol", rtol)
@@ -31,7 +77,7 @@ def _rtol(rtol):
 
 def _tol(M: np.ndarray, s: np.ndarray, rtol: float | None) -> float:
     smax = s[0] if s.size else 0.0
-    return (rtol if rtol is not None else max(M.shape) * _EPS * 1e3) * max(smax, 0.0)
+    return (rtol if rtol is not None else max(M.shape) * EPS * 1e3) * max(smax, 0.0)
 
 
 def rank(M: np.ndarray, rtol: float | None = None) -> int:
@@ -60,7 +106,7 @@ def rank(M: np.ndarray, rtol: float | None = None) -> int:
     >>> rank(np.array([[1.0, 2.0], [2.0, 4.0]]))
     1
     """
-    M, rtol = _mat("M", M), _rtol(rtol)
+    M, rtol = as_2d("M", M), checked_rtol(rtol)
     if M.size == 0:
         return 0
     s = np.linalg.svd(M, compute_uv=False)
@@ -93,7 +139,7 @@ def orth(M: np.ndarray, rtol: float | None = None) -> np.ndarray:
     >>> orth(np.array([[1.0, 2.0], [2.0, 4.0]])).shape
     (2, 1)
     """
-    M, rtol = _mat("M", M), _rtol(rtol)
+    M, rtol = as_2d("M", M), checked_rtol(rtol)
     if M.size == 0:
         return np.zeros((M.shape[0], 0), dtype=M.dtype)
     U, s, _ = np.linalg.svd(M, full_matrices=False)
@@ -128,7 +174,7 @@ def null(M: np.ndarray, rtol: float | None = None) -> np.ndarray:
     >>> N.shape, np.round(np.abs(N.ravel()), 6).tolist()
     ((2, 1), [0.707107, 0.707107])
     """
-    M, rtol = _mat("M", M), _rtol(rtol)
+    M, rtol = as_2d("M", M), checked_rtol(rtol)
     if M.shape[0] == 0:
         return np.eye(M.shape[1], dtype=M.dtype)
     _, s, Vh = np.linalg.svd(M, full_matrices=True)
@@ -163,7 +209,7 @@ def span_sum(*bases: np.ndarray, rtol: float | None = None) -> np.ndarray:
     >>> span_sum(e[:, [0]], e[:, [1]], e[:, [0]]).shape
     (3, 2)
     """
-    bases = [_mat(f"basis {i}", b) for i, b in enumerate(bases) if np.size(b)]
+    bases = [as_2d(f"basis {i}", b) for i, b in enumerate(bases) if np.size(b)]
     if not bases:
         raise ParameterError("span_sum needs at least one non-empty basis")
     rows = {b.shape[0] for b in bases}
@@ -242,8 +288,8 @@ def contains(U: np.ndarray, x: np.ndarray, rtol: float = 1e-8) -> bool:
     """
     Q = orth(U)
     x = np.asarray(x)
-    x = _mat("x", x.reshape(-1, 1) if x.ndim == 1 else x)
+    x = as_2d("x", x.reshape(-1, 1) if x.ndim == 1 else x)
     if x.shape[0] != Q.shape[0]:
         raise ParameterError(f"x has {x.shape[0]} rows but U has {Q.shape[0]}; pass vectors of length {Q.shape[0]}")
     res = x - Q @ (Q.conj().T @ x)
-    return bool(np.linalg.norm(res) <= rtol * max(np.linalg.norm(x), _EPS))
+    return bool(np.linalg.norm(res) <= rtol * max(np.linalg.norm(x), EPS))
