@@ -197,12 +197,12 @@ class Fault(ABC):
 class Bias(Fault):
     """Additive step: ``v + size`` (sensor bias, Douglas et al. 1996 eq. (3.3); actuator offset).
 
+    The target, onset, end and location are those of :class:`Fault`.
+
     Parameters
     ----------
     size : float
         The step added to the signal, in its units.
-
-    The target, onset, end and location are those of :class:`Fault`.
 
     Examples
     --------
@@ -221,12 +221,12 @@ class Bias(Fault):
 class Drift(Fault):
     """Ramp: ``v + rate * (t - onset)``.
 
+    The target, onset, end and location are those of :class:`Fault`.
+
     Parameters
     ----------
     rate : float
         Slope, in the signal's units per second.
-
-    The target, onset, end and location are those of :class:`Fault`.
 
     Examples
     --------
@@ -248,12 +248,12 @@ class Stuck(Fault):
     Lock-in-place of a control surface, Hallouzi 2008, §4.1; stuck actuator,
     Douglas et al. 1996, App. A (``m_i = −u_i + u_ic``).
 
+    The target, onset, end and location are those of :class:`Fault`.
+
     Parameters
     ----------
     value : float or None
         The value the signal holds; ``None`` (default) holds its value at the onset.
-
-    The target, onset, end and location are those of :class:`Fault`.
 
     Examples
     --------
@@ -278,12 +278,12 @@ class Stuck(Fault):
 class LossOfEffectiveness(Fault):
     """Multiplicative loss: ``(1 - loss) * v`` with ``loss`` in [0, 1] (Hallouzi 2008, §4.1).
 
+    The target, onset, end and location are those of :class:`Fault`.
+
     Parameters
     ----------
     loss : float
         Lost fraction of the signal, in [0, 1] (1: the actuator does nothing).
-
-    The target, onset, end and location are those of :class:`Fault`.
 
     Examples
     --------
@@ -307,12 +307,12 @@ class LossOfEffectiveness(Fault):
 class ScaleFactor(Fault):
     """Gain error: ``factor * v`` (a sensor scale-factor fault; van der Ploeg's ``f_m``).
 
+    The target, onset, end and location are those of :class:`Fault`.
+
     Parameters
     ----------
     factor : float
         Multiplier of the signal (1: no fault).
-
-    The target, onset, end and location are those of :class:`Fault`.
 
     Examples
     --------
@@ -331,12 +331,12 @@ class ScaleFactor(Fault):
 class Noise(Fault):
     """Extra zero-mean Gaussian noise of standard deviation ``std``.
 
+    The target, onset, end and location are those of :class:`Fault`.
+
     Parameters
     ----------
     std : float
         Standard deviation of the added noise (>= 0), in the signal's units.
-
-    The target, onset, end and location are those of :class:`Fault`.
 
     Examples
     --------
@@ -362,6 +362,8 @@ class Noise(Fault):
 class Intermittent(Fault):
     """Bias ``size`` switched on for ``duty * period`` seconds out of every ``period`` after onset.
 
+    The target, onset, end and location are those of :class:`Fault`.
+
     Parameters
     ----------
     size : float
@@ -370,8 +372,6 @@ class Intermittent(Fault):
         Period [s] (> 0, default 1).
     duty : float
         On fraction of each period, in (0, 1] (default 0.5).
-
-    The target, onset, end and location are those of :class:`Fault`.
 
     Examples
     --------
