@@ -47,3 +47,12 @@ def test_test_files_named_in_the_docs_exist():
     named = {(p.name, m) for p in texts for m in re.findall(r"tests/[\w/]+\.py", p.read_text(encoding="utf-8"))}
     missing = sorted(f"{page}: {path}" for page, path in named if not (ROOT / path).exists())
     assert not missing, "the docs name test files that do not exist:\n" + "\n".join(missing)
+
+
+def test_module_paths_named_in_the_architecture_exist():
+    # The layout block and the where-is table name modules by path under src/fdikit/ (`design/observers/uio.py`).
+    text = (ROOT / "docs" / "ARCHITECTURE.md").read_text(encoding="utf-8")
+    src = ROOT / "src" / "fdikit"
+    named = set(re.findall(r"`((?:[a-z0-9_]+/)*[a-z0-9_]+\.py)`", text))
+    missing = sorted(p for p in named if not any(base.joinpath(p).exists() for base in (src, ROOT / "tests", ROOT)))
+    assert not missing, "docs/ARCHITECTURE.md names modules that do not exist: " + ", ".join(missing)
