@@ -1,6 +1,6 @@
 """The non-finite-trace diagnosis of :mod:`fdikit.simulate`: which sample went bad, and why.
 
-An internal module (re-exported by :mod:`fdikit.simulate_checks`): a run that overflows is
+An internal module (used by :mod:`fdikit.simulate`): a run that overflows is
 refused with a :class:`~fdikit.errors.DataError` naming the first non-finite sample (index and
 time) and signal (:func:`refuse_non_finite`), and the likely cause — the unstable eigenvalue
 (Re λ > 0, or |λ| > 1 when discrete) of the plant (:func:`linear_cause`), of the Jacobian of a

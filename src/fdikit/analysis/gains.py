@@ -5,14 +5,14 @@
   singular-value plots of Douglas et al. 1996, Figs. 4.1–4.4; Varga's internal form ``R``);
   :meth:`GainTable.plot` draws the fault × residual "structure plot".
 * :func:`structure_matrix` -- which residual group responds to which fault (a number, not a plot).
-* :func:`fdi_report` (module :mod:`fdikit.analysis.geometry`, re-exported here) -- before any design:
+* :func:`~fdikit.analysis.geometry.fdi_report` (module :mod:`fdikit.analysis.geometry`) -- before any design:
   detection-space dimensions, invariant zeros, output separability, mutual detectability and ``Σν``
   against ``n`` for a candidate set of faults, with advice on what to change (Douglas et al. 1996, §4.1
   and App. A; Murray 2012, §2.3).
 
 Examples
 --------
->>> from fdikit.analysis.gains import fdi_report
+>>> from fdikit.analysis import fdi_report
 >>> from fdikit.plants import path_vehicle_14
 >>> rep = fdi_report(path_vehicle_14(), ["throttle_actuator", "brake_actuator", "steering_actuator",
 ...                                      "air_mass_sensor:magnitude"])

@@ -82,6 +82,7 @@ def caisa(A: np.ndarray, C: np.ndarray, F: np.ndarray, rtol: float | None = None
 
     >>> from fdikit.plants import white_speyer
     >>> m = white_speyer()
+    >>> from fdikit.linalg import contains
     >>> W = caisa(m.A, m.C, m.Bf[:, 0])
     >>> W.shape, contains(W, m.Bf[:, 0])
     ((3, 1), True)

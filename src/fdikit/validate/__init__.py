@@ -19,6 +19,7 @@ from fdikit.validate.arrays import (  # noqa: F401 - the package namespace
     as_square,
     as_vector,
     noise_covariance,
+    psd_part,
 )
 from fdikit.validate.scalars import (  # noqa: F401 - the package namespace
     choice,
@@ -39,6 +40,7 @@ __all__ = [
     "as_complex_vector",
     "as_covariance",
     "noise_covariance",
+    "psd_part",
     "number",
     "positive",
     "non_negative",

@@ -34,6 +34,7 @@ __all__ = [
     "as_complex_vector",
     "as_covariance",
     "noise_covariance",
+    "psd_part",
 ]
 
 
@@ -457,7 +458,32 @@ def noise_covariance(std_name: str, std, cov_name: str, cov, k: int, what: str =
 
 def psd_part(name: str, M, *, error: type[Exception] = ParameterError) -> np.ndarray:
     """Symmetric part of the square covariance ``M``: :func:`as_covariance` with the tolerances of the Kalman
-    steps (symmetry to 1e-8, eigenvalues to −1e-10 of the largest entry)."""
+    steps (symmetry to 1e-8, eigenvalues to −1e-10 of the largest entry).
+
+    Parameters
+    ----------
+    name : str
+        The argument's name, as the error message quotes it.
+    M : array_like
+        A square covariance matrix (its size is taken from ``M``).
+    error : type, optional
+        The error class to raise (default :class:`~fdikit.errors.ParameterError`).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(M + Mᵀ) / 2``.
+
+    Raises
+    ------
+    ParameterError
+        (or ``error``) for a non-square, asymmetric or indefinite ``M``.
+
+    Examples
+    --------
+    >>> psd_part("P0", [[2.0, 0.5], [0.5, 1.0]]).tolist()
+    [[2.0, 0.5], [0.5, 1.0]]
+    """
     M = as_array(name, M, error=error)
     return as_covariance(name, M, M.shape[0] if M.ndim else 1, error=error, scalar_ok=False, rtol=1e-8,
                          psd_rtol=1e-10)
