@@ -44,7 +44,7 @@ the report's, so a positive bias gives a positive residual.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
@@ -54,14 +54,14 @@ from fdikit.design.observers.full_order import observer_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.fault_maps import resolve_faults
 from fdikit.model import FaultModel
-from fdikit.protocols import joined_form
+from fdikit.protocols import FieldReport
 from fdikit.residuals import ResidualGenerator, stack_generators
 
 __all__ = ["BeardJonesDesign", "beard_jones", "restricted_diagonal", "RestrictedDiagonalDesign"]
 
 
 @dataclass(frozen=True, eq=False)
-class BeardJonesDesign:
+class BeardJonesDesign(FieldReport):
     """A Beard–Jones detection filter and its design report.
 
     Attributes
@@ -114,16 +114,6 @@ class BeardJonesDesign:
     def condition_number(self) -> float:
         """``σ_max(𝒱) / σ_min(𝒱)`` of the unit-norm left eigenvectors."""
         return float(self.sigma[0] / self.sigma[-1])
-
-    model: FaultModel | None = field(default=None, repr=False, kw_only=True)  # set by the design function
-
-    def internal_form(self) -> FaultModel:
-        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
-
-        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
-        model the design was made for (field ``model``, set by the design function).
-        """
-        return joined_form(self, self.model)
 
     def report(self) -> dict:
         """``gain`` (the attribute ``gain``), ``assigned_poles`` (by fault), ``poles`` (obtained),
@@ -399,7 +389,7 @@ def beard_jones(
 
 
 @dataclass(frozen=True, eq=False)
-class RestrictedDiagonalDesign:
+class RestrictedDiagonalDesign(FieldReport):
     """A bank of restricted-diagonal filters, one per target fault (App. A.4).
 
     ``filters[name]`` is the single-group design whose nuisance detection space ``T̂_i``
@@ -433,16 +423,6 @@ class RestrictedDiagonalDesign:
     generator: ResidualGenerator
     filters: dict[str, BeardJonesDesign]
     nuisance_spaces: dict[str, np.ndarray]
-    model: FaultModel | None = field(default=None, repr=False, kw_only=True)  # set by the design function
-
-    def internal_form(self) -> FaultModel:
-        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
-
-        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
-        model the design was made for (field ``model``, set by the design function).
-        """
-        return joined_form(self, self.model)
-
     def report(self) -> dict:
         """By target fault: ``gains`` (each filter's ``gain``), ``poles``, ``nuisance_spaces`` (``T̂_i``),
         ``projectors`` (``Ĥ_i``) and ``condition_numbers`` (of each filter's left eigenvectors)."""

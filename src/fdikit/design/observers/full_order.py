@@ -17,7 +17,7 @@ Kalman residual the white innovation sequence with covariance ``C P Cᵀ + R``.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
@@ -25,14 +25,14 @@ import scipy.linalg
 from fdikit import lti, validate
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
-from fdikit.protocols import joined_form
+from fdikit.protocols import FieldReport
 from fdikit.residuals import ResidualGenerator
 
 __all__ = ["ObserverDesign", "observer", "kalman", "observer_generator", "unobservable_modes"]
 
 
 @dataclass(frozen=True, eq=False)
-class ObserverDesign:
+class ObserverDesign(FieldReport):
     """Result of an observer design.
 
     Attributes
@@ -69,16 +69,6 @@ class ObserverDesign:
     poles: np.ndarray
     covariance: np.ndarray | None = None
     innovation_covariance: np.ndarray | None = None
-    model: FaultModel | None = field(default=None, repr=False, kw_only=True)  # set by the design function
-
-    def internal_form(self) -> FaultModel:
-        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
-
-        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
-        model the design was made for (field ``model``, set by the design function).
-        """
-        return joined_form(self, self.model)
-
     def report(self) -> dict:
         """``gain`` (``L``), ``poles`` (of ``A − L C``), ``covariance`` (``P``) and ``innovation_covariance``.
 

@@ -45,7 +45,7 @@ report's matrix, which stays available as :attr:`HinfDesign.report_gain`; the re
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
@@ -56,7 +56,7 @@ from fdikit.design.observers.detection_gain import DetectionGainFamily, detectio
 from fdikit.design.observers.full_order import observer_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
-from fdikit.protocols import joined_form
+from fdikit.protocols import FieldReport
 from fdikit.residuals import ResidualGenerator
 
 __all__ = [
@@ -195,7 +195,7 @@ def _integrate(ric: _Riccati, Y0, gamma, horizon, steady_tol, polish) -> tuple[n
 
 
 @dataclass(frozen=True, eq=False)
-class HinfDesign:
+class HinfDesign(FieldReport):
     """An H∞-bounded detection filter (Douglas et al. 1996, Prop. C.7) and its design report.
 
     Attributes
@@ -263,16 +263,6 @@ class HinfDesign:
         H = np.vstack(list(self.family.residual_maps.values()))
         A, C, L = self.family.A, self.family.C, self.gain
         return control.ss(A - L @ C, self.B - L @ self.D, H @ C, H @ self.D)
-
-    model: FaultModel | None = field(default=None, repr=False, kw_only=True)  # set by the design function
-
-    def internal_form(self) -> FaultModel:
-        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
-
-        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
-        model the design was made for (field ``model``, set by the design function).
-        """
-        return joined_form(self, self.model)
 
     def report(self) -> dict:
         """``gain`` (the attribute ``gain``), ``gamma``, ``form``, ``poles``, ``hinf_norm`` (attained ``‖T_zω‖∞``),
@@ -419,7 +409,7 @@ def hinf_detection_filter(
 
 # ---------------------------------------------------------------------- (c.19)–(c.26) fault enhancement
 @dataclass(frozen=True, eq=False)
-class Enhancement:
+class Enhancement(FieldReport):
     """A fault-enhancing residual direction (Douglas et al. 1996, App. C.4, (c.26), T = ∞).
 
     Attributes
@@ -449,16 +439,6 @@ class Enhancement:
     direction: np.ndarray
     ratio: float
     generator: ResidualGenerator
-    model: FaultModel | None = field(default=None, repr=False, kw_only=True)  # set by the design function
-
-    def internal_form(self) -> FaultModel:
-        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
-
-        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
-        model the design was made for (field ``model``, set by the design function).
-        """
-        return joined_form(self, self.model)
-
     def report(self) -> dict:
         """``fault``, ``direction`` (unit ``q``) and ``ratio`` (fault-to-disturbance energy ratio along ``q``)."""
         return {"fault": self.fault, "direction": self.direction, "ratio": self.ratio}

@@ -52,7 +52,7 @@ must be stable); the design's ``fixed_modes`` and ``notes`` report them.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
@@ -60,7 +60,7 @@ import scipy.linalg
 from fdikit import fault_maps, linalg, lti, validate
 from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.model import FaultModel
-from fdikit.protocols import joined_form
+from fdikit.protocols import FieldReport
 from fdikit.residuals import ResidualGenerator
 
 __all__ = ["UIODesign", "uio", "uio_bank", "unknown_input_matrix"]
@@ -71,7 +71,7 @@ _ZERO = np.sqrt(_EPS)
 
 
 @dataclass(frozen=True, eq=False)
-class UIODesign:
+class UIODesign(FieldReport):
     """An unknown-input observer residual generator and its design report.
 
     Attributes
@@ -124,16 +124,6 @@ class UIODesign:
     target_gain: float
     decoupling: dict[str, float]
     notes: tuple[str, ...] = ()
-    model: FaultModel | None = field(default=None, repr=False, kw_only=True)  # set by the design function
-
-    def internal_form(self) -> FaultModel:
-        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
-
-        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
-        model the design was made for (field ``model``, set by the design function).
-        """
-        return joined_form(self, self.model)
-
     def report(self) -> dict:
         """``target``, ``decoupled`` (inputs the residual is blind to), the UIO matrices ``H``, ``T``, ``K``,
         ``K1``, ``N``, ``poles`` (of ``N``), ``fixed_modes``, ``visibility`` (``σ_min(C E₀) / ‖C‖``),

@@ -38,7 +38,7 @@ The bar matrices, the left null space, the minimal degree and the rank tests (2.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -47,7 +47,7 @@ from fdikit.dae import DAEModel, dae_form
 from fdikit.design.parity.polynomial_rank import bar_matrices, minimal_degree, target_fault
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
-from fdikit.protocols import joined_form, no_internal_form
+from fdikit.protocols import FieldReport, joined_form, no_internal_form
 from fdikit.residuals import ResidualGenerator
 
 __all__ = [
@@ -95,7 +95,7 @@ def _newton_chain(num: np.ndarray, poles: np.ndarray) -> tuple[np.ndarray, np.nd
 
 
 @dataclass(frozen=True, eq=False)
-class PolynomialParityDesign:
+class PolynomialParityDesign(FieldReport):
     """An LTI parity (DAE null-space) fault detection filter (van der Ploeg 2018, (2.6)–(2.9)).
 
     Attributes
@@ -165,8 +165,6 @@ class PolynomialParityDesign:
         while nf.size > 1 and abs(nf[-1]) <= 1e-10 * np.abs(self.NF).max():
             nf = nf[:-1]
         return np.roots(nf[::-1])
-
-    model: FaultModel | None = field(default=None, repr=False, kw_only=True)  # set by the design function
 
     def internal_form(self) -> FaultModel:
         """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.

@@ -19,7 +19,7 @@ at every sample of a trace (16).  The robust choice of ``W₂`` is in
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -27,7 +27,7 @@ from fdikit import validate
 from fdikit.errors import DataError, DesignError, ModelError, ParameterError
 from fdikit.lpv import LPVModel, StackedMatrices, check_horizon, lpv_stacked_matrices, stacked_matrices
 from fdikit.model import FaultModel
-from fdikit.protocols import joined_form
+from fdikit.protocols import FieldReport
 from fdikit.residuals import ResidualGenerator, Residuals
 from fdikit.trace import Trace
 
@@ -184,7 +184,7 @@ def parity_matrix(H_os: np.ndarray, rows: Sequence[int] | None = None, cond_max:
 
 # ---------------------------------------------------------------------------------------------- LTI generator
 @dataclass(frozen=True, eq=False)
-class ParityDesign:
+class ParityDesign(FieldReport):
     """An LTI parity-space residual generator and its design data.
 
     Attributes
@@ -222,16 +222,6 @@ class ParityDesign:
     def q(self) -> int:
         """Dimension of the parity space, ``(s+1)p − n``."""
         return self.P.shape[0]
-
-    model: FaultModel | None = field(default=None, repr=False, kw_only=True)  # set by the design function
-
-    def internal_form(self) -> FaultModel:
-        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
-
-        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
-        model the design was made for (field ``model``, set by the design function).
-        """
-        return joined_form(self, self.model)
 
     def report(self) -> dict:
         """``s`` (horizon), ``q`` (parity-space dimension), ``rows`` (of ``H_os1``), ``P`` (parity basis),
