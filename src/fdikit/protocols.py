@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Protocol, runtime_checkable
 if TYPE_CHECKING:
     from fdikit.model import FaultModel
 
-__all__ = ["DesignResult", "Evaluator", "FieldReport", "joined_form", "no_internal_form"]
+__all__ = ["DesignResult", "Evaluator", "FieldReport", "ProblemDesign", "joined_form", "no_internal_form"]
 
 
 @runtime_checkable
@@ -262,3 +262,28 @@ class FieldReport:
         dict
         """
         return {name: getattr(self, name) for name in self.REPORT}
+
+
+class ProblemDesign:
+    """Base of a design that holds its :class:`~fdikit.design.game.setup.GameProblem` as ``problem``.
+
+    :meth:`internal_form` joins ``problem.model`` (the model the targets and nuisance were resolved on) with
+    ``generator``; the subclass gives :meth:`report`.
+
+    Examples
+    --------
+    >>> from fdikit.design.game.single_fault import single_fault_game_filter
+    >>> from fdikit.plants import white_speyer
+    >>> isinstance(single_fault_game_filter(white_speyer(), "f1"), ProblemDesign)
+    True
+    """
+
+    def internal_form(self) -> FaultModel:
+        """The plant ``problem.model`` and ``generator`` in series, from ``(u, d, f, w)`` to ``r``.
+
+        Returns
+        -------
+        FaultModel
+            ``generator.internal_form(problem.model)``.
+        """
+        return joined_form(self, self.problem.model)

@@ -55,7 +55,7 @@ from fdikit.design.game.single_fault import (
 from fdikit.design.observers.full_order import observer_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
-from fdikit.protocols import joined_form
+from fdikit.protocols import ProblemDesign
 from fdikit.residuals import ResidualGenerator
 
 __all__ = [
@@ -71,7 +71,7 @@ _MINIMIZE_METHODS = ("nelder-mead", "powell", "cg", "bfgs", "newton-cg", "l-bfgs
 
 # ---------------------------------------------------------------------------- multiple faults
 @dataclass(frozen=True, eq=False)
-class GameDesign:
+class GameDesign(ProblemDesign):
     """Steady-state game-theoretic multiple-fault detection filter (GTMFDF, Murray 2012 (3.27)–(3.28)).
 
     Attributes
@@ -115,13 +115,6 @@ class GameDesign:
     nit: int
     problem: GameProblem
 
-    def internal_form(self) -> FaultModel:
-        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
-
-        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
-        model the design was made for (the model of ``problem``).
-        """
-        return joined_form(self, self.problem.model)
 
     def report(self) -> dict:
         """``gain`` (``L``), ``poles``, ``riccati`` (``Π_i``) and ``hamiltonian_margins`` by target, ``projectors``

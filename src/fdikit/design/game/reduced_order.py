@@ -46,14 +46,14 @@ from fdikit.design.game.goh import GohRiccatiSolution, goh_riccati
 from fdikit.design.game.setup import GameProblem, game_problem, per_target
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
-from fdikit.protocols import joined_form
+from fdikit.protocols import ProblemDesign
 from fdikit.residuals import ResidualGenerator
 
 __all__ = ["GohFilterDesign", "goh_filter", "goh_detector"]
 
 
 @dataclass(frozen=True, eq=False)
-class GohFilterDesign:
+class GohFilterDesign(ProblemDesign):
     """A reduced-order asymptotic (γ → 0) game filter and its design report.
 
     Attributes
@@ -113,13 +113,6 @@ class GohFilterDesign:
         return {"A11": At[:k, :k], "A12": At[:k, k:], "A21": At[k:, :k], "A22": At[k:, k:],
                 "C1": Ct[:, :k], "C2": Ct[:, k:]}
 
-    def internal_form(self) -> FaultModel:
-        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
-
-        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
-        model the design was made for (the model of ``problem``).
-        """
-        return joined_form(self, self.problem.model)
 
     def report(self) -> dict:
         """``gain`` (``L₁``), ``poles`` (of ``A₁₁ − L₁C₁``), ``order`` (``n₁``), ``transformation`` (``Γ``),

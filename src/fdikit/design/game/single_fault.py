@@ -33,7 +33,7 @@ from fdikit.design.observers.full_order import observer_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.fault_maps import resolve_nuisance
 from fdikit.model import FaultModel
-from fdikit.protocols import joined_form
+from fdikit.protocols import ProblemDesign, joined_form
 from fdikit.residuals import ResidualGenerator, stack_generators
 
 __all__ = [
@@ -88,7 +88,7 @@ def continuous_only(model: FaultModel, **given) -> None:
 
 # ---------------------------------------------------------------------------- single fault
 @dataclass(frozen=True, eq=False)
-class SingleFaultGameDesign:
+class SingleFaultGameDesign(ProblemDesign):
     """Single-fault game-theoretic detection filter (GTFDF, Murray 2012 (3.29)–(3.30)).
 
     Attributes
@@ -125,13 +125,6 @@ class SingleFaultGameDesign:
     problem: GameProblem
     solver: str
 
-    def internal_form(self) -> FaultModel:
-        """The plant ``model`` and this filter in series, from ``(u, d, f, w)`` to ``r``.
-
-        ``generator.internal_form(model)`` (:meth:`~fdikit.residuals.ResidualGenerator.internal_form`) with the
-        model the design was made for (the model of ``problem``).
-        """
-        return joined_form(self, self.problem.model)
 
     def report(self) -> dict:
         """``target``, ``gain`` (``L``), ``poles`` (of ``A − L C``), ``covariance`` (``P``), ``projector`` (``Ĥ``)
