@@ -382,3 +382,10 @@ def test_game_filter_on_a_discrete_model_is_dgtmfdf():
         game_filter(st.model, ["f1", "f2"], **kw, options={"maxfun": 3})
     with pytest.raises(ParameterError, match="discrete optimiser method"):
         game_filter(st.model, ["f1", "f2"], **kw, method="L-BFGS-B")
+
+
+def test_a_non_model_is_a_parameter_error_not_an_attribute_error():
+    from fdikit.errors import ParameterError
+
+    with pytest.raises(ParameterError, match="model"):
+        discrete_game_setup("not a model", ["f1"], gamma=1.0, Vbar=1.0, Q=1.0, M=1.0)

@@ -300,3 +300,14 @@ def test_bias_detectable_in_noisy_simulation(plant, printed):
         pre, post = blocks[(tb >= 4) & (tb + 2.0 <= 60)], blocks[tb >= 80]
         shift = np.abs(post.mean(axis=0) - pre.mean(axis=0)) / pre.std(axis=0, ddof=1)
         assert shift[iso == fault].max() > floor and shift[iso != fault].max() < 1.0, (fault, shift)
+
+
+def test_invariance_defect_is_at_rounding_level_when_the_image_collapses():
+    # With α = 0 for the sensor fault, (A − LC) W maps the sensor space to ~1e-15: the space is exactly invariant,
+    # and the defect must say so (relative to ‖A − LC‖ ‖W‖, not to the collapsed image).
+    fam = detection_gain_family(f16xl_gust(), ["y_Az_sensor", "elevon_actuator"])
+    L = fam.gain({"elevon_actuator": [[-2.0]]})
+    A_cl = fam.A - L @ fam.C
+    W = fam.spaces["y_Az_sensor"]
+    assert np.linalg.norm(A_cl @ W) < 1e-12 * np.linalg.norm(A_cl, 2) * np.linalg.norm(W, 2)
+    assert max(fam.invariance_defect(L).values()) < 1e-12

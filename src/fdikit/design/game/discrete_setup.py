@@ -205,8 +205,8 @@ def discrete_game_setup(
         A continuous model, a singular Φ, a name given both as target and nuisance, or a target hidden by its
         complementary faults (:func:`~fdikit.design.game.setup.game_problem`).
     ParameterError
-        γ not positive and finite, ``steps`` not a positive integer, ``V̄``, ``P0`` or ``M_i`` not positive
-        definite, a weight of the wrong size or not symmetric positive semidefinite, a weight mapping that misses
+        ``model`` not a FaultModel, γ not positive and finite, ``steps`` not a positive integer, ``V̄``, ``P0``
+        or ``M_i`` not positive definite, a weight of the wrong size or not symmetric positive semidefinite, a weight mapping that misses
         a target, or an unknown fault name.
 
     Examples
@@ -221,9 +221,9 @@ def discrete_game_setup(
     ----------
     Murray 2012, §5.1.1, (5.1), (5.8), Assumptions 5.1–5.5; §5.1.2, (5.9); §5.2.2, (5.39).
     """
+    validate.instance("model", model, FaultModel)
     if not model.is_discrete:
         raise DesignError("the discrete game filter needs a discrete model; sample the plant with model.discretize(dt)")
-    validate.instance("model", model, FaultModel)
     gamma = validate.number("gamma", gamma, finite=False)
     if not (np.isfinite(gamma) and gamma > 0):
         raise ParameterError(f"gamma must be a positive finite attenuation bound, got {gamma}")

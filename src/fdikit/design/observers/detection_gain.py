@@ -117,13 +117,22 @@ class DetectionGainFamily:
         return alphas, -L @ N0
 
     def invariance_defect(self, L: np.ndarray) -> dict[str, float]:
-        """``‖(I − P_{W_i})(A − LC) W_i‖ / ‖(A − LC) W_i‖`` per fault, for an observer gain (0: ``W_i`` invariant)."""
+        """``‖(I − P_{W_i})(A − LC) W_i‖ / (‖A − LC‖ ‖W_i‖)`` per fault, for an observer gain (0: ``W_i`` invariant).
+
+        The part of ``(A − LC) W_i`` outside ``W_i``, relative to the scale of the closed loop and of the basis
+        (spectral norms), so an exactly invariant space reads at rounding level (~1e-16) even when
+        ``(A − LC) W_i`` itself is nearly zero; the defect of a space that is not invariant is at most 1.
+        (Normalising by ``‖(A − LC) W_i‖`` instead, as before, read 0.38 for an invariant space whose image had
+        collapsed to 2e-15.)
+        """
         Acl = self.A - np.asarray(L, dtype=float) @ self.C
+        scale = np.linalg.norm(Acl, 2)
         out = {}
         for k, W in self.spaces.items():
             Q = linalg.orth(W)
             X = Acl @ W
-            out[k] = float(np.linalg.norm(X - Q @ (Q.T @ X)) / max(np.linalg.norm(X), np.finfo(float).tiny))
+            denom = max(scale * np.linalg.norm(W, 2), np.finfo(float).tiny)
+            out[k] = float(np.linalg.norm(X - Q @ (Q.T @ X), 2) / denom)
         return out
 
 
