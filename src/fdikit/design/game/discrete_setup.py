@@ -206,8 +206,8 @@ def discrete_game_setup(
         complementary faults (:func:`~fdikit.design.game.setup.game_problem`).
     ParameterError
         ``model`` not a FaultModel, γ not positive and finite, ``steps`` not a positive integer, ``V̄``, ``P0``
-        or ``M_i`` not positive definite, a weight of the wrong size or not symmetric positive semidefinite, a weight mapping that misses
-        a target, or an unknown fault name.
+        or ``M_i`` not positive definite, a weight of the wrong size or not symmetric positive semidefinite, a
+        weight mapping that misses a target, or an unknown fault name.
 
     Examples
     --------
