@@ -241,13 +241,13 @@ def test_bad_input_raises_design_errors():
     st = discrete_game_setup(md, ["f1", "f2"], gamma=1.0, Vbar=1.0, Q=0.1, M=1.0, steps=10)
     with pytest.raises(DesignError, match="I − LC is singular"):
         discrete_game_riccati(st, np.linalg.pinv(md.C) @ np.diag([1.0, 1.0]) @ md.C @ np.linalg.pinv(md.C))
-    with pytest.raises(DesignError, match="name the one"):
+    with pytest.raises(ParameterError, match="name the one"):
         dgtfdf(st)
     with pytest.raises(DesignError, match="K_i and N_i are all zero"):
         dgtmfdf(st)
     with pytest.raises(ParameterError, match="max_radius"):
         dgtmfdf(st, max_radius=1.0)
-    with pytest.raises(DesignError, match="one constant gain"):
+    with pytest.raises(ParameterError, match="one constant gain"):
         secondary_cost(st, np.zeros((10, 3, 2)))
 
 

@@ -152,11 +152,11 @@ def dgtfdf(setup: DiscreteGameSetup, targets: str | Sequence[str] | None = None,
     Raises
     ------
     ParameterError
-        ``setup`` not a :class:`~fdikit.design.game.discrete_setup.DiscreteGameSetup`, or more than one target
-        named.
+        ``setup`` not a :class:`~fdikit.design.game.discrete_setup.DiscreteGameSetup`, more than one target
+        named, no target named when the setup has several, or a name that is not a target of the setup.
     DesignError
-        No target named when the setup has several, a name that is not a target of the setup, or positivity of
-        ``Γ = Θ − CᵀĤQĤC`` lost at a step (γ is not attainable with these weights; the message gives the step).
+        Positivity of ``Γ = Θ − CᵀĤQĤC`` lost at a step (γ is not attainable with these weights; the message
+        gives the step).
 
     Examples
     --------
@@ -174,13 +174,13 @@ def dgtfdf(setup: DiscreteGameSetup, targets: str | Sequence[str] | None = None,
     """
     validate.instance("setup", setup, DiscreteGameSetup, "build it with discrete_game_setup(...)")
     if targets is None and len(setup.names) > 1:
-        raise DesignError(f"the setup has targets {list(setup.names)}; name the one the single-fault filter detects")
+        raise ParameterError(f"the setup has targets {list(setup.names)}; name the one the single-fault filter detects")
     given = [setup.names[0]] if targets is None else [targets] if isinstance(targets, str) else list(targets)
     if len(given) != 1:
         raise ParameterError(f"dgtfdf detects one target, got {given}; use dgtmfdf for several")
     target = str(given[0]).partition(":")[0]
     if target not in setup.names:
-        raise DesignError(f"{target!r} is not a target of the setup; targets are {list(setup.names)}")
+        raise ParameterError(f"{target!r} is not a target of the setup; targets are {list(setup.names)}")
     m = setup.model
     Phi, C, V = m.A, m.C, setup.V
     R, Nc = setup.output_weight_root(target), setup.nuisance_covariance(target)

@@ -324,9 +324,11 @@ def discrete_game_riccati(setup: DiscreteGameSetup, L) -> GameRiccatiSolution:
 
     Raises
     ------
+    ParameterError
+        ``L`` of another shape.
     DesignError
-        ``L`` of another shape, ``I − L(k)C`` singular, or positivity of ``P⁻¹ − CᵀĤQĤC`` lost (the message
-        names the target, the step and the smallest eigenvalue: γ is not met with this gain).
+        ``I − L(k)C`` singular, or positivity of ``P⁻¹ − CᵀĤQĤC`` lost (the message names the target, the step
+        and the smallest eigenvalue: γ is not met with this gain).
 
     Examples
     --------
@@ -349,7 +351,7 @@ def discrete_game_riccati(setup: DiscreteGameSetup, L) -> GameRiccatiSolution:
     n = m.n
     L = np.asarray(L, dtype=float)
     if L.shape not in ((n, m.p), (steps, n, m.p)):
-        raise DesignError(f"gain has shape {L.shape}; give n x p = {n} x {m.p} or a ({steps}, {n}, {m.p}) sequence")
+        raise ParameterError(f"gain has shape {L.shape}; give n x p = {n} x {m.p} or a ({steps}, {n}, {m.p}) sequence")
     Ls = L if L.ndim == 3 else L[None]
     for Lk in Ls:
         _check_gain(Lk, m.C)
@@ -410,7 +412,7 @@ def _adjoint(setup: DiscreteGameSetup, L: np.ndarray, sol: GameRiccatiSolution):
 def _constant_gain(setup: DiscreteGameSetup, L) -> np.ndarray:
     L = np.asarray(L, dtype=float)
     if L.shape != (setup.model.n, setup.model.p):
-        raise DesignError(f"the secondary optimisation uses one constant gain: L must be n x p = "
+        raise ParameterError(f"the secondary optimisation uses one constant gain: L must be n x p = "
                           f"{setup.model.n} x {setup.model.p}, got shape {L.shape}")
     return L
 
@@ -438,9 +440,10 @@ def secondary_cost(setup: DiscreteGameSetup, L) -> tuple[float, np.ndarray]:
 
     Raises
     ------
+    ParameterError
+        ``L`` not n x p.
     DesignError
-        ``L`` not n x p, ``I − LC`` singular, or the DARI infeasible with this gain
-        (:func:`discrete_game_riccati`).
+        ``I − LC`` singular, or the DARI infeasible with this gain (:func:`discrete_game_riccati`).
 
     Examples
     --------
@@ -481,8 +484,10 @@ def gain_update(setup: DiscreteGameSetup, L) -> np.ndarray:
 
     Raises
     ------
+    ParameterError
+        ``L`` not n x p.
     DesignError
-        ``L`` not n x p, ``I − LC`` singular or the DARI infeasible (:func:`discrete_game_riccati`), or
+        ``I − LC`` singular or the DARI infeasible (:func:`discrete_game_riccati`), or
         ``Σ Γ_iΛ_i(Γ_i + CᵀV⁻¹C)`` singular (the null spaces overlap across targets, Remark 5.3).
 
     Examples
