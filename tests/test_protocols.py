@@ -22,6 +22,7 @@ from fdikit.decision import (
     MhsprtEvaluator,
     SprtEvaluator,
     ThresholdEvaluator,
+    Whitened,
 )
 from fdikit.errors import DesignError
 from fdikit.plants.f16xl import F16XL_DRYDEN_GAIN, f16xl_gust, f16xl_longitudinal
@@ -272,6 +273,8 @@ def _fit(kind, ev=None):
         "mhsprt": (lambda: MhsprtEvaluator(), lambda e: e.fit({"none": h, "fa": fa, "fb": fb})),
         "gaussian_ml": (lambda: GaussianMlEvaluator(inputs="raw"), lambda e: e.fit(labelled)),
         "bnn": (lambda: BnnEvaluator(inputs="raw", max_iter=8, rm_steps=0), lambda e: e.fit(labelled)),
+        "whitened_cusum": (lambda: Whitened(CusumEvaluator(hold=2), order=2),
+                           lambda e: e.fit(h, arl0=500.0, shift=1.0)),
     }[kind]
     return fit(new() if ev is None else ev)
 
@@ -299,7 +302,8 @@ def _assert_same(d, stepped, what):
     np.testing.assert_array_equal(d.valid, valid, err_msg=what)
 
 
-@pytest.mark.parametrize("kind", ["threshold", "cusum", "glr", "sprt", "mhsprt", "gaussian_ml", "bnn"])
+@pytest.mark.parametrize("kind", ["threshold", "cusum", "glr", "sprt", "mhsprt", "gaussian_ml", "bnn",
+                                  "whitened_cusum"])
 def test_evaluator_protocol_batch_online_refit_reset(kind):
     ev = _fit(kind)
     assert isinstance(ev, Evaluator)

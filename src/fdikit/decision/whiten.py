@@ -18,7 +18,7 @@ import numpy as np
 import scipy.linalg
 import scipy.signal
 
-from fdikit.decision.common import is_count
+from fdikit.decision.common import is_count, step_vector
 from fdikit.diagnosis import Diagnosis, StepDecision
 from fdikit.errors import DataError, ParameterError
 from fdikit.residuals import Residuals
@@ -153,13 +153,19 @@ class Whitened:
         if reset is not None:
             reset()
 
-    def step(self, r) -> StepDecision:
-        """One sample: the innovation from the last ``p`` valid samples, then the wrapped ``step``."""
+    def step(self, r, *, valid: bool = True, names=None) -> StepDecision:
+        """One sample: the innovation from the last ``p`` valid samples, then the wrapped ``step``.
+
+        The :class:`~fdikit.protocols.Evaluator` step: ``valid=False`` or a NaN/inf entry (a gap, or a
+        recovering sample after one) skips the sample as :meth:`run` does — the AR memory is not advanced and
+        the wrapped evaluator holds its decision; ``names`` (or a mapping ``{name: value}``) are checked
+        against the residual names of the fit.
+        """
         if self.coef is None:
             raise ParameterError("the whitener is not fitted; call fit() on fault-free residuals")
-        r = np.asarray(r, dtype=float).ravel()
-        if not np.all(np.isfinite(r)):
-            return self.evaluator.step(r)  # the wrapped evaluator holds its decision
+        r = step_vector(r, getattr(self.evaluator, "names", None), names, "the whitener")
+        if not valid or not np.all(np.isfinite(r)):
+            return self.evaluator.step(np.full(r.shape, np.nan), valid=False)  # skipped, as in run()
         x = r - self.center
         e = x.copy()
         for j, past in enumerate(reversed(self._past)):  # past[-1] is x_{k−1}
