@@ -10,40 +10,8 @@ Both are imported here (they need only numpy and scipy.linalg): ``from fdikit im
 The fault maps ``F`` these functions take are built by :mod:`fdikit.fault_maps`.
 """
 
-from fdikit.linalg.geometry import (  # noqa: F401 - the package namespace
-    caisa,
-    detection_space,
-    invariant_zeros,
-    mutually_detectable,
-    output_projector,
-    output_separable,
-)
-from fdikit.linalg.subspaces import (  # noqa: F401 - the package namespace
-    EPS,
-    as_2d,
-    checked_rtol,
-    contains,
-    intersect,
-    null,
-    orth,
-    rank,
-    span_sum,
-)
+from fdikit.linalg import geometry, subspaces
+from fdikit.linalg.geometry import *  # noqa: F403 - the package namespace is its modules' names
+from fdikit.linalg.subspaces import *  # noqa: F403 - the package namespace is its modules' names
 
-__all__ = [
-    "rank",
-    "orth",
-    "null",
-    "intersect",
-    "span_sum",
-    "contains",
-    "as_2d",
-    "checked_rtol",
-    "EPS",
-    "output_projector",
-    "caisa",
-    "invariant_zeros",
-    "detection_space",
-    "output_separable",
-    "mutually_detectable",
-]
+__all__ = [*subspaces.__all__, *geometry.__all__]

@@ -11,42 +11,8 @@ constructors pass ``error=ModelError`` and data readers ``error=DataError``.
 Both are imported here: ``from fdikit import validate; validate.positive("dt", dt)``.
 """
 
-from fdikit.validate.arrays import (  # noqa: F401 - the package namespace
-    as_array,
-    as_complex_vector,
-    as_covariance,
-    as_matrix,
-    as_square,
-    as_vector,
-    noise_covariance,
-    psd_part,
-)
-from fdikit.validate.scalars import (  # noqa: F401 - the package namespace
-    choice,
-    in_range,
-    instance,
-    integer,
-    non_negative,
-    number,
-    positive,
-    shown,
-)
+from fdikit.validate import arrays, scalars
+from fdikit.validate.arrays import *  # noqa: F403 - the package namespace is its modules' names
+from fdikit.validate.scalars import *  # noqa: F403 - the package namespace is its modules' names
 
-__all__ = [
-    "as_array",
-    "as_matrix",
-    "as_square",
-    "as_vector",
-    "as_complex_vector",
-    "as_covariance",
-    "noise_covariance",
-    "psd_part",
-    "number",
-    "positive",
-    "non_negative",
-    "integer",
-    "in_range",
-    "choice",
-    "instance",
-    "shown",
-]
+__all__ = [*arrays.__all__, *scalars.__all__]
