@@ -59,7 +59,7 @@ from fdikit.simulate_diagnosis import jacobian_text, linear_cause, refuse_non_fi
 from fdikit.simulate_varying import frozen_A, simulate_varying
 from fdikit.trace import Trace
 
-__all__ = ["NonlinearPlant", "simulate", "simulate_scheduled", "time_grid"]
+__all__ = ["NonlinearPlant", "apply_faults", "simulate", "simulate_scheduled", "time_grid"]
 
 
 @dataclass(frozen=True)
@@ -165,12 +165,46 @@ def _gaussian(rng: np.random.Generator, cov: np.ndarray, N: int) -> np.ndarray:
     return rng.standard_normal((N, cov.shape[0])) @ L.T
 
 
-def _apply_faults(scenario: FaultScenario, location: str, t: np.ndarray, signals: np.ndarray,
-                  names: Sequence[str], streams: Sequence[np.random.Generator]) -> np.ndarray:
+def apply_faults(scenario: FaultScenario, location: str, t: np.ndarray, signals: np.ndarray,
+                 names: Sequence[str], streams: Sequence[np.random.Generator]) -> np.ndarray:
     """``signals`` (N, k) with the scenario's ``location`` faults applied in scenario order, one stream per fault.
 
-    A fault that makes a finite signal non-finite (an overflow of a finite but huge size) is
-    refused with a DataError naming the fault, the signal and the first bad sample.
+    What :func:`simulate` does to the commands (``"actuator"``) before the plant and to the
+    measurements (``"sensor"``) after the noise; public so that other simulators (the compiled
+    car of :mod:`fdikit.vehicle`) inject faults the same way.
+
+    Parameters
+    ----------
+    scenario : FaultScenario
+        Resolved against ``names`` (:meth:`FaultScenario.resolve`).
+    location : {"actuator", "sensor"}
+        Which faults to apply.
+    t : (N,) ndarray
+        Sample times [s].
+    signals : (N, k) ndarray
+        The clean signals, one column per name.
+    names : sequence of str
+        Column names (controls or outputs).
+    streams : sequence of numpy.random.Generator
+        One random stream per fault of the scenario (in scenario order).
+
+    Returns
+    -------
+    (N, k) ndarray
+        A copy with the faults applied.
+
+    Raises
+    ------
+    DataError
+        When a fault makes a finite signal non-finite (the message names the fault, signal and first bad sample).
+
+    Examples
+    --------
+    >>> from fdikit.faults import Bias
+    >>> sc = FaultScenario([Bias("y", 2.0, onset=0.5)]).resolve(["y"], [])
+    >>> apply_faults(sc, "sensor", np.array([0.0, 1.0]), np.zeros((2, 1)), ["y"],
+    ...              np.random.default_rng(0).spawn(1)).ravel().tolist()
+    [0.0, 2.0]
     """
     out = signals.copy()
     for f, rf in zip(scenario, streams):
@@ -347,7 +381,7 @@ def simulate(
 
     # independent streams: adding a fault or a noise source never shifts the others' draws
     rng_w, rng_v, *rng_f = rng.spawn(2 + len(scenario))
-    u_act = _apply_faults(scenario, "actuator", t, u_cmd, controls, rng_f)
+    u_act = apply_faults(scenario, "actuator", t, u_cmd, controls, rng_f)
     if isinstance(plant, FaultModel):
         y, x = _simulate_linear(plant, h, t, u_act, d_arr, x0, W, rng_w)
     else:
@@ -357,7 +391,7 @@ def simulate(
         with np.errstate(over="ignore", invalid="ignore"):
             y = y + _gaussian(rng_v, R, N)
         refuse_non_finite(t, [("output", y, outputs)], lambda: "the measurement noise is too large for the outputs")
-    y = _apply_faults(scenario, "sensor", t, y, outputs, rng_f)
+    y = apply_faults(scenario, "sensor", t, y, outputs, rng_f)
 
     info = {"plant": repr(plant), "seed": seed, "scenario": scenario.label, "faults": [repr(f) for f in scenario]}
     info.update(meta or {})
@@ -547,7 +581,7 @@ def simulate_scheduled(
     d_arr = check_signal("d", d, t, m0.disturbances)
     warn_inactive(scenario, t)
     _, _, *rng_f = gen.spawn(2 + len(scenario))  # the fault streams of simulate()
-    u_act = _apply_faults(scenario, "actuator", t, u_cmd, m0.controls, rng_f)
+    u_act = apply_faults(scenario, "actuator", t, u_cmd, m0.controls, rng_f)
     if np.all(rho == rho[0]):
         y, x = _simulate_linear(m0, m0.dt, t, u_act, d_arr, x0, None, None)
     else:
@@ -557,7 +591,7 @@ def simulate_scheduled(
                               lambda: scheduled_cause(lambda values: frozen_A(family, m0, rho, values), rho, x))
         np.add(y, 0.0, out=y)
         np.add(x, 0.0, out=x)
-    y = _apply_faults(scenario, "sensor", t, y, m0.outputs, rng_f)
+    y = apply_faults(scenario, "sensor", t, y, m0.outputs, rng_f)
     return Trace(t=t, u=u_cmd, y=np.hstack([y, rho[:, None]]), controls=m0.controls,
                  outputs=m0.outputs + (schedule_name,), x=x, states=m0.states, d=d_arr,
                  disturbances=m0.disturbances, fault=scenario.truth(t),
