@@ -3,13 +3,16 @@
 The report gives no vehicle parameters (Douglas et al. 1996, Ch. 2 and Ch. 8 print none); its
 Berkeley model is that of Peng 1992.  :data:`MID_SIZE_SEDAN` is a front-drive mid-size sedan of the
 1990s with values in the ranges of the sources named per field below; they are fdikit's choices
-within those ranges, not the measured data of one car.  Five numbers were then calibrated to the
-report's own runs (:mod:`fdikit.vehicle.calibration` reproduces it):
+within those ranges, not the measured data of one car.  These numbers were then calibrated to the
+report's own runs and spectrum (:func:`fdikit.vehicle.calibration.calibrate` reproduces the first two):
 
-* ``indicated_efficiency`` so that 22.555 % throttle (of the 90° butterfly) holds 27 m/s on a level
-  road (§8.3.1);
+* ``throttle_max_flow`` (the throttle body's capacity MAX) so that 22.555 % throttle (of the 90°
+  butterfly) holds 27 m/s on a level road (§8.3.1);
 * ``cg_to_front_axle`` (the weight split, hence the understeer) so that a 0.005 rad steer at
   24.87 m/s gives the 638.73 m radius of §2.2;
+* springs and dampers (ride modes ≈ 1 Hz, damping ratio ≈ 0.3), ``manifold_volume`` and
+  ``clutch_slip_damping`` chosen by hand so the body and engine modes of the Method-1 model are
+  near Table 2.1's (−2.07 ± 6.54i, −1.44 ± 5.50i, −2.82 ± 5.60i; −26.46 ± 4.32i);
 * ``brake_lag`` 0.8 s, ``throttle_lag`` 11 ms and ``steering_lag`` 12.5 ms: the actuator modes
   −1.25, −90.91 and −80 of the 22-state spectrum (§2.3).
 
@@ -110,14 +113,14 @@ class SedanParameters:
     pitch_inertia: float = 2400.0
     yaw_inertia: float = 2600.0
     wheelbase: float = 2.69
-    cg_to_front_axle: float = 1.2266
+    cg_to_front_axle: float = 1.226594
     track: float = 1.56
     cg_height: float = 0.55
-    spring_front: float = 27000.0
-    spring_rear: float = 20000.0
+    spring_front: float = 19000.0
+    spring_rear: float = 14000.0
     spring_cubic: float = 2.0e8
-    damper_front: float = 2150.0
-    damper_rear: float = 1500.0
+    damper_front: float = 1800.0
+    damper_rear: float = 1250.0
     damper_knee: float = 0.13
     damper_blowoff: float = 0.5
     tire_stiffness: float = 200000.0
@@ -135,10 +138,10 @@ class SedanParameters:
     final_drive: float = 3.05
     driveline_efficiency: float = 0.90
     gear: int = 4
-    clutch_slip_damping: float = 30.0
+    clutch_slip_damping: float = 6.5
     engine_inertia: float = 0.20
-    throttle_max_flow: float = 0.303764
-    manifold_volume: float = 3.5e-3
+    throttle_max_flow: float = 0.319236
+    manifold_volume: float = 1.85e-3
     manifold_temperature: float = 300.0
     displacement: float = 3.0e-3
     volumetric_efficiency: float = 0.80

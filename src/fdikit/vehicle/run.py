@@ -121,9 +121,9 @@ def simulate_sedan(car, duration: float, *, start=None, commands=None, road=None
     w = np.zeros((n_steps, 2)) if wind is None else validate.as_array("wind(t)", wind(t_step))
     if w.shape != (n_steps, 2):
         raise ParameterError(f"simulate_sedan: wind(t) must return ({n_steps}, 2) earth-frame wind, got {w.shape}")
-    reach = duration * max(start.speed, 1.0) * 2.0 + 50.0
-    road = flat_road(reach) if road is None else validate.instance("road", road, RoadProfile)
-    if road.length < min(reach, duration * 60.0):
+    reach = duration * max(start.speed, 1.0) * 1.5 + 20.0  # room for the car to speed up by half
+    road = flat_road(2.0 * reach) if road is None else validate.instance("road", road, RoadProfile)
+    if road.length < reach:
         raise ParameterError(f"simulate_sedan: the road is {road.length:g} m long, the run may travel about "
                              f"{reach:g} m; generate a longer road")
     std = _noise(measurement_noise_std)

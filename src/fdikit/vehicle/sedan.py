@@ -218,7 +218,7 @@ class Sedan:
         loads = P.corner_loads()
         r = P.tire_radius - loads / P.tire_stiffness
         x = np.zeros(len(STATES))
-        x[0] = 2.0e-3
+        x[0] = 0.5 * P.ambient_pressure * P.manifold_volume / (287.05 * P.manifold_temperature)  # half an atmosphere
         x[1] = P.gear_ratio() * speed / r[0]
         x[2] = speed
         x[5] = P.cg_height

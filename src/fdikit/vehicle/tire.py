@@ -1,4 +1,4 @@
-"""Magic-Formula tire forces with combined slip (Bakker, Nyborg & Pacejka 1987).
+"""Magic-Formula tire forces with combined slip (Bakker et al. 1987).
 
 Douglas et al. 1996, Ch. 8 §8.1.8 (8.43)–(8.45) and §8.2 Table 8.1 give the Magic Formula
 ``y(x) = D sin(C atan(Bx − E(Bx − atan Bx)))`` with load-dependent factors, and (8.98)–(8.103) the
@@ -18,7 +18,7 @@ The report's slip ``λ = 1 − v/(r ω)`` (8.41) is singular at ω = 0 and unbou
 
 The kernels are compiled with numba (the car integrates at 1 kHz); :func:`tire_forces` is their
 array interface.  Written by hand because no maintained Python tire library implements the
-1987 Magic Formula with Bakker's combined slip as the report uses it.
+Magic Formula of Bakker et al. 1987 with Bakker's combined slip as the report uses it.
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ __all__ = ["TireCoefficients", "BAKKER_1987", "tire_forces", "peak_slips", "slip
 
 @dataclass(frozen=True)
 class TireCoefficients:
-    """Magic-Formula 1987 coefficients (load in kN, slip ratio in %, slip angle in degrees, forces in N).
+    """Magic-Formula coefficients of the 1987 form (load in kN, slip ratio in %, slip angle in degrees, forces in N).
 
     Longitudinal: ``C = a0``, ``D = a1 N² + a2 N``, ``BCD = (a3 N² + a4 N) e^{−a5 N}``, ``E = a6 N² + a7 N + a8``.
     Lateral: ``C = b0``, ``D = b1 N² + b2 N``, ``BCD = b3 sin(b4 atan(b5 N))``, ``E = b6 N² + b7 N + b8``.
@@ -106,7 +106,7 @@ class TireCoefficients:
         return np.array(astuple(self), dtype=float)
 
 
-#: The passenger-car tire of Bakker, Nyborg & Pacejka 1987 (SAE 870421), zero camber.
+#: The passenger-car tire of Bakker et al. 1987 (SAE 870421), zero camber.
 BAKKER_1987 = TireCoefficients(
     a0=1.65, a1=-21.3, a2=1144.0, a3=49.6, a4=226.0, a5=0.069, a6=-0.006, a7=0.056, a8=0.486,
     b0=1.30, b1=-22.1, b2=1011.0, b3=1078.0, b4=1.82, b5=0.208, b6=0.0, b7=-0.354, b8=0.707,

@@ -196,7 +196,8 @@ def _dc(model: FaultModel, gen: ResidualGenerator) -> np.ndarray:
     return R.C @ np.linalg.solve(M, R.Bf) + R.Df
 
 
-def path_bank(dt: float | None = None, poles: dict | None = None) -> PathBank:
+def path_bank(dt: float | None = None, poles: dict | None = None, *, models: tuple[FaultModel, FaultModel] | None = None,
+              nominal: Mapping[str, float] | None = None) -> PathBank:
     """Design the PATH four-filter bank (continuous, or on the ZOH models at ``dt`` with ``e^{λ dt}``).
 
     Parameters
@@ -207,6 +208,12 @@ def path_bank(dt: float | None = None, poles: dict | None = None) -> PathBank:
     poles : dict, optional
         Filter name → ``(sets, complement)`` replacing entries of :data:`EIGENVALUES` (continuous-time
         eigenvalues of ``A − L C``: one list per fault in :data:`FILTER_GROUPS` order, then Ξ_0).
+    models : (FaultModel, FaultModel), optional
+        The continuous 12-state (sensor filters) and 14-state (filter 4) design models, e.g. those of the
+        nonlinear car (:func:`fdikit.studies.path1996.reduction.path_design_models`); default App. D
+        (``tiny='midpoint'``).  Outputs and controls must carry the App. D names.
+    nominal : mapping of str to float, optional
+        Nominal fault sizes for the residual scaling (default :func:`nominal_fault_sizes`); all 15 faults.
 
     Returns
     -------
@@ -244,10 +251,17 @@ def path_bank(dt: float | None = None, poles: dict | None = None) -> PathBank:
             raise ParameterError(f"poles given for unknown filter(s) {unknown}; the filters are "
                                  f"{list(FILTER_GROUPS)}")
     eig = dict(EIGENVALUES, **(poles or {}))
-    nominal = nominal_fault_sizes()
+    if models is None:
+        models = (path_vehicle_12("midpoint"), path_vehicle_14("midpoint"))
+    elif len(models) != 2 or not all(isinstance(m, FaultModel) and not m.is_discrete for m in models):
+        raise ParameterError("models must be (12-state, 14-state) continuous FaultModels")
+    nominal = dict(nominal_fault_sizes() if nominal is None else nominal)
+    missing = sorted({f.partition(":")[0] for specs in FILTER_GROUPS.values() for f in specs} - set(nominal))
+    if missing:
+        raise ParameterError(f"nominal: no size for {missing}; give all 15 fault sizes")
     designs, gens, groups, scales = {}, [], [], {}
     for name, specs in FILTER_GROUPS.items():
-        base = path_vehicle_14("midpoint") if name == "filter4" else path_vehicle_12("midpoint")
+        base = models[1] if name == "filter4" else models[0]
         model = base if dt is None else base.discretize(dt)
         sets, comp = eig[name]
 
