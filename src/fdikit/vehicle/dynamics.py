@@ -23,8 +23,8 @@ Equations (with the corrections the report's own checks call for):
   (``y`` the signed lateral position, ``y = −s`` of the report); normal force
   ``N = K_w max(r_w0 − r_w, 0)`` (8.29);
 * suspension (8.77) **with ``r_zz`` for the printed cos(θ − γ)**: ``N r_zz = f_K(h) + f_C(ḣ)``,
-  ``f_K = F_0 − K(h − h_s) − K'(h − h_s)^5`` (8.25) about the static length, ``f_C = −F_d(ḣ)`` the piecewise-linear damper
-  (8.27, on ``ḣ``), solved for ``ḣ``;
+  ``f_K = F_0 − K(h − h_s) − K'(h − h_s)^5`` (8.25) about the static length, ``f_C = −F_d(ḣ)``
+  the piecewise-linear damper (8.27, on ``ḣ``), solved for ``ḣ``;
 * wheel-centre velocity (8.93), slip angle (8.95) ``α = −atan(v·r_y / v·r_x)``, slip ratio (8.92)
   regularised (:mod:`fdikit.vehicle.tire`), combined-slip Magic Formula;
 * forces (8.82)–(8.87); moments **from the cross product** ``(l, y, −h) × F`` (the printed

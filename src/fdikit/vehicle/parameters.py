@@ -167,7 +167,8 @@ class SedanParameters:
                 validate.positive(f"SedanParameters.{f.name}", v)
             object.__setattr__(self, f.name, v)
         validate.instance("SedanParameters.tire", self.tire, TireCoefficients)
-        ratios = tuple(validate.positive(f"SedanParameters.gear_ratios[{k}]", r) for k, r in enumerate(self.gear_ratios))
+        ratios = tuple(validate.positive(f"SedanParameters.gear_ratios[{k}]", r)
+                       for k, r in enumerate(self.gear_ratios))
         object.__setattr__(self, "gear_ratios", ratios)
         validate.integer("SedanParameters.gear", self.gear, minimum=1)
         if self.gear > len(ratios):
