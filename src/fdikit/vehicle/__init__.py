@@ -11,6 +11,7 @@ road roughness, slope, 32 → 22 states) and Ch. 8 (Nguyen's 6-DOF equations of 
 * :mod:`fdikit.vehicle.sedan` — The car as a plant: operating points, linearisation, simulation.
 * :mod:`fdikit.vehicle.run` — Simulation runs with road, wind, faults and sensor noise.
 * :mod:`fdikit.vehicle.road` — Road profiles (Robson, Gill two-track, bumps) and crosswind.
+* :mod:`fdikit.vehicle.longitudinal` — The 3-DOF longitudinal car of §8.1 (x, z, pitch) on the same parts.
 * :mod:`fdikit.vehicle.validity` — The effective ranges of the linearised car (Table 8.2, ≤ 10 % error).
 """
 
@@ -26,6 +27,8 @@ __getattr__, __dir__, __all__ = lazy.attach(
         "integrate": ["run_kernel"],
         "sedan": ["OperatingPoint", "SIGNALS", "Sedan"],
         "run": ["GEARBOX_MODES", "simulate_sedan"],
+        "longitudinal": ["LONGITUDINAL_AUXILIARY", "LONGITUDINAL_CONTROLS", "LONGITUDINAL_SENSORS",
+                         "LONGITUDINAL_STATES", "LongitudinalCar", "LongitudinalPoint"],
         "validity": ["NOMINAL_THROTTLE", "TABLE_8_2", "ValidityRanges", "steady_state_error", "validity_ranges"],
     },
 )
