@@ -49,9 +49,20 @@ def test_simulate_bad_input():
     assert res.exit_code == 2 and "gremlin" in res.output and "kind" in res.output
 
 
-def test_demo_bank(tmp_path):
-    """The default demo: the PATH bank isolates a yaw-rate gyro bias and a throttle fault."""
+def test_demo_vehicle(tmp_path):
+    """The default demo: on the nonlinear car at realistic noise the game bank + MHSSPRT isolate both faults."""
     res = runner.invoke(app, ["demo", "--out", str(tmp_path)], terminal_width=200)
+    assert res.exit_code == 0, res.output
+    assert "yaw_rate_sensor" in res.output and "throttle_actuator" in res.output
+    assert res.output.count("True") == 2
+    assert (tmp_path / "report.png").stat().st_size > 10_000
+    tr = Trace.load(tmp_path / "trace_throttle_actuator.parquet")
+    assert np.isclose(tr.fault_onset, 10.0) and set(tr.fault) == {"none", "throttle_actuator"}
+
+
+def test_demo_bank(tmp_path):
+    """The linear demo: the PATH Beard–Jones bank isolates a yaw-rate gyro bias and a throttle fault."""
+    res = runner.invoke(app, ["demo", "--method", "bank", "--out", str(tmp_path)], terminal_width=200)
     assert res.exit_code == 0, res.output
     assert "yaw_rate_sensor" in res.output and "throttle_actuator" in res.output
     assert res.output.count("True") == 2

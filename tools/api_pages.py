@@ -31,6 +31,7 @@ PAGES = [
     ("estimate", "fdikit.estimate", "Fault estimation"),
     ("analysis", "fdikit.analysis", "Analysis"),
     ("nonlinear", "fdikit.nonlinear", "Nonlinear plants: trim, linearisation, reduction"),
+    ("vehicle", "fdikit.vehicle", "The nonlinear PATH vehicle"),
     ("studies-path1996", "fdikit.studies.path1996", "Study: Douglas et al. 1996 (PATH)"),
     ("studies-hallouzi2008", "fdikit.studies.hallouzi2008", "Study: Hallouzi 2008"),
     ("studies-vanderploeg2018", "fdikit.studies.vanderploeg2018", "Study: van der Ploeg 2018"),

@@ -34,7 +34,7 @@ def test_nominal_sizes_follow_section_5_1_1(setup):
 @pytest.mark.parametrize("fault", ["yaw_rate_sensor", "accel_z_sensor", "engine_speed_sensor"])
 def test_a_nominal_sensor_fault_drives_its_own_residual_to_one_on_the_nonlinear_car(setup, fault):
     run = fault_run(setup, fault, "smooth", duration=12.0, noise=False)
-    mags = group_magnitudes(run.residuals, setup.bank)
+    mags = group_magnitudes(run.residuals["beard-jones"])  # the report's filters, as §5.1.1 checks them
     own = [g for g in mags if g.endswith(":" + fault)]
     for g in own:
         # scaled on the linear model to 1; the car is nonlinear, the fault small: within 10 %
@@ -46,25 +46,43 @@ def test_a_nominal_sensor_fault_drives_its_own_residual_to_one_on_the_nonlinear_
 
 
 def test_off_nominal_throttle_against_the_report(setup):
-    peaks = off_nominal_peaks(setup, duration=30.0)
-    # the report: every scaled residual < 0.25 in the +2° off-nominal run.  Met by the sensor filters except the
-    # vertical accelerometer of filter 1; not met in filter 4 (brake, steering, air mass): docs/methods/
-    # nonlinear_vehicle.md gives the numbers.
+    peaks = off_nominal_peaks(setup, bank="beard-jones")
+    # the report: every scaled residual < 0.25 in the +2° off-nominal run.  Met by filters 2 and 3, filter 1's
+    # engine-speed and pitch-rate groups and filter 4's throttle group; not met by filter 1's lateral (0.26) and
+    # vertical (2.6) accelerometer groups and filter 4's brake, steering and air-mass groups: the numbers are in
+    # docs/methods/nonlinear_vehicle.md.
     met = [g for g in peaks if g.split(":")[0] in ("filter2", "filter3")] + [
-        "filter1:engine_speed_sensor", "filter1:accel_y_sensor", "filter1:pitch_rate_sensor",
-        "filter4:throttle_actuator"]
+        "filter1:engine_speed_sensor", "filter1:pitch_rate_sensor", "filter4:throttle_actuator"]
     assert max(peaks[g] for g in met) < 0.25
     assert len(peaks) == 16
 
 
-def test_reduced_table_runs_and_scores(setup):
-    table = path_evaluation_table(setup, roads=("smooth",), faults=["yaw_rate_sensor", "engine_speed_sensor"],
-                                  fault_free_hours=0.1, seed=3)
-    rows = {(r.fault, r.processor): r for r in table.rows}
-    for f in ("yaw_rate_sensor", "engine_speed_sensor"):
-        assert rows[(f, "MHSSPRT")].detected and rows[(f, "MHSSPRT")].isolated
-        assert rows[(f, "threshold (5 of 10)")].detected
-    # thresholds set for 1 false alarm per hour: over 0.1 h a Poisson count of mean 0.1 exceeds 2 with p ≈ 1.5e-4
-    n, hours = table.false_alarms[("smooth", "threshold (5 of 10)")]
-    assert 0.09 < hours <= 0.101 and n <= 2
-    assert np.isfinite(table.rate("smooth", "MHSSPRT"))
+def test_reduced_table_both_banks(setup):
+    # the same runs through both banks; the game bank is the PATH monitor's default
+    faults = ["yaw_rate_sensor", "pitch_rate_sensor", "accel_x_sensor", "throttle_actuator"]
+    table = path_evaluation_table(setup, roads=("rough",), faults=faults, fault_free_hours=0.1, seed=3,
+                                  processors=["threshold", "mhsprt-whitened"])
+    rows = {(r.bank, r.fault, r.processor): r for r in table.rows}
+    for f in faults:
+        r = rows[("game", f, "MHSSPRT, whitened")]
+        assert r.detected and r.isolated, r
+    # thresholds for 1 false alarm per hour: over 0.1 h a Poisson count of mean 0.1 exceeds 2 with p ≈ 1.5e-4; the
+    # whitened MHSSPRT's F_T is set on a fault-free run of the same length, so it is held to the same bound
+    for bank in ("beard-jones", "game"):
+        for proc in ("threshold (5 of 10)", "MHSSPRT, whitened"):
+            n, hours = table.false_alarms[("rough", bank, proc)]
+            assert 0.09 < hours <= 0.101 and n <= 2, (bank, proc, n)
+    # at realistic noise the report's Beard–Jones bank with thresholds misses the pitch-rate and accelerometer biases
+    assert not rows[("beard-jones", "pitch_rate_sensor", "threshold (5 of 10)")].detected
+    assert table.counts()[("rough", "game", "MHSSPRT, whitened")] == (4, 4, 4)
+
+
+def test_game_bank_attenuates_the_noise_the_beard_jones_bank_amplifies(setup):
+    # fault-free rms of each scaled residual group (nominal fault = 1) on the smooth road with sensor noise
+    run = fault_run(setup, None, "smooth", duration=60.0, rng=5)
+    rms = {b: {g: float(np.sqrt(np.mean(m[500:] ** 2))) for g, m in group_magnitudes(run.residuals[b]).items()}
+           for b in ("beard-jones", "game")}
+    # the pitch-rate and vertical-accelerometer groups: measured ≈ 22 and ≈ 150 (Beard–Jones) against ≈ 0.2 and ≈ 4.5
+    # (game); asserted with a factor-2 margin on each side
+    assert rms["beard-jones"]["filter1:pitch_rate_sensor"] > 10 > 0.5 > rms["game"]["filter1:pitch_rate_sensor"]
+    assert rms["beard-jones"]["filter1:accel_z_sensor"] > 75 > 10 > rms["game"]["filter1:accel_z_sensor"]

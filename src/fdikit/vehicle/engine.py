@@ -88,9 +88,9 @@ def engine_state(params, air_mass, engine_speed, throttle) -> dict[str, np.ndarr
     Examples
     --------
     >>> from fdikit.vehicle.parameters import MID_SIZE_SEDAN
-    >>> out = engine_state(MID_SIZE_SEDAN, 2.0e-3, 190.0, 20.0)
+    >>> out = engine_state(MID_SIZE_SEDAN, 1.0e-3, 190.0, 20.0)
     >>> round(float(out["manifold_pressure"]) / 1e3, 1)  # kPa
-    49.2
+    46.5
     """
     from fdikit.errors import ParameterError
 

@@ -103,7 +103,7 @@ class SedanParameters:
     Examples
     --------
     >>> MID_SIZE_SEDAN.mass, round(MID_SIZE_SEDAN.front_weight_fraction, 3)
-    (1550.0, 0.605)
+    (1550.0, 0.544)
     >>> MID_SIZE_SEDAN.with_(mass=1600.0).mass
     1600.0
     """

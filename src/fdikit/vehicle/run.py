@@ -89,8 +89,8 @@ def simulate_sedan(car, duration: float, *, start=None, commands=None, road=None
     >>> from fdikit.faults import Bias, FaultScenario
     >>> car = Sedan()
     >>> tr = simulate_sedan(car, 2.0, scenario=FaultScenario([Bias("yaw_rate", 0.02, onset=1.0)]))
-    >>> round(float(tr.y[-1, 7]), 6), tr.fault[-1].tolist()
-    (0.02, [True])
+    >>> round(float(tr.y[-1, 7]), 6), str(tr.fault[-1])
+    (0.02, 'yaw_rate_sensor')
     """
     from fdikit.faults import FaultScenario
     from fdikit.simulate import apply_faults

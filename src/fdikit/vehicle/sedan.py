@@ -267,7 +267,7 @@ class Sedan:
         --------
         >>> op = Sedan().operating_point(speed=24.87, steering=0.005)
         >>> round(op.radius), round(op.lateral_acceleration_g, 3)
-        (637, 0.099)
+        (639, 0.099)
         """
         from fdikit.nonlinear import trim
 

@@ -250,7 +250,7 @@ def peak_slips(load, tire: TireCoefficients = BAKKER_1987) -> tuple[np.ndarray, 
     --------
     >>> lam, alpha = peak_slips(4000.0)
     >>> round(float(lam), 3), round(float(np.degrees(alpha)), 2)
-    (0.122, 7.01)
+    (0.103, 9.35)
     """
     loads = _loads(load, "peak_slips")
     c = tire.as_array()
@@ -296,9 +296,10 @@ def tire_forces(load, slip_ratio, slip_angle, tire: TireCoefficients = BAKKER_19
     --------
     Pure slip at 4 kN: the lateral peak is about 0.92 × the load, the longitudinal about 1.06 ×:
 
-    >>> fx, fy = tire_forces(4000.0, [0.0, 0.122], [0.1223, 0.0])
+    >>> lam, alpha = peak_slips(4000.0)
+    >>> fx, fy = tire_forces(4000.0, [0.0, float(lam)], [float(alpha), 0.0])
     >>> np.round(fy / 4000, 3).tolist(), np.round(fx / 4000, 3).tolist()
-    ([0.922, 0.0], [0.0, 1.059])
+    ([0.923, 0.0], [0.0, 1.059])
     """
     loads = np.asarray(load, dtype=float)
     lam = np.asarray(slip_ratio, dtype=float)

@@ -48,6 +48,7 @@ from fdikit.residuals import ResidualGenerator, stack_generators
 
 __all__ = [
     "PathBank", "path_bank", "path_runs", "FILTER_GROUPS", "EIGENVALUES", "nominal_fault_sizes", "path_fault_model",
+    "scale_to_nominal",
 ]
 
 #: Fault names per filter (``<output>_sensor``, ``<control>_actuator``; ``:magnitude`` keeps ``A F¹`` only).
@@ -196,7 +197,71 @@ def _dc(model: FaultModel, gen: ResidualGenerator) -> np.ndarray:
     return R.C @ np.linalg.solve(M, R.Bf) + R.Df
 
 
-def path_bank(dt: float | None = None, poles: dict | None = None, *, models: tuple[FaultModel, FaultModel] | None = None,
+def scale_to_nominal(name: str, base: FaultModel, generator: ResidualGenerator, faults, nominal: Mapping[str, float],
+                     dt: float | None = None) -> tuple[ResidualGenerator, dict]:
+    """Scale each fault's residual group of one filter so its nominal fault gives magnitude 1 in steady state.
+
+    Parameters
+    ----------
+    name : str
+        The filter's name; the residuals are renamed ``'<name>:<residual>'``.
+    base : FaultModel
+        The continuous design model the filter was designed on (its sensor, and for filter 4 actuator, faults are
+        added to compute the steady-state gains).
+    generator : ResidualGenerator
+        The filter's generator (continuous, or discrete at ``dt``), ``isolates`` naming the faults.
+    faults : sequence of str
+        The filter's faults.
+    nominal : mapping of str to float
+        Nominal size of each fault.
+    dt : float, optional
+        Sample time of a discrete generator.
+
+    Returns
+    -------
+    generator : ResidualGenerator
+        The scaled, renamed generator.
+    scales : dict of (str, str) to float
+        ``(name, fault)`` → the divisor.
+
+    Raises
+    ------
+    DesignError
+        When a fault has no steady-state residual.
+
+    References
+    ----------
+    Douglas et al. 1996, §5.1.1 (the residual scaling).
+
+    Examples
+    --------
+    >>> bank = path_bank()  # doctest: +SKIP
+    >>> round(bank.scales[("filter2", "yaw_rate_sensor")], 4) > 0  # doctest: +SKIP
+    True
+    """
+    check = base.with_sensor_faults(base.outputs)
+    if any(f.endswith("_actuator") for f in faults):
+        check = check.with_actuator_faults(base.controls)
+    if dt is not None:
+        check = check.discretize(dt)
+    G = _dc(check, generator)
+    g = generator
+    factors = np.ones(len(g.residuals))
+    scales = {}
+    for f in faults:
+        rows = [k for k, iso in enumerate(g.isolates) if iso == f]
+        mag = np.linalg.norm(G[rows, check.faults.index(f)]) * nominal[f]
+        if not mag > 0:
+            raise DesignError(f"{name}: fault {f} has no steady-state residual; it cannot be scaled")
+        factors[rows] = 1.0 / mag
+        scales[(name, f)] = mag
+    scaled = ResidualGenerator(g.A, g.B, factors[:, None] * g.C, factors[:, None] * g.D, g.controls, g.outputs,
+                               [f"{name}:{r}" for r in g.residuals], g.dt, g.isolates)
+    return scaled, scales
+
+
+def path_bank(dt: float | None = None, poles: dict | None = None, *,
+              models: tuple[FaultModel, FaultModel] | None = None,
               nominal: Mapping[str, float] | None = None) -> PathBank:
     """Design the PATH four-filter bank (continuous, or on the ZOH models at ``dt`` with ``e^{λ dt}``).
 
@@ -279,26 +344,9 @@ def path_bank(dt: float | None = None, poles: dict | None = None, *, models: tup
         except DesignError as exc:
             raise DesignError(f"{name}: {exc}") from exc
         designs[name] = d
-        # scale each fault's residual group so the nominal fault gives magnitude 1 in steady state
-        check = base.with_sensor_faults(base.outputs)
-        if name == "filter4":
-            check = check.with_actuator_faults(base.controls)
-        if dt is not None:
-            check = check.discretize(dt)
-        G = _dc(check, d.generator)
-        g = d.generator
-        factors = np.ones(len(g.residuals))
-        for f in faults:
-            rows = [k for k, iso in enumerate(g.isolates) if iso == f]
-            mag = np.linalg.norm(G[rows, check.faults.index(f)]) * nominal[f]
-            if not mag > 0:
-                raise DesignError(f"{name}: fault {f} has no steady-state residual; it cannot be scaled")
-            factors[rows] = 1.0 / mag
-            scales[(name, f)] = mag
-        gens.append(ResidualGenerator(
-            g.A, g.B, factors[:, None] * g.C, factors[:, None] * g.D, g.controls, g.outputs,
-            [f"{name}:{r}" for r in g.residuals], g.dt, g.isolates,
-        ))
+        g, group_scales = scale_to_nominal(name, base, d.generator, faults, nominal, dt)
+        scales.update(group_scales)
+        gens.append(g)
         groups += [name] * len(g.residuals)
     return PathBank(designs, stack_generators(gens), tuple(groups), nominal, scales)
 

@@ -1,6 +1,7 @@
-"""The end-to-end demos on the PATH vehicle.
+"""The end-to-end demos on the linear PATH vehicle (the default demo on the nonlinear car is
+:mod:`fdikit.studies.path1996.vehicle_demo`).
 
-:func:`run_demo` (``fdikit demo``): the four-filter Beard–Jones bank of
+:func:`run_demo` (``fdikit demo --method bank``): the four-filter Beard–Jones bank of
 :mod:`fdikit.studies.path1996.bank` diagnoses a yaw-rate gyro bias and a throttle actuator
 fault, each isolated by the bank logic, and writes a structure plot (fault × residual gain).
 
@@ -94,7 +95,7 @@ class DemoResult:
     files: dict
 
 
-def check_demo_arguments(*, out="out/demo", seed=2026, method="bank", onset=10.0, duration=30.0,
+def check_demo_arguments(*, out="out/demo", seed=2026, method="vehicle", onset=10.0, duration=30.0,
                          calibration_minutes=10.0, dt=0.01, **positive) -> Path:
     """Check the demo's arguments before any work; return the output folder (created, writable).
 
@@ -104,7 +105,7 @@ def check_demo_arguments(*, out="out/demo", seed=2026, method="bank", onset=10.0
         Output folder; created if missing, must be writable.
     seed : int, default 2026
         Seed, >= 0.
-    method : {"bank", "kalman"}, default "bank"
+    method : {"vehicle", "bank", "kalman"}, default "vehicle"
         Which demo.
     onset, duration : float, default 10.0, 30.0
         Fault onset and run length [s]; ``onset < duration``.
@@ -123,9 +124,9 @@ def check_demo_arguments(*, out="out/demo", seed=2026, method="bank", onset=10.0
     Raises
     ------
     ParameterError
-        Naming the argument: ``method`` 'bank' or 'kalman', ``seed`` an integer >= 0, ``onset`` < ``duration``,
-        times and the other keyword values (``fault_size``, ``noise_fraction``, ``false_alarms_per_hour``)
-        finite and > 0, ``out`` a writable folder.
+        Naming the argument: ``method`` 'vehicle', 'bank' or 'kalman', ``seed`` an integer >= 0,
+        ``onset`` < ``duration``, times and the other keyword values (``fault_size``, ``noise_fraction``,
+        ``false_alarms_per_hour``) finite and > 0, ``out`` a writable folder.
 
     References
     ----------
@@ -140,8 +141,8 @@ def check_demo_arguments(*, out="out/demo", seed=2026, method="bank", onset=10.0
     """
     from fdikit.resume import check_output_folder, check_positive, check_seed
 
-    if method not in ("bank", "kalman"):
-        raise ParameterError(f"unknown method (--method) {method!r}; use 'bank' or 'kalman'")
+    if method not in ("vehicle", "bank", "kalman"):
+        raise ParameterError(f"unknown method (--method) {method!r}; use 'vehicle', 'bank' or 'kalman'")
     check_seed(seed)
     for name, value in {"onset": onset, "duration": duration, "calibration_minutes": calibration_minutes, "dt": dt,
                         **positive}.items():

@@ -52,10 +52,14 @@ class EvaluationSetup:
         Linearisation and reductions at that point.
     nominal : dict of str to float
         Nominal size of each of the 15 faults (sensor units; deg, N m, rad).
-    bank : PathBank
-        The four Beard–Jones filters designed on ``models`` (continuous), scaled with ``nominal``.
-    generator : ResidualGenerator
-        The bank discretised at 100 Hz (what runs on the data).
+    banks : dict of str to PathBank
+        The banks on ``models`` (continuous, scaled with ``nominal``): ``"beard-jones"`` (the report's filters,
+        :func:`~fdikit.studies.path1996.bank.path_bank`) and ``"game"`` (disturbance attenuating,
+        :func:`~fdikit.studies.path1996.game_bank.path_game_bank`).
+    generators : dict of str to ResidualGenerator
+        Each bank discretised at 100 Hz (what runs on the data).
+    default : str
+        The bank :attr:`bank` and :attr:`generator` return (the PATH monitor's default, ``"game"``).
 
     References
     ----------
@@ -72,8 +76,19 @@ class EvaluationSetup:
     operating_point: object
     models: object
     nominal: dict
-    bank: object
-    generator: object = field(repr=False)
+    banks: dict = field(repr=False)
+    generators: dict = field(repr=False)
+    default: str = "game"
+
+    @property
+    def bank(self):
+        """The default bank."""
+        return self.banks[self.default]
+
+    @property
+    def generator(self):
+        """The default bank's 100 Hz generator."""
+        return self.generators[self.default]
 
 
 def car_nominal_sizes(car, op) -> dict[str, float]:
@@ -166,6 +181,7 @@ def evaluation_setup(car=None) -> EvaluationSetup:
     8
     """
     from fdikit.studies.path1996.bank import path_bank
+    from fdikit.studies.path1996.game_bank import path_game_bank
     from fdikit.studies.path1996.reduction import path_design_models
     from fdikit.vehicle import Sedan
 
@@ -173,8 +189,10 @@ def evaluation_setup(car=None) -> EvaluationSetup:
     op = car.operating_point(speed=24.87, steering=0.005)
     nominal = car_nominal_sizes(car, op)
     models = path_design_models(car, nominal=nominal)
-    bank = path_bank(models=(models.model12, models.method1), nominal=nominal)
-    return EvaluationSetup(car, op, models, nominal, bank, bank.generator.discretize(_DT))
+    pair = (models.model12, models.method1)
+    banks = {"beard-jones": path_bank(models=pair, nominal=nominal),
+             "game": path_game_bank(pair, nominal, NOISE_STD, dt=_DT)}
+    return EvaluationSetup(car, op, models, nominal, banks, {k: b.generator.discretize(_DT) for k, b in banks.items()})
 
 
 def deviation_trace(trace, op):
@@ -220,8 +238,12 @@ class FaultRun:
         ``"smooth"`` or ``"rough"``.
     trace : Trace
         Deviation trace (:func:`deviation_trace`).
-    residuals : Residuals
-        The bank's scaled residuals.
+    residuals : dict of str to Residuals
+        Every bank's scaled residuals on the same trace.
+
+    References
+    ----------
+    Douglas et al. 1996, §5.1.
 
     Examples
     --------
@@ -274,7 +296,7 @@ def fault_run(setup: EvaluationSetup, fault: str | None, road: str, *, duration:
     Examples
     --------
     >>> run = fault_run(evaluation_setup(), "yaw_rate_sensor", "smooth", duration=4.0)  # doctest: +SKIP
-    >>> run.residuals.r.shape  # doctest: +SKIP
+    >>> run.residuals["beard-jones"].r.shape  # doctest: +SKIP
     (401, 29)
     """
     from fdikit import validate
@@ -295,18 +317,16 @@ def fault_run(setup: EvaluationSetup, fault: str | None, road: str, *, duration:
     trace = setup.car.simulate(duration, start=op, commands=commands, road=profile, scenario=FaultScenario(faults),
                                measurement_noise_std=NOISE_STD if noise else None, rng=rng_sim)
     dev = deviation_trace(trace, op)
-    return FaultRun(fault, road, dev, setup.generator.run(dev))
+    return FaultRun(fault, road, dev, {k: g.run(dev) for k, g in setup.generators.items()})
 
 
-def group_magnitudes(residuals, bank) -> dict[str, np.ndarray]:
+def group_magnitudes(residuals) -> dict[str, np.ndarray]:
     """Per (filter, fault) residual group: the Euclidean norm of its scaled residuals per sample.
 
     Parameters
     ----------
     residuals : Residuals
-        The bank's residuals.
-    bank : PathBank
-        The bank (its residual names ``'<filter>:<fault>[k]'``).
+        A bank's residuals (names ``'<filter>:<fault>[k]'``).
 
     Returns
     -------
@@ -321,7 +341,7 @@ def group_magnitudes(residuals, bank) -> dict[str, np.ndarray]:
     --------
     >>> from fdikit.residuals import Residuals
     >>> res = Residuals(np.arange(2.0), np.array([[3.0, 4.0], [0.0, 1.0]]), ("f1:a[0]", "f1:a[1]"), ("a", "a"))
-    >>> group_magnitudes(res, None)["f1:a"].tolist()
+    >>> group_magnitudes(res)["f1:a"].tolist()
     [5.0, 1.0]
     """
     groups: dict[str, list[int]] = {}
@@ -330,7 +350,8 @@ def group_magnitudes(residuals, bank) -> dict[str, np.ndarray]:
     return {g: np.linalg.norm(residuals.r[:, idx], axis=1) for g, idx in groups.items()}
 
 
-def off_nominal_peaks(setup: EvaluationSetup, *, duration: float = 60.0, settle: float = 2.0) -> dict[str, float]:
+def off_nominal_peaks(setup: EvaluationSetup, *, duration: float = 60.0, settle: float = 2.0,
+                      bank: str | None = None) -> dict[str, float]:
     """The §5.1.1 off-nominal test: +2° throttle, no fault, smooth road, no noise; peak scaled magnitude per group.
 
     Parameters
@@ -341,6 +362,8 @@ def off_nominal_peaks(setup: EvaluationSetup, *, duration: float = 60.0, settle:
         Run length [s] (the car settles ≈ 2 m/s faster).
     settle : float, default 2.0
         Filter start-up time left out [s] (the report adds faults at 2 s for the same reason).
+    bank : str, optional
+        Which bank (default the setup's default).
 
     Returns
     -------
@@ -360,5 +383,6 @@ def off_nominal_peaks(setup: EvaluationSetup, *, duration: float = 60.0, settle:
     op = setup.operating_point
     run = fault_run(setup, None, "smooth", duration=duration, noise=False,
                     commands=[op.u[0] + 2.0, op.u[1], op.u[2]])
-    keep = run.residuals.t >= settle
-    return {g: float(m[keep].max()) for g, m in group_magnitudes(run.residuals, setup.bank).items()}
+    res = run.residuals[setup.default if bank is None else bank]
+    keep = res.t >= settle
+    return {g: float(m[keep].max()) for g, m in group_magnitudes(res).items()}

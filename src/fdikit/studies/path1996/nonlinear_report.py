@@ -42,23 +42,27 @@ def table_markdown(table) -> str:
     Examples
     --------
     >>> from fdikit.studies.path1996.nonlinear_table import EvaluationTable
-    >>> table_markdown(EvaluationTable([], {}, {"filter1:a": 0.1}, {})).splitlines()[0]
+    >>> table_markdown(EvaluationTable([], {}, {"game": {"filter1:a": 0.1}}, {})).splitlines()[0]
     '# PATH Ch. 5 on the nonlinear car'
     """
     lines = ["# PATH Ch. 5 on the nonlinear car", "",
              "The report: every fault \"clearly identified\" on both roads (§5.1). fdikit, realistic sensor noise:", "",
-             "| road | processor | detected | isolated | false alarms / h |", "|---|---|---|---|---|"]
-    for (road, proc), (det, iso, n) in sorted(table.counts().items()):
-        lines.append(f"| {road} | {proc} | {det}/{n} | {iso}/{n} | {table.rate(road, proc):.3g} |")
+             "| road | bank | processor | detected | isolated | false alarms / h |", "|---|---|---|---|---|---|"]
+    for (road, bank, proc), (det, iso, n) in sorted(table.counts().items()):
+        lines.append(f"| {road} | {bank} | {proc} | {det}/{n} | {iso}/{n} | {table.rate(road, bank, proc):.3g} |")
+    banks = list(table.off_nominal)
     lines += ["", "Off-nominal (+2° throttle, no fault, smooth road): peak scaled magnitude per residual group "
-              "(the report: all < 0.25)", "", "| group | peak |", "|---|---|"]
-    lines += [f"| {g} | {v:.3g} |" for g, v in table.off_nominal.items()]
-    lines += ["", "| road | fault | processor | detected | delay [s] | isolated as | isolation delay [s] |",
-              "|---|---|---|---|---|---|---|"]
+              "(the report: all < 0.25)", "", "| group | " + " | ".join(banks) + " |",
+              "|---|" + "---|" * len(banks)]
+    groups = list(table.off_nominal[banks[0]]) if banks else []
+    lines += [f"| {g} | " + " | ".join(f"{table.off_nominal[b].get(g, float('nan')):.3g}" for b in banks) + " |"
+              for g in groups]
+    lines += ["", "| road | bank | fault | processor | detected | delay [s] | isolated as | isolation delay [s] |",
+              "|---|---|---|---|---|---|---|---|"]
     for r in table.rows:
         d = "—" if r.detection_delay is None else f"{r.detection_delay:.2f}"
         i = "—" if r.isolation_delay is None else f"{r.isolation_delay:.2f}"
-        lines.append(f"| {r.road} | {r.fault} | {r.processor} | {'yes' if r.detected else 'no'} | {d} | "
+        lines.append(f"| {r.road} | {r.bank} | {r.fault} | {r.processor} | {'yes' if r.detected else 'no'} | {d} | "
                      f"{r.isolated_as} | {i} |")
     return "\n".join(lines) + "\n"
 
@@ -145,15 +149,15 @@ def plot_fig_2_6(models, ax=None, path=None, frequencies=None):
     return finish_plot(fig, ax, path)
 
 
-def plot_fault_residuals(run, bank, ax=None, path=None, onset: float = 2.0):
+def plot_fault_residuals(run, bank: str, ax=None, path=None, onset: float = 2.0):
     """Scaled residual magnitudes of every group in the faulty run's own filter, with the nominal level 1.
 
     Parameters
     ----------
     run : FaultRun
         A faulty run.
-    bank : PathBank
-        The bank.
+    bank : str
+        Which bank's residuals (a key of ``run.residuals``).
     ax : matplotlib Axes, optional
         Where to draw.
     path : str or Path, optional
@@ -171,29 +175,30 @@ def plot_fault_residuals(run, bank, ax=None, path=None, onset: float = 2.0):
 
     Examples
     --------
-    >>> fig = plot_fault_residuals(run, bank)  # doctest: +SKIP
+    >>> fig = plot_fault_residuals(run, "game")  # doctest: +SKIP
     """
     from fdikit.plots import axes_or_new, finish_plot
     from fdikit.studies.path1996.nonlinear_evaluation import group_magnitudes
 
-    mags = group_magnitudes(run.residuals, bank)
+    res = run.residuals[bank]
+    mags = group_magnitudes(res)
     own = [g for g in mags if g.split(":")[1] == run.fault.split(":")[0]]
     filt = own[0].split(":")[0] if own else next(iter(mags)).split(":")[0]
     fig, (a,) = axes_or_new(ax, 1)
     for g, m in mags.items():
         if g.startswith(filt + ":"):
-            a.plot(run.residuals.t, m, label=g.split(":")[1], lw=1.8 if g in own else 0.8)
+            a.plot(res.t, m, label=g.split(":")[1], lw=1.8 if g in own else 0.8)
     a.axhline(1.0, color="k", ls=":", lw=0.8)
     a.axvline(onset, color="grey", ls="--", lw=0.8)
     a.set_xlabel("t [s]")
     a.set_ylabel("scaled residual magnitude")
-    a.set_title(f"{run.fault} ({run.road} road), {filt}")
+    a.set_title(f"{run.fault} ({run.road} road), {bank} bank, {filt}")
     a.legend(fontsize=7)
     return finish_plot(fig, ax, path)
 
 
 def write_path_evaluation(out, table, setup) -> dict[str, Path]:
-    """Write ``table.md``, ``rows.csv``, ``table_2_1.md``, ``fig_2_6.png`` and ``residuals/<road>_<fault>.png``.
+    """Write ``table.md``, ``rows.csv``, ``table_2_1.md``, ``fig_2_6.png``, ``residuals/<bank>_<road>_<fault>.png``.
 
     Parameters
     ----------
@@ -230,15 +235,16 @@ def write_path_evaluation(out, table, setup) -> dict[str, Path]:
     (out / "residuals").mkdir(parents=True, exist_ok=True)
     files = {"table": write_text(out / "table.md", table_markdown(table)),
              "table_2_1": write_text(out / "table_2_1.md", table_2_1_markdown(setup.models))}
-    head = "road,fault,processor,detected,isolated,detection_delay,isolation_delay,isolated_as\n"
-    csv = head + "".join(f"{r.road},{r.fault},{r.processor},{r.detected},{r.isolated},{r.detection_delay},"
+    head = "road,bank,fault,processor,detected,isolated,detection_delay,isolation_delay,isolated_as\n"
+    csv = head + "".join(f"{r.road},{r.bank},{r.fault},{r.processor},{r.detected},{r.isolated},{r.detection_delay},"
                          f"{r.isolation_delay},{r.isolated_as}\n" for r in table.rows)
     files["rows"] = write_text(out / "rows.csv", csv)
     fig = plot_fig_2_6(setup.models, path=out / "fig_2_6.png")
     plt.close(fig)
     files["fig_2_6"] = out / "fig_2_6.png"
     for (road, fault), run in table.runs.items():
-        p = out / "residuals" / f"{road}_{fault}.png"
-        plt.close(plot_fault_residuals(run, setup.bank, path=p))
-        files[f"residuals/{road}_{fault}"] = p
+        for bank in run.residuals:
+            p = out / "residuals" / f"{bank}_{road}_{fault}.png"
+            plt.close(plot_fault_residuals(run, bank, path=p))
+            files[f"residuals/{bank}_{road}_{fault}"] = p
     return files
