@@ -238,6 +238,9 @@ def path_evaluation(
     seed: int = typer.Option(0, help="Seed of every run."),
     roads: str = typer.Option("smooth,rough", help="Comma-separated roads: smooth, rough."),
     faults: str = typer.Option(None, help="Comma-separated fault names (default all 15)."),
+    banks: str = typer.Option(None, help="Comma-separated banks (default all): beard-jones, game, kalman."),
+    processors: str = typer.Option(None, help="Comma-separated processors (default threshold, cusum-whitened, "
+                                   "mhsprt-whitened; 'mhsprt' adds the raw MHSSPRT)."),
     fresh: bool = _fresh_option(),
 ) -> None:
     """The PATH Ch. 5 evaluation on the nonlinear car at realistic sensor noise (Douglas et al. 1996, §5.1).
@@ -255,7 +258,9 @@ def path_evaluation(
     start = time.perf_counter()
     try:
         args = check_evaluation_arguments(roads=roads.split(","), fault_free_hours=hours, seed=seed,
-                                          faults=None if faults is None else faults.split(","))
+                                          faults=None if faults is None else faults.split(","),
+                                          banks=None if banks is None else banks.split(","),
+                                          processors=None if processors is None else processors.split(","))
         store = RunStore(out, "path-evaluation", args, fresh=fresh)
         setup = evaluation_setup()
         table = path_evaluation_table(setup, progress=True, keep_runs=True, store=store, **args)

@@ -57,24 +57,26 @@ def test_off_nominal_throttle_against_the_report(setup):
     assert len(peaks) == 16
 
 
-def test_reduced_table_both_banks(setup):
-    # the same runs through both banks; the game bank is the PATH monitor's default
+def test_reduced_table_all_banks(setup):
+    # the same runs through the three banks
     faults = ["yaw_rate_sensor", "pitch_rate_sensor", "accel_x_sensor", "throttle_actuator"]
     table = path_evaluation_table(setup, roads=("rough",), faults=faults, fault_free_hours=0.1, seed=3,
                                   processors=["threshold", "mhsprt-whitened"])
     rows = {(r.bank, r.fault, r.processor): r for r in table.rows}
-    for f in faults:
-        r = rows[("game", f, "MHSSPRT, whitened")]
-        assert r.detected and r.isolated, r
+    for bank in ("game", "kalman"):
+        for f in faults:
+            r = rows[(bank, f, "MHSSPRT, whitened")]
+            assert r.detected and r.isolated, r
     # thresholds for 1 false alarm per hour: over 0.1 h a Poisson count of mean 0.1 exceeds 2 with p ≈ 1.5e-4; the
     # whitened MHSSPRT's F_T is set on a fault-free run of the same length, so it is held to the same bound
-    for bank in ("beard-jones", "game"):
+    for bank in ("beard-jones", "game", "kalman"):
         for proc in ("threshold (5 of 10)", "MHSSPRT, whitened"):
             n, hours = table.false_alarms[("rough", bank, proc)]
             assert 0.09 < hours <= 0.101 and n <= 2, (bank, proc, n)
     # at realistic noise the report's Beard–Jones bank with thresholds misses the pitch-rate and accelerometer biases
     assert not rows[("beard-jones", "pitch_rate_sensor", "threshold (5 of 10)")].detected
     assert table.counts()[("rough", "game", "MHSSPRT, whitened")] == (4, 4, 4)
+    assert table.counts()[("rough", "kalman", "MHSSPRT, whitened")] == (4, 4, 4)
 
 
 def test_game_bank_attenuates_the_noise_the_beard_jones_bank_amplifies(setup):

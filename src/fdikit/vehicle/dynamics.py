@@ -98,7 +98,7 @@ _V_MIN = 0.5  # m/s: speed floor of the slip definitions
 
 
 @njit(cache=True)
-def _damper_rate(force, c, knee, blowoff):  # pragma: no cover - compiled
+def damper_rate(force, c, knee, blowoff):  # pragma: no cover - compiled
     """``ḣ`` with ``F_d(ḣ) = force`` for the piecewise-linear damper (8.27) (slope c inside ±knee, blowoff·c beyond)."""
     f_knee = c * knee
     if force > f_knee:
@@ -164,7 +164,7 @@ def rhs(x, u, env, p, dx, aux):  # pragma: no cover - compiled
         c = p[_CF] if front else p[_CR]
         dh = hi - p[_HS + i]
         f_k = p[_F0 + i] - k * dh - p[_KC] * dh ** 5
-        hdot = _damper_rate(f_k - n * rzz, c, p[_KNEE], p[_BLOW])
+        hdot = damper_rate(f_k - n * rzz, c, p[_KNEE], p[_BLOW])
         dx[18 + i] = hdot
         # tire heading r_x ⟂ axle and r_z; r_y = r_z × r_x
         tan_d = sd / cd if front else 0.0

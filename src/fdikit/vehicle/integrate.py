@@ -27,7 +27,7 @@ _L = INDEX["wheelbase"]
 
 
 @njit(cache=True)
-def _road(profile, spacing, s):  # pragma: no cover - compiled
+def road_height(profile, spacing, s):  # pragma: no cover - compiled
     """Linear interpolation of ``profile`` (grid step ``spacing``) at distance ``s`` (held beyond the ends)."""
     q = s / spacing
     if q <= 0.0:
@@ -42,10 +42,10 @@ def _road(profile, spacing, s):  # pragma: no cover - compiled
 @njit(cache=True)
 def _stage(x, u, env, p, left, right, spacing, dx, aux):  # pragma: no cover - compiled
     s, wb = x[25], p[_L]
-    env[0] = _road(left, spacing, s)
-    env[1] = _road(right, spacing, s)
-    env[2] = _road(left, spacing, s - wb)
-    env[3] = _road(right, spacing, s - wb)
+    env[0] = road_height(left, spacing, s)
+    env[1] = road_height(right, spacing, s)
+    env[2] = road_height(left, spacing, s - wb)
+    env[3] = road_height(right, spacing, s - wb)
     rhs(x, u, env, p, dx, aux)
 
 

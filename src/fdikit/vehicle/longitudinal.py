@@ -43,7 +43,9 @@ from numba import njit
 
 from fdikit import validate
 from fdikit.errors import DataError, ParameterError
+from fdikit.vehicle.dynamics import damper_rate
 from fdikit.vehicle.engine import engine_kernel
+from fdikit.vehicle.integrate import road_height
 from fdikit.vehicle.parameters import INDEX, MID_SIZE_SEDAN, SedanParameters
 from fdikit.vehicle.tire import combined_forces, slip_kernel
 
@@ -81,17 +83,6 @@ _V_MIN = 0.5  # m/s: speed floor of the slip definition, as the 6-DOF car
 
 
 @njit(cache=True)
-def _damper_rate(force, c, knee, blowoff):  # pragma: no cover - compiled
-    """``ḣ`` with ``F_d(ḣ) = force`` for the piecewise-linear damper (8.27)."""
-    f_knee = c * knee
-    if force > f_knee:
-        return knee + (force - f_knee) / (blowoff * c)
-    if force < -f_knee:
-        return -knee + (force + f_knee) / (blowoff * c)
-    return force / c
-
-
-@njit(cache=True)
 def _rhs(x, u, env, p, dx, aux):  # pragma: no cover - compiled
     """Fill ``dx`` (14) and ``aux``; ``env`` = (road front, road rear, wind_x, grade)."""
     z, th, vx, vz, wy = x[1], x[2], x[3], x[4], x[5]
@@ -116,7 +107,7 @@ def _rhs(x, u, env, p, dx, aux):  # pragma: no cover - compiled
         k, c = 2.0 * (p[_KF] if front else p[_KR]), 2.0 * (p[_CF] if front else p[_CR])
         dh = hi - (p[_HSF] if front else p[_HSR])
         f_k = 2.0 * (p[_F0F] if front else p[_F0R]) - k * dh - 2.0 * p[_KC] * dh ** 5
-        hdot = _damper_rate(f_k - n * cth, c, p[_KNEE], p[_BLOW])
+        hdot = damper_rate(f_k - n * cth, c, p[_KNEE], p[_BLOW])
         dx[8 + i] = hdot
         # wheel-centre velocity (8.39) along r_x = (cos θ, sin θ) in body axes (8.40)
         v_f = (vx - hi * wy) * cth + (vz - li * wy - hdot) * sth
@@ -149,21 +140,9 @@ def _sensors(x, aux, y):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _interp(profile, spacing, s):  # pragma: no cover - compiled
-    """Linear interpolation on the grid ``k · spacing`` (held beyond the ends), as the 6-DOF integrator."""
-    q = s / spacing
-    if q <= 0.0:
-        return profile[0]
-    k = int(math.floor(q))
-    if k >= profile.size - 1:
-        return profile[profile.size - 1]
-    return (1.0 - (q - k)) * profile[k] + (q - k) * profile[k + 1]
-
-
-@njit(cache=True)
 def _stage(x, u, env, p, road, spacing, dx, aux):  # pragma: no cover - compiled
-    env[0] = _interp(road, spacing, x[0])
-    env[1] = _interp(road, spacing, x[0] - p[_L])
+    env[0] = road_height(road, spacing, x[0])
+    env[1] = road_height(road, spacing, x[0] - p[_L])
     _rhs(x, u, env, p, dx, aux)
 
 

@@ -30,7 +30,7 @@ _SHIFT_UP, _SHIFT_DOWN = 4500 * np.pi / 30, 1500 * np.pi / 30
 def simulate_sedan(car, duration: float, *, start=None, commands=None, road=None, wind: Callable | None = None,
                    scenario=None, measurement_noise_std: Mapping | None = None, dt: float = 0.01,
                    step: float = 0.001, gearbox: str = "held", grade: float | None = None, bank: float | None = None,
-                   rng=None):
+                   rng=None, keep_signals: bool = True):
     """Simulate the nonlinear car for ``duration`` seconds.
 
     Parameters
@@ -64,12 +64,16 @@ def simulate_sedan(car, duration: float, *, start=None, commands=None, road=None
         Road slope [rad] (default the start point's).
     rng : numpy.random.Generator or int, optional
         Random source (noise and random faults).
+    keep_signals : bool, default True
+        Keep the auxiliary signals in ``meta["signals"]`` (long runs that do not need them save the memory and the
+        trace's metadata checks).
 
     Returns
     -------
     Trace
         ``u`` the commands (before actuator faults), ``y`` the 12 sensors (noise and sensor faults), ``x`` the 26
-        states; ``meta["signals"]`` a dict of the auxiliary signals per sample and ``meta["gear"]``.
+        states; ``meta["signals"]`` a dict of the auxiliary signals per sample (unless ``keep_signals`` is false) and
+        ``meta["gear"]``.
 
     Raises
     ------
@@ -141,8 +145,10 @@ def simulate_sedan(car, duration: float, *, start=None, commands=None, road=None
     y = y + rng_v.standard_normal(y.shape) * std
     y = apply_faults(scenario, "sensor", t, y, SENSORS, rng_f)
     u_out = u_cmd[np.minimum(np.arange(t.size) * every, n_steps - 1)]
-    meta = {"plant": repr(car), "scenario": scenario.label, "faults": [repr(f) for f in scenario],
-            "signals": dict(zip(AUXILIARY, aux.T)), "gear": gear, "road": road.label, "step": step}
+    meta = {"plant": repr(car), "scenario": scenario.label, "faults": [repr(f) for f in scenario], "gear": gear,
+            "road": road.label, "step": step}
+    if keep_signals:
+        meta["signals"] = dict(zip(AUXILIARY, aux.T))
     return Trace(t=t, u=u_out, y=y, x=x, controls=CONTROLS, outputs=SENSORS, states=STATES,
                  fault=scenario.truth(t), meta=meta)
 

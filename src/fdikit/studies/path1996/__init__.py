@@ -11,6 +11,8 @@ end-to-end demos.
   Table 2.1 and Fig. 2.6.
 * :mod:`fdikit.studies.path1996.game_bank` — The PATH monitor with disturbance-attenuating (game-theoretic) filters on
   the report's fault groups.
+* :mod:`fdikit.studies.path1996.kalman_bank` — A Kalman-filter monitor for the PATH car: one steady-state filter, its
+  12 innovations as residuals.
 * :mod:`fdikit.studies.path1996.nonlinear_evaluation` — The Ch. 5 evaluation on the nonlinear car at realistic sensor
   noise: setup, nominal sizes, runs.
 * :mod:`fdikit.studies.path1996.nonlinear_table` — The Ch. 5 table: detection, isolation and false alarms per fault,
@@ -39,13 +41,16 @@ __getattr__, __dir__, __all__ = lazy.attach(
             "DesignModels", "FAST_STATES", "STATIC_ACTUATORS", "match_eigenvalues", "path_design_models",
             "singular_values",
         ],
+        "kalman_bank": [
+            "path_kalman_bank",
+        ],
         "nonlinear_evaluation": [
             "EvaluationSetup", "FaultRun", "NOISE_STD", "car_nominal_sizes", "deviation_trace", "evaluation_setup",
             "fault_run", "group_magnitudes", "off_nominal_peaks",
         ],
         "nonlinear_table": [
-            "BANKS", "EvaluationTable", "FAULTS", "PROCESSORS", "Prewhitened", "TableRow", "check_evaluation_arguments",
-            "path_evaluation_table", "whitened_mhsprt",
+            "BANKS", "DEFAULT_PROCESSORS", "EvaluationTable", "FAULTS", "PROCESSORS", "Prewhitened", "TableRow",
+            "check_evaluation_arguments", "path_evaluation_table", "whitened_mhsprt",
         ],
         "nonlinear_report": [
             "plot_fault_residuals", "plot_fig_2_6", "table_2_1_markdown", "table_markdown", "write_path_evaluation",

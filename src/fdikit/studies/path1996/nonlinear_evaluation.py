@@ -55,7 +55,8 @@ class EvaluationSetup:
     banks : dict of str to PathBank
         The banks on ``models`` (continuous, scaled with ``nominal``): ``"beard-jones"`` (the report's filters,
         :func:`~fdikit.studies.path1996.bank.path_bank`) and ``"game"`` (disturbance attenuating,
-        :func:`~fdikit.studies.path1996.game_bank.path_game_bank`).
+        :func:`~fdikit.studies.path1996.game_bank.path_game_bank`) and ``"kalman"`` (one steady-state Kalman
+        filter, :func:`~fdikit.studies.path1996.kalman_bank.path_kalman_bank`).
     generators : dict of str to ResidualGenerator
         Each bank discretised at 100 Hz (what runs on the data).
     default : str
@@ -182,6 +183,7 @@ def evaluation_setup(car=None) -> EvaluationSetup:
     """
     from fdikit.studies.path1996.bank import path_bank
     from fdikit.studies.path1996.game_bank import path_game_bank
+    from fdikit.studies.path1996.kalman_bank import path_kalman_bank
     from fdikit.studies.path1996.reduction import path_design_models
     from fdikit.vehicle import Sedan
 
@@ -191,8 +193,10 @@ def evaluation_setup(car=None) -> EvaluationSetup:
     models = path_design_models(car, nominal=nominal)
     pair = (models.model12, models.method1)
     banks = {"beard-jones": path_bank(models=pair, nominal=nominal),
-             "game": path_game_bank(pair, nominal, NOISE_STD, dt=_DT)}
-    return EvaluationSetup(car, op, models, nominal, banks, {k: b.generator.discretize(_DT) for k, b in banks.items()})
+             "game": path_game_bank(pair, nominal, NOISE_STD, dt=_DT),
+             "kalman": path_kalman_bank(models.method1, NOISE_STD, dt=_DT)}
+    generators = {k: b.generator if b.generator.dt else b.generator.discretize(_DT) for k, b in banks.items()}
+    return EvaluationSetup(car, op, models, nominal, banks, generators)
 
 
 def deviation_trace(trace, op):
@@ -223,7 +227,8 @@ def deviation_trace(trace, op):
     """
     from dataclasses import replace
 
-    return replace(trace, u=trace.u - op.u, y=trace.y - op.y, meta=dict(trace.meta, signals=None))
+    meta = {k: v for k, v in trace.meta.items() if k != "signals"}
+    return replace(trace, u=trace.u - op.u, y=trace.y - op.y, meta=meta)
 
 
 @dataclass(frozen=True, eq=False)
@@ -315,7 +320,7 @@ def fault_run(setup: EvaluationSetup, fault: str | None, road: str, *, duration:
     length = duration * op.speed * 1.5 + 50.0
     profile = None if road == "smooth" else robson_road(length, rng=rng_road)
     trace = setup.car.simulate(duration, start=op, commands=commands, road=profile, scenario=FaultScenario(faults),
-                               measurement_noise_std=NOISE_STD if noise else None, rng=rng_sim)
+                               measurement_noise_std=NOISE_STD if noise else None, rng=rng_sim, keep_signals=False)
     dev = deviation_trace(trace, op)
     return FaultRun(fault, road, dev, {k: g.run(dev) for k, g in setup.generators.items()})
 
