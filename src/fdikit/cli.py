@@ -61,18 +61,11 @@ def demo(
             res = runners[method](out, seed=seed)
         except (FdiError, OSError) as exc:
             _fail(exc)
-    if method == "vehicle":
-        table = Table(title="Nonlinear PATH car, rough road, realistic sensor noise: game-theoretic bank + MHSSPRT, "
-                            "fault at t = 10 s")
-        for col in ("scenario", "detected", "delay", "isolated fault", "correct", "false alarms"):
-            table.add_column(col, no_wrap=col == "isolated fault")
-        for label, s in res.scores.items():
-            table.add_row(label, "[green]yes[/green]" if s.detected else "[red]no[/red]",
-                          f"{s.detection_delay:.2f} s" if s.detected else "—", s.isolated,
-                          str(s.isolation_correct), str(s.false_alarms))
-        ok = all(s.isolation_correct for s in res.scores.values())
-    elif method == "bank":
-        table = Table(title="PATH vehicle, bank of 4 Beard–Jones filters (15 faults), fault at t = 10 s")
+    titles = {"vehicle": "Nonlinear PATH car, rough road, realistic sensor noise: game-theoretic bank + MHSSPRT, "
+                         "fault at t = 10 s",
+              "bank": "PATH vehicle, bank of 4 Beard–Jones filters (15 faults), fault at t = 10 s"}
+    if method in titles:
+        table = Table(title=titles[method])
         for col in ("scenario", "detected", "delay", "isolated fault", "correct", "false alarms"):
             table.add_column(col, no_wrap=col == "isolated fault")
         for label, s in res.scores.items():

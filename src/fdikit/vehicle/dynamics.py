@@ -92,7 +92,7 @@ _ZETA, _ETA, _CCL, _JE = _I["gear_ratio"], _I["driveline_efficiency"], _I["clutc
 _TA, _TB, _TD, _KB = _I["throttle_lag"], _I["brake_lag"], _I["steering_lag"], _I["brake_front_share"]
 _WB, _G = _I["brake_smoothing"], _I["gravity"]
 _HS, _F0, _PX, _PY = _I["static_length_fl"], _I["preload_fl"], _I["corner_x"], _I["corner_y"]
-_TIRE, _ENG = _I["tire"], _I["engine"]
+_TIRE, _ENG, _SMALL = _I["tire"], _I["engine"], _I["small_angle"]
 _N_AUX = len(AUXILIARY)
 _V_MIN = 0.5  # m/s: speed floor of the slip definitions
 
@@ -115,7 +115,10 @@ def rhs(x, u, env, p, dx, aux):  # pragma: no cover - compiled
     phi, wx, th, wy, wz = x[6], x[7], x[8], x[9], x[10]
     alpha_t, tau_b, delta = x[15], x[16], x[17]
     eps = x[24]
-    cphi, sphi, cth, sth = math.cos(phi), math.sin(phi), math.cos(th), math.sin(th)
+    if p[_SMALL] > 0.0:  # §8.3: small relative roll and pitch (yaw exact)
+        cphi, sphi, cth, sth, tphi = 1.0, phi, 1.0, th, phi
+    else:
+        cphi, sphi, cth, sth, tphi = math.cos(phi), math.sin(phi), math.cos(th), math.sin(th), math.tan(phi)
     ceps, seps = math.cos(eps), math.sin(eps)
     m, g = p[_M], p[_G]
     # road normal in body axes (n = e_z of the road plane)
@@ -226,7 +229,7 @@ def rhs(x, u, env, p, dx, aux):  # pragma: no cover - compiled
     b2 = cphi * vy - sphi * c1
     dx[5] = sphi * vy + cphi * c1
     dx[6] = cth * wx + sth * wz
-    dx[8] = math.tan(phi) * (sth * wx - cth * wz) + wy
+    dx[8] = tphi * (sth * wx - cth * wz) + wy
     deps = (-sth * wx + cth * wz) / cphi
     dx[24] = deps
     dx[22] = ceps * a1 - seps * b2

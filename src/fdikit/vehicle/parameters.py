@@ -94,6 +94,9 @@ class SedanParameters:
         Wheel speed [rad/s] below which the brake torque fades (tanh) so a stopped wheel does not turn back (§8.1.6).
     gravity : float
         [m/s²].
+    small_angle : bool
+        Small-angle roll and pitch (``sin a = a``, ``cos a = 1``, ``tan a = a`` for the angles relative to the road;
+        yaw and the grade stay exact): the variant §8.3 compares with the full model.
 
     References
     ----------
@@ -155,17 +158,20 @@ class SedanParameters:
     brake_front_share: float = 0.7
     brake_smoothing: float = 0.5
     gravity: float = 9.81
+    small_angle: bool = False
     gear_ratios: tuple = GEAR_RATIOS
     tire: TireCoefficients = field(default=BAKKER_1987)
 
     def __post_init__(self) -> None:
         for f in fields(self):
-            if f.name in ("tire", "gear_ratios", "gear"):
+            if f.name in ("tire", "gear_ratios", "gear", "small_angle"):
                 continue
             v = validate.number(f"SedanParameters.{f.name}", getattr(self, f.name))
             if f.name not in ("lift_coefficient", "pitch_moment_coefficient", "yaw_moment_coefficient") and v <= 0:
                 validate.positive(f"SedanParameters.{f.name}", v)
             object.__setattr__(self, f.name, v)
+        if not isinstance(self.small_angle, bool):
+            validate.instance("SedanParameters.small_angle", self.small_angle, bool)
         validate.instance("SedanParameters.tire", self.tire, TireCoefficients)
         ratios = tuple(validate.positive(f"SedanParameters.gear_ratios[{k}]", r)
                        for k, r in enumerate(self.gear_ratios))
@@ -224,6 +230,7 @@ class SedanParameters:
         for name in _SCALARS:
             p[INDEX[name]] = getattr(self, name)
         p[INDEX["gear_ratio"]] = self.gear_ratio(gear)
+        p[INDEX["small_angle"]] = 1.0 if self.small_angle else 0.0
         h_s, load = self.static_lengths(), self.corner_loads()
         for j, c in enumerate(_CORNERS):
             p[INDEX[f"static_length_{c}"]] = h_s[j]
@@ -237,11 +244,12 @@ class SedanParameters:
 
 
 _CORNERS = ("fl", "fr", "rl", "rr")
-_SCALARS = tuple(f.name for f in fields(SedanParameters) if f.name not in ("tire", "gear_ratios", "gear"))
+_SCALARS = tuple(f.name for f in fields(SedanParameters)
+                 if f.name not in ("tire", "gear_ratios", "gear", "small_angle"))
 
 
 def _index() -> dict[str, int]:
-    names = (list(_SCALARS) + ["gear_ratio"] + [f"static_length_{c}" for c in _CORNERS]
+    names = (list(_SCALARS) + ["gear_ratio", "small_angle"] + [f"static_length_{c}" for c in _CORNERS]
              + [f"preload_{c}" for c in _CORNERS])
     index = {n: k for k, n in enumerate(names)}
     k = len(names)

@@ -334,7 +334,8 @@ class Sedan:
     # --------------------------------------------------------------------------------------------- simulation
     def simulate(self, duration: float, *, start: OperatingPoint | None = None, commands=None, road=None,
                  wind: Callable | None = None, scenario=None, measurement_noise_std: Mapping | None = None,
-                 dt: float = 0.01, step: float = 0.001, gearbox: str = "held", rng=None, keep_signals: bool = True):
+                 dt: float = 0.01, step: float = 0.001, gearbox: str = "held", grade: float | None = None,
+                 bank: float | None = None, rng=None, keep_signals: bool = True):
         """Simulate a run; see :func:`fdikit.vehicle.run.simulate_sedan` (this car, same arguments).
 
         Returns
@@ -351,8 +352,8 @@ class Sedan:
         from fdikit.vehicle.run import simulate_sedan
 
         return simulate_sedan(self, duration, start=start, commands=commands, road=road, wind=wind, scenario=scenario,
-                              measurement_noise_std=measurement_noise_std, dt=dt, step=step, gearbox=gearbox, rng=rng,
-                              keep_signals=keep_signals)
+                              measurement_noise_std=measurement_noise_std, dt=dt, step=step, gearbox=gearbox,
+                              grade=grade, bank=bank, rng=rng, keep_signals=keep_signals)
 
 
 def _vector(name: str, value, n: int) -> np.ndarray:

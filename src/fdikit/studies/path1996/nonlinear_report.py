@@ -107,14 +107,14 @@ def table_2_1_markdown(models) -> str:
 
 
 def plot_fig_2_6(models, ax=None, path=None, frequencies=None):
-    """Fig. 2.6: singular values of the 22-state model and of Methods 1 and 2 over 0.1–100 rad/s.
+    """Fig. 2.6: singular values of the 22-state model and of Methods 1 and 2 over 0.1–100 rad/s, and their errors.
 
     Parameters
     ----------
     models : DesignModels
         The models.
-    ax : matplotlib Axes, optional
-        Where to draw (a new figure otherwise).
+    ax : sequence of 2 matplotlib Axes, optional
+        Where to draw (values, relative errors; a new figure otherwise).
     path : str or Path, optional
         Save the figure there.
     frequencies : array_like, optional
@@ -136,16 +136,22 @@ def plot_fig_2_6(models, ax=None, path=None, frequencies=None):
     from fdikit.studies.path1996.reduction import singular_values
 
     w = np.logspace(-1, 2, 200) if frequencies is None else np.asarray(frequencies, dtype=float)
-    fig, (a,) = axes_or_new(ax, 1)
+    fig, (a, b) = axes_or_new(ax, 2, figsize=(7, 7), sharex=True)
+    full = singular_values(models.full, w)
     for model, style, label in ((models.full, "-", "22 states"), (models.method1, "--", "Method 1 (14)"),
                                 (models.method2, ":", "Method 2 (14)")):
         sv = singular_values(model, w)
         for k in range(sv.shape[1]):
             a.loglog(w, sv[:, k], style, color=f"C{k}", label=label if k == 0 else None)
-    a.set_xlabel("ω [rad/s]")
+            if model is not models.full:
+                b.loglog(w, np.abs(sv[:, k] - full[:, k]) / full[:, k], style, color=f"C{k}",
+                         label=label if k == 0 else None)
     a.set_ylabel("singular value")
-    a.set_title("Fig. 2.6: control inputs → sensors")
+    a.set_title("Fig. 2.6: control inputs → sensors (colour: σ₁, σ₂, σ₃)")
     a.legend()
+    b.set_xlabel("ω [rad/s]")
+    b.set_ylabel("|σ_reduced − σ_22| / σ_22")
+    b.legend()
     return finish_plot(fig, ax, path)
 
 
