@@ -88,3 +88,47 @@ def test_game_bank_attenuates_the_noise_the_beard_jones_bank_amplifies(setup):
     # (game); asserted with a factor-2 margin on each side
     assert rms["beard-jones"]["filter1:pitch_rate_sensor"] > 10 > 0.5 > rms["game"]["filter1:pitch_rate_sensor"]
     assert rms["beard-jones"]["filter1:accel_z_sensor"] > 75 > 10 > rms["game"]["filter1:accel_z_sensor"]
+
+
+def test_hinf_bank_has_no_steady_state_on_the_car(setup):
+    # The H∞-bounded filter of App. C on filter 1's group, outputs in units of their noise (unit-weight noise
+    # inputs √Δt, actuator process noise): the Hamiltonian of (c.18) without its extra term has no eigenvalue
+    # near the imaginary axis (|Re λ| ≥ 1.2, checked here independently), so the design gets past that test —
+    # and the modified differential Riccati equation then escapes to infinity from the ARE start: no H∞-bounded
+    # bank exists for these models and weights (docs/methods/nonlinear_vehicle.md).
+    import scipy.linalg
+
+    from fdikit.design.observers import detection_gain_family, hinf_detection_filter
+    from fdikit.errors import DesignError
+    from fdikit.fault_maps import resolve_faults
+    from fdikit.model import FaultModel
+    from fdikit.studies.path1996.bank import FILTER_GROUPS
+    from fdikit.studies.path1996.nonlinear_evaluation import NOISE_STD
+
+    base, dt = setup.models.model12, 0.01
+    scale = np.array([1.0 / NOISE_STD[o] for o in base.outputs])
+    model = FaultModel(A=base.A, Bu=base.Bu, C=scale[:, None] * base.C, Du=scale[:, None] * base.Du,
+                       Bw=np.hstack([np.zeros((base.n, 12)), base.Bu]),
+                       Dw=np.hstack([np.eye(12) * np.sqrt(dt), np.zeros((12, 3))]), states=base.states,
+                       outputs=base.outputs, controls=base.controls,
+                       noise=[f"v_{o}" for o in base.outputs] + [f"w_{c}" for c in base.controls])
+    maps = resolve_faults(model, FILTER_GROUPS["filter1"])
+    fam = detection_gain_family(model, maps)
+    # (c.17)–(c.18) data by hand (corrected form, γ = 10): Â = A + L̂C, B̂ = B + L̂D, the Hamiltonian of the ARE
+    g2, T = 10.0 ** -2, fam.coordinates
+    Lh = -fam.base_gain
+    Ah, Bh = model.A + Lh @ model.C, model.Bw + Lh @ model.Dw
+    C2, D21 = T @ model.C, T @ model.Dw
+    k = sum(H.shape[0] for H in fam.residual_maps.values())
+    Cz, Dz = C2[:k], D21[:k]
+    Vt = D21 @ D21.T + g2 * D21 @ Dz.T @ Dz @ D21.T
+    Ct = C2 + g2 * D21 @ Dz.T @ Cz
+    Bt = Bh @ (D21.T + g2 * Dz.T @ Dz @ D21.T)
+    Vi = np.linalg.inv(Vt)
+    At = Ah + g2 * Bh @ Dz.T @ Cz - Bt @ Vi @ Ct
+    Qt = Bh @ Bh.T + g2 * Bh @ Dz.T @ Dz @ Bh.T - Bt @ Vi @ Bt.T
+    Rt = Ct.T @ Vi @ Ct - g2 * Cz.T @ Cz
+    ham = np.block([[At.T, -Rt], [-Qt, -At]])
+    assert np.abs(scipy.linalg.eigvals(ham).real).min() > 1.0
+    with pytest.raises(DesignError, match="escapes to infinity"):
+        hinf_detection_filter(model, maps, gamma=10.0)

@@ -135,8 +135,12 @@ def _stabilising_are(ric: _Riccati, gamma: float) -> np.ndarray:
     """Stabilising solution of ``ÃY + YÃᵀ + Q̃ − YR̃Y = 0`` (R̃ indefinite) by the ordered Hamiltonian Schur form."""
     n = ric.At.shape[0]
     Ham = np.block([[ric.At.T, -ric.Rt], [-ric.Qt, -ric.At]])
-    ev = scipy.linalg.eigvals(Ham)
-    tol = 1e-9 * max(np.linalg.norm(Ham, 1), 1.0)
+    # the test for eigenvalues on the imaginary axis runs on the diagonally balanced matrix: with outputs of very
+    # different units (kg next to rad/s) ‖Ham‖ is dominated by one block and a tolerance relative to it would call
+    # eigenvalues of real part ≈ 1 "on the axis" (a similarity: the eigenvalues are the same)
+    balanced, _ = scipy.linalg.matrix_balance(Ham, permute=False)
+    ev = scipy.linalg.eigvals(balanced)
+    tol = 1e-9 * max(np.linalg.norm(balanced, 1), 1.0)
     if np.any(np.abs(ev.real) <= tol):
         raise DesignError(
             f"the Riccati equation of (c.18) without its extra term has no stabilising solution for gamma = {gamma:g} "
