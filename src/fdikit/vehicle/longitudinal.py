@@ -434,10 +434,11 @@ class LongitudinalCar:
             x0[13] = brake
             op = trim(plant, x0[1:], [throttle, brake], tol=tol)
         else:
+            from fdikit.vehicle.sedan import throttle_for_speed
+
             speed = validate.positive("speed", speed)
-            x0 = self._guess(speed, 20.0, gear)
-            x0[13] = brake
-            op = trim(plant, x0[1:], [20.0, brake], y0=[speed], iu=["brake"], tol=tol)
+            return throttle_for_speed(lambda th: self.operating_point(throttle=th, brake=brake, grade=grade, gear=gear,
+                                                                      tol=tol), speed, 20.3 * (speed / 27.0) ** 2)
         x = np.zeros(_N)
         x[1:] = op.x
         _, y, sig = self.derivatives(x, op.u, grade=grade, gear=gear)

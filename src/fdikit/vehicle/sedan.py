@@ -26,7 +26,7 @@ from fdikit.errors import ParameterError
 from fdikit.vehicle.dynamics import AUXILIARY, CONTROLS, N_DESIGN_STATES, SENSORS, STATES, evaluate
 from fdikit.vehicle.parameters import MID_SIZE_SEDAN, SedanParameters
 
-__all__ = ["Sedan", "OperatingPoint", "SIGNALS"]
+__all__ = ["Sedan", "OperatingPoint", "SIGNALS", "throttle_for_speed"]
 
 #: Outputs a design plant can have: the 12 sensors and the auxiliary signals.
 SIGNALS = SENSORS + AUXILIARY
@@ -284,10 +284,9 @@ class Sedan:
             op = trim(plant, x0[:N_DESIGN_STATES], [throttle, brake, steering], tol=tol)
         else:
             speed = validate.positive("speed", speed)
-            x0 = self._straight_guess(speed)
-            x0[16:18] = brake, steering
-            op = trim(plant, x0[:N_DESIGN_STATES], [20.0, brake, steering], y0=[speed], iu=["brake", "steering"],
-                      tol=tol)
+            return throttle_for_speed(
+                lambda th: self.operating_point(throttle=th, steering=steering, brake=brake, grade=grade, bank=bank,
+                                                tol=tol), speed, 20.3 * (speed / 27.0) ** 2)
         x = np.zeros(len(STATES))
         x[:N_DESIGN_STATES] = op.x
         _, y, aux = self.derivatives(x, op.u, grade=grade, bank=bank)
@@ -354,6 +353,74 @@ class Sedan:
         return simulate_sedan(self, duration, start=start, commands=commands, road=road, wind=wind, scenario=scenario,
                               measurement_noise_std=measurement_noise_std, dt=dt, step=step, gearbox=gearbox,
                               grade=grade, bank=bank, rng=rng, keep_signals=keep_signals)
+
+
+def throttle_for_speed(point_at: Callable, speed: float, guess: float, *, rtol: float = 1e-10,
+                       max_iterations: int = 40):
+    """The steady state at ``speed``: the throttle found by the secant method on steady states at fixed throttle.
+
+    A trim with the speed as an output target and the throttle free can wander into the throttle's clipped,
+    flat region (below 0°) from a poor guess — which guess is poor depends on rounding, so it changed with the
+    BLAS kernel; every trim at a fixed throttle is a square, well-conditioned solve, and the speed is monotone in
+    the throttle.
+
+    Parameters
+    ----------
+    point_at : callable
+        ``point_at(throttle) -> point`` with a ``speed`` attribute (a steady state at that throttle [deg]).
+    speed : float
+        Target speed [m/s].
+    guess : float
+        First throttle [deg].
+    rtol : float, default 1e-10
+        Relative speed tolerance.
+    max_iterations : int, default 40
+        Secant steps.
+
+    Returns
+    -------
+    point
+        ``point_at`` at the throttle found.
+
+    Raises
+    ------
+    DesignError
+        When the speed is not reached (the last throttle and speed in the message).
+
+    References
+    ----------
+    Douglas et al. 1996, §2.2 (the turn at 24.87 m/s), §8.3.1 (27 m/s).
+
+    Examples
+    --------
+    >>> car = Sedan()
+    >>> round(float(throttle_for_speed(lambda th: car.operating_point(throttle=th), 27.0, 15.0).u[0]) / 90 * 100, 3)
+    22.555
+    """
+    from fdikit.errors import DesignError
+
+    lo, hi = 0.05, 79.0
+    t0 = min(max(guess, lo), hi)
+    p0 = point_at(t0)
+    t1 = min(max(t0 + (1.0 if p0.speed < speed else -1.0), lo), hi)
+    p1 = point_at(t1)
+    for _ in range(max_iterations):
+        if abs(p1.speed - speed) <= rtol * speed:
+            return p1
+        slope = (p1.speed - p0.speed) / (t1 - t0) if t1 != t0 else 0.0
+        step = (speed - p1.speed) / slope if slope > 0 else (1.0 if p1.speed < speed else -1.0)
+        t_next = min(max(t1 + max(min(step, 10.0), -10.0), lo), hi)
+        t0, p0 = t1, p1
+        while True:
+            try:
+                p1, t1 = point_at(t_next), t_next
+                break
+            except DesignError:
+                if abs(t_next - t0) < 1e-6:
+                    raise
+                t_next = 0.5 * (t_next + t0)  # the car may not run steadily that far: a shorter step
+    raise DesignError(f"no steady state at {speed:g} m/s: throttle {t1:.6g} deg gives {p1.speed:.9g} m/s after "
+                      f"{max_iterations} secant steps")
 
 
 def _vector(name: str, value, n: int) -> np.ndarray:
