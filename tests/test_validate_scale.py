@@ -24,3 +24,11 @@ def test_a_negative_eigenvalue_is_judged_relative_to_the_entries(scale):
         validate.as_covariance("Q", M, 2)
     np.testing.assert_array_equal(validate.as_covariance("Q", scale * np.diag([1.0, 0.0]), 2),
                                   scale * np.diag([1.0, 0.0]))
+
+
+@pytest.mark.parametrize("value", [np.nan, np.inf, -np.inf, np.float64(np.nan), np.array(np.nan)])
+def test_as_array_refuses_a_non_finite_scalar(value):
+    # a 0-d array has no index columns for np.argwhere: the check must not depend on them
+    with pytest.raises(ParameterError, match="x has a non-finite entry"):
+        validate.as_array("x", value)
+    assert validate.as_array("x", value, finite=False).shape == ()

@@ -88,12 +88,11 @@ def as_array(name: str, value, *, error: type[Exception] = ParameterError, finit
     if raw.dtype.kind not in "biufc":
         raise error(f"{name} must be an array of numbers, got entries of type {raw.dtype} ({shown(value)})")
     out = raw.astype(complex if np.iscomplexobj(raw) else float, copy=True)
-    if finite:
-        bad = np.argwhere(~np.isfinite(out))
-        if bad.size:
-            where = tuple(int(i) for i in bad[0])
-            at = f" at row {where[0]}, column {where[1]}" if out.ndim == 2 else f" at index {where}" if out.ndim else ""
-            raise error(f"{name} has a non-finite entry{at} ({out[where]!r}); every entry must be a finite number")
+    if finite and not np.all(np.isfinite(out)):
+        # np.argwhere of a 0-d array has no columns (its size is 0 even for NaN): test the whole array first
+        where = tuple(int(i) for i in np.argwhere(~np.isfinite(out))[0])
+        at = f" at row {where[0]}, column {where[1]}" if out.ndim == 2 else f" at index {where}" if out.ndim else ""
+        raise error(f"{name} has a non-finite entry{at} ({out[where]!r}); every entry must be a finite number")
     return out
 
 
