@@ -92,12 +92,10 @@ def engine_state(params, air_mass, engine_speed, throttle) -> dict[str, np.ndarr
     >>> round(float(out["manifold_pressure"]) / 1e3, 1)  # kPa
     46.5
     """
-    from fdikit.errors import ParameterError
+    from fdikit import validate
 
-    arrays = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (air_mass, engine_speed, throttle)))
-    for name, a in zip(("air_mass", "engine_speed", "throttle"), arrays):
-        if not np.all(np.isfinite(a)):
-            raise ParameterError(f"engine_state: {name} must be finite numbers")
+    arrays = np.broadcast_arrays(*(validate.as_array(f"engine_state: {name}", v) for name, v in
+                                   (("air_mass", air_mass), ("engine_speed", engine_speed), ("throttle", throttle))))
     e = params.engine_array()
     out = {k: np.empty(arrays[0].shape) for k in ("air_mass_rate", "torque", "manifold_pressure")}
     for k in np.ndindex(arrays[0].shape):

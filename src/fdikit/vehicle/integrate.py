@@ -77,7 +77,8 @@ def run_kernel(x0, commands, wind, slope, p, left, right, spacing, h, every, rat
     for k in range(n_steps + 1):
         uk = commands[min(k, n_steps - 1)]
         env[4], env[5] = wind[min(k, n_steps - 1), 0], wind[min(k, n_steps - 1), 1]
-        if k % every == 0:
+        fresh = k % every == 0  # k1 of this step is the recorded sample's derivative (unless the gear changes)
+        if fresh:
             _stage(x, uk, env, q, left, right, spacing, k1, aux)
             sensors(x, aux, y)
             xs[r] = x
@@ -97,10 +98,13 @@ def run_kernel(x0, commands, wind, slope, p, left, right, spacing, h, every, rat
             w_e = x[1]
             if w_e > shift_up and gear < ratios.size:
                 gear += 1
+                fresh = False
             elif w_e < shift_down and gear > 1:
                 gear -= 1
+                fresh = False
             q[_ZETA] = ratios[gear - 1] * final_drive
-        _stage(x, uk, env, q, left, right, spacing, k1, aux)
+        if not fresh:
+            _stage(x, uk, env, q, left, right, spacing, k1, aux)
         for j in range(_N):
             xt[j] = x[j] + 0.5 * h * k1[j]
         _stage(xt, uk, env, q, left, right, spacing, k2, aux)

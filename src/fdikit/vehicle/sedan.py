@@ -275,9 +275,9 @@ class Sedan:
             raise ParameterError("operating_point: give exactly one of throttle= [deg] and speed= [m/s]")
         steering = validate.number("steering", steering)
         brake = validate.non_negative("brake", brake)
-        plant = self.design_plant(("ground_speed",), grade=grade, bank=bank)
         if throttle is not None:
             throttle = validate.positive("throttle", throttle)
+            plant = self.design_plant(("ground_speed",), grade=grade, bank=bank)
             guess_speed = 27.0 * throttle / 20.3
             x0 = self._straight_guess(guess_speed, throttle)
             x0[15:18] = throttle, brake, steering

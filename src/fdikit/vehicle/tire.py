@@ -301,13 +301,8 @@ def tire_forces(load, slip_ratio, slip_angle, tire: TireCoefficients = BAKKER_19
     >>> np.round(fy / 4000, 3).tolist(), np.round(fx / 4000, 3).tolist()
     ([0.923, 0.0], [0.0, 1.059])
     """
-    loads = np.asarray(load, dtype=float)
-    lam = np.asarray(slip_ratio, dtype=float)
-    alpha = np.asarray(slip_angle, dtype=float)
-    for name, a in (("load", loads), ("slip_ratio", lam), ("slip_angle", alpha)):
-        if not np.all(np.isfinite(a)):
-            raise ParameterError(f"tire_forces: {name} must be finite numbers")
-    loads, lam, alpha = np.broadcast_arrays(loads, lam, alpha)
+    loads, lam, alpha = np.broadcast_arrays(*(validate.as_array(f"tire_forces: {name}", v) for name, v in
+                                              (("load", load), ("slip_ratio", slip_ratio), ("slip_angle", slip_angle))))
     c = tire.as_array()
     fx = np.empty(loads.shape)
     fy = np.empty(loads.shape)
@@ -317,7 +312,7 @@ def tire_forces(load, slip_ratio, slip_angle, tire: TireCoefficients = BAKKER_19
 
 
 def _loads(load, owner: str) -> np.ndarray:
-    loads = np.asarray(load, dtype=float)
-    if not (np.all(np.isfinite(loads)) and np.all(loads > 0)):
-        raise ParameterError(f"{owner}: load must be finite and > 0 [N], got {load!r:.60}")
+    loads = validate.as_array(f"{owner}: load", load)
+    if not np.all(loads > 0):
+        raise ParameterError(f"{owner}: load must be > 0 [N], got {load!r:.60}")
     return loads

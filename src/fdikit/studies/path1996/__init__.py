@@ -46,7 +46,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
         ],
         "nonlinear_evaluation": [
             "EvaluationSetup", "FaultRun", "NOISE_STD", "car_nominal_sizes", "deviation_trace", "evaluation_setup",
-            "fault_run", "group_magnitudes", "off_nominal_peaks",
+            "fault_run", "group_magnitudes", "off_nominal_peaks", "off_nominal_run",
         ],
         "nonlinear_table": [
             "BANKS", "DEFAULT_PROCESSORS", "EvaluationTable", "FAULTS", "PROCESSORS", "Prewhitened", "TableRow",

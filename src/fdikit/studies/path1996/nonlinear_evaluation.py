@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 __all__ = ["NOISE_STD", "EvaluationSetup", "evaluation_setup", "car_nominal_sizes", "deviation_trace",
-           "FaultRun", "fault_run", "group_magnitudes", "off_nominal_peaks"]
+           "FaultRun", "fault_run", "group_magnitudes", "off_nominal_run", "off_nominal_peaks"]
 
 #: Sensor noise standard deviations [units of each sensor] per sample at 100 Hz (air mass: 1 % of 1.1e-3 kg).
 NOISE_STD = {
@@ -355,8 +355,36 @@ def group_magnitudes(residuals) -> dict[str, np.ndarray]:
     return {g: np.linalg.norm(residuals.r[:, idx], axis=1) for g, idx in groups.items()}
 
 
+def off_nominal_run(setup: EvaluationSetup, duration: float = 60.0) -> FaultRun:
+    """The §5.1.1 off-nominal run: +2° throttle above the turn's, no fault, smooth road, no noise; every bank.
+
+    Parameters
+    ----------
+    setup : EvaluationSetup
+        From :func:`evaluation_setup`.
+    duration : float, default 60.0
+        Run length [s].
+
+    Returns
+    -------
+    FaultRun
+
+    References
+    ----------
+    Douglas et al. 1996, §5.1.1.
+
+    Examples
+    --------
+    >>> run = off_nominal_run(evaluation_setup(), 5.0)  # doctest: +SKIP
+    >>> sorted(run.residuals)  # doctest: +SKIP
+    ['beard-jones', 'game', 'kalman']
+    """
+    op = setup.operating_point
+    return fault_run(setup, None, "smooth", duration=duration, noise=False, commands=[op.u[0] + 2.0, op.u[1], op.u[2]])
+
+
 def off_nominal_peaks(setup: EvaluationSetup, *, duration: float = 60.0, settle: float = 2.0,
-                      bank: str | None = None) -> dict[str, float]:
+                      bank: str | None = None, run: FaultRun | None = None) -> dict[str, float]:
     """The §5.1.1 off-nominal test: +2° throttle, no fault, smooth road, no noise; peak scaled magnitude per group.
 
     Parameters
@@ -369,6 +397,8 @@ def off_nominal_peaks(setup: EvaluationSetup, *, duration: float = 60.0, settle:
         Filter start-up time left out [s] (the report adds faults at 2 s for the same reason).
     bank : str, optional
         Which bank (default the setup's default).
+    run : FaultRun, optional
+        The off-nominal run already simulated (every bank's residuals are in it); ``duration`` is then unused.
 
     Returns
     -------
@@ -385,9 +415,7 @@ def off_nominal_peaks(setup: EvaluationSetup, *, duration: float = 60.0, settle:
     >>> len(peaks)  # doctest: +SKIP
     16
     """
-    op = setup.operating_point
-    run = fault_run(setup, None, "smooth", duration=duration, noise=False,
-                    commands=[op.u[0] + 2.0, op.u[1], op.u[2]])
+    run = off_nominal_run(setup, duration) if run is None else run
     res = run.residuals[setup.default if bank is None else bank]
     keep = res.t >= settle
     return {g: float(m[keep].max()) for g, m in group_magnitudes(res).items()}

@@ -272,7 +272,8 @@ def whitened_mhsprt(healthy, labelled) -> Prewhitened:
     center = h.r[ok].mean(axis=0)
     # shared covariance: in z = L⁻¹(x − μ_0) every hypothesis is N(m_i, I), and only the projection of z on the span
     # of the m_i changes the likelihood ratios — the test runs on that projection (≤ one coordinate per fault)
-    L = np.linalg.cholesky(np.cov(h.r[ok], rowvar=False) + 1e-9 * np.diag(np.diag(np.cov(h.r[ok], rowvar=False))))
+    cov = np.cov(h.r[ok], rowvar=False)
+    L = np.linalg.cholesky(cov + 1e-9 * np.diag(np.diag(cov)))
     means = {}
     for fault, res in labelled:
         x = white.whiten(res).slice(start=_ONSET + 1.0)
@@ -421,7 +422,12 @@ def path_evaluation_table(setup=None, *, roads=("smooth", "rough"), faults=None,
     """
     from fdikit import validate
     from fdikit.metrics import score
-    from fdikit.studies.path1996.nonlinear_evaluation import evaluation_setup, fault_run, off_nominal_peaks
+    from fdikit.studies.path1996.nonlinear_evaluation import (
+        evaluation_setup,
+        fault_run,
+        off_nominal_peaks,
+        off_nominal_run,
+    )
 
     args = check_evaluation_arguments(roads=roads, faults=faults, processors=processors, banks=banks,
                                       fault_free_hours=fault_free_hours, duration=duration, seed=seed)
@@ -480,7 +486,8 @@ def path_evaluation_table(setup=None, *, roads=("smooth", "rough"), faults=None,
                                  "false_alarms": [[b, p, list(v)] for (_, b, p), v in road_alarms.items()]})
             rows += road_rows
             false_alarms.update(road_alarms)
-    off = {b: off_nominal_peaks(setup, bank=b) for b in banks if setup.banks[b].scales}  # scaled banks only
+    off_run = off_nominal_run(setup)
+    off = {b: off_nominal_peaks(setup, bank=b, run=off_run) for b in banks if setup.banks[b].scales}  # scaled only
     return EvaluationTable(rows, false_alarms, off, dict(setup.nominal), runs)
 
 

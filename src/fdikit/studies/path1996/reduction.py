@@ -29,6 +29,7 @@ FAST_STATES = ("wheel_speed_fl", "wheel_speed_fr", "wheel_speed_rl", "wheel_spee
                "tire_force_fl", "tire_force_fr", "tire_force_rl", "tire_force_rr")
 #: Actuators made static for the 12-state model (App. D).
 STATIC_ACTUATORS = ("throttle", "steering")
+_FORCES = ("normal_force_fl", "normal_force_fr", "normal_force_rl", "normal_force_rr")
 #: State names of the App. D models, in the car's names (same order as ``plants.path_vehicle.STATES_14``).
 _APP_D_14 = ("air_mass", "engine_speed", "v_x", "v_y", "v_z", "height", "roll", "roll_rate", "pitch", "pitch_rate",
              "yaw_rate", "throttle", "brake", "steering")
@@ -123,8 +124,15 @@ def path_design_models(car=None, *, speed: float = 24.87, steering: float = 0.00
 
     car = Sedan() if car is None else car
     op = car.operating_point(speed=speed, steering=steering)
-    full = car.linearize(op)
-    m1 = residualize(_with_force_states(car, op, full), keep=list(_APP_D_14)).model
+    from fdikit.vehicle import SENSORS
+
+    # one linearisation for the sensors and the tire forces (every entry's step is chosen on its own, so the
+    # sensor rows are those of car.linearize(op))
+    both = car.linearize(op, outputs=SENSORS + _FORCES)
+    p = len(SENSORS)
+    full = FaultModel(A=both.A, Bu=both.Bu, C=both.C[:p], Du=both.Du[:p], states=both.states, outputs=SENSORS,
+                      controls=both.controls)
+    m1 = residualize(_with_force_states(full, both.C[p:]), keep=list(_APP_D_14)).model
     m1 = _reorder(m1, _APP_D_14)
     m12 = residualize(m1, keep=[s for s in _APP_D_14 if s not in STATIC_ACTUATORS]).model
     su, sy = _scales(nominal)
@@ -137,15 +145,14 @@ def path_design_models(car=None, *, speed: float = 24.87, steering: float = 0.00
     return DesignModels(op, full, m1, m2, m12, np.asarray(bal.hankel), float(bal.error_bound))
 
 
-def _with_force_states(car, op, full: FaultModel) -> FaultModel:
+def _with_force_states(full: FaultModel, dN: np.ndarray) -> FaultModel:
     """``full`` with each suspension length ``h_i`` replaced by the tire normal force ``N_i`` (Ch. 2's state ``F_i``).
 
     Residualising ``h_i`` (``ḣ_i = 0``) would freeze the dampers and leave the body modes undamped; the report's
     fast state is the force of the massless tire, and ``Ḟ_i = 0`` makes the wheel follow the road, so the damper
-    acts on the body velocity (§2.1.1, (2.4)).  ``N_i`` is linear in the state near the point: ``N = K_w (r_w0 − r_w)``.
+    acts on the body velocity (§2.1.1, (2.4)).  ``N_i`` is linear in the state near the point: ``N = K_w (r_w0 − r_w)``;
+    ``dN`` holds its rows ``∂N_i/∂x`` (fl, fr, rl, rr).
     """
-    forces = [f"normal_force_{c}" for c in ("fl", "fr", "rl", "rr")]
-    dN = car.linearize(op, outputs=forces).C
     T = np.eye(full.n)
     for k, c in enumerate(("fl", "fr", "rl", "rr")):
         T[full.states.index(f"suspension_{c}")] = dN[k]
