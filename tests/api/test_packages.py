@@ -60,12 +60,12 @@ def test_no_module_is_over_600_lines(module):
 
 #: Modules a light package import must not load (each costs 0.1–1 s; the packages that need them load them lazily).
 HEAVY = ("scipy.signal", "scipy.stats", "scipy.optimize", "scipy.integrate", "control", "cvxpy", "matplotlib",
-         "pandas", "pyarrow", "rich", "typer")
+         "pandas", "pyarrow", "rich", "typer", "jsbsim")
 
 
 @pytest.mark.parametrize("package", ["fdikit", "fdikit.design", "fdikit.decision", "fdikit.multimodel",
                                      "fdikit.plants", "fdikit.studies", "fdikit.analysis", "fdikit.estimate",
-                                     "fdikit.vehicle"])
+                                     "fdikit.vehicle", "fdikit.aircraft"])
 def test_package_import_is_light(package):
     # A fresh interpreter: which modules does importing the package (not using it) load?  The wall time of the same
     # imports is measured in benchmarks/bench_import.py (docs/PERFORMANCE.md), not here.
