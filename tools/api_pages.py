@@ -32,6 +32,7 @@ PAGES = [
     ("analysis", "fdikit.analysis", "Analysis"),
     ("nonlinear", "fdikit.nonlinear", "Nonlinear plants: trim, linearisation, reduction"),
     ("vehicle", "fdikit.vehicle", "The nonlinear PATH vehicle"),
+    ("aircraft", "fdikit.aircraft", "Nonlinear aircraft through JSBSim"),
     ("studies-path1996", "fdikit.studies.path1996", "Study: Douglas et al. 1996 (PATH)"),
     ("studies-hallouzi2008", "fdikit.studies.hallouzi2008", "Study: Hallouzi 2008"),
     ("studies-vanderploeg2018", "fdikit.studies.vanderploeg2018", "Study: van der Ploeg 2018"),

@@ -76,8 +76,12 @@ class TravelFault(Fault):
 class LockInPlace(TravelFault):
     """Lock-in-place (Hallouzi 2008, §4.2): the surface travels at its maximum rate to ``position`` and stays.
 
-    The parameters are those of :class:`TravelFault`; with ``rate=None`` the actuator's rate limit
-    is used.
+    Parameters
+    ----------
+    position : float
+        The lock position (rad for a surface); it may differ from the position at the onset.
+    rate : float or None
+        Travel rate [units/s]; ``None`` (default): the actuator's rate limit (offline: at once).
 
     Examples
     --------
@@ -90,7 +94,12 @@ class LockInPlace(TravelFault):
 class Runaway(TravelFault):
     """Runaway / hard-over (Hallouzi 2008, §6.5.3): the surface runs at ``rate`` to ``position`` (a limit) and sticks.
 
-    The parameters are those of :class:`TravelFault`; ``rate`` is required.
+    Parameters
+    ----------
+    position : float
+        The limit the surface runs to.
+    rate : float
+        The runaway rate [units/s] (required; capped online by the actuator's rate limit).
 
     Examples
     --------
@@ -110,8 +119,14 @@ class Float(TravelFault):
     """Floating surface: the actuator lets go and the surface trails the flow (zero hinge moment).
 
     Approximation: the hinge moment is not modelled; the surface is taken to trail at ``position``
-    (default 0, faired with the wing or tail) and to get there at ``rate`` (the actuator's rate limit
-    when ``None``).
+    (default 0, faired with the wing or tail) and to get there at ``rate``.
+
+    Parameters
+    ----------
+    position : float
+        The trail position (default 0).
+    rate : float or None
+        Travel rate [units/s]; ``None``: the actuator's rate limit.
 
     Examples
     --------
@@ -124,8 +139,14 @@ class Float(TravelFault):
 class EngineFailure(Fault):
     """Engine failure: no thrust from the onset (online: fuel cut off, the engine spools down).
 
-    The target is the engine's throttle (``throttle_<i>``); the other parameters are those of
-    :class:`fdikit.faults.Fault`. Offline ``apply`` sets the signal to zero.
+    Offline ``apply`` sets the signal to zero.
+
+    Parameters
+    ----------
+    target : str
+        The engine's throttle, ``throttle_<i>`` (1-based engine number).
+    onset : float
+        Time of the failure [s]; ``end`` and ``location`` as for :class:`fdikit.faults.Fault`.
 
     Examples
     --------

@@ -15,7 +15,7 @@ import lazy_loader as lazy
 __getattr__, __dir__, __all__ = lazy.attach(
     __name__,
     submod_attrs={
-        "definition": ["SURFACES", "AircraftDefinition", "jsbsim_aircraft", "prepare_aircraft"],
+        "definition": ["STABILIZER_GAIN", "SURFACES", "AircraftDefinition", "jsbsim_aircraft", "prepare_aircraft"],
         "actuators": ["B747_LIMITS", "ActuatorBank", "SurfaceLimits", "default_limits"],
         "plant": ["FT", "KT", "LBF", "LBM", "SENSORS", "STATES", "AircraftSnapshot", "JSBSimAircraft"],
         "trim": ["HALLOUZI_POINT", "AircraftTrim", "FlightCondition", "trim_aircraft"],

@@ -12,7 +12,8 @@ to the position limits, integrated exactly over a step for the lag and then rate
 
 The B747 limits are Hallouzi's App. A (Table A.2, after Hanke & Nordwall 1970) lumped as in Ch. 4:
 elevator −23…17 deg at 37 deg/s, ailerons ±15 deg at 40/45 deg/s (down/up), rudder ±25 deg at
-50 deg/s, flaps 0…25 deg at 1.8 deg/s. Other aircraft get their JSBSim FCS ranges and 60 deg/s.
+50 deg/s, flaps 0…25 deg at 1.8 deg/s, stabiliser −12…3 deg at 0.5 deg/s (App. A: 0.2 to 0.5).
+Other aircraft get their JSBSim FCS ranges and 60 deg/s.
 
 References
 ----------
@@ -75,6 +76,7 @@ B747_LIMITS = {
     "aileron": _deg(-15, 15, 40, 45),
     "rudder": _deg(-25, 25, 50, 50),
     "flap": _deg(0, 25, 1.8, 1.8),
+    "stabilizer": _deg(-12, 3, 0.5, 0.5),
 }
 
 
@@ -127,7 +129,7 @@ class ActuatorBank:
     Examples
     --------
     >>> bank = ActuatorBank(B747_LIMITS)
-    >>> p = bank.update({"elevator": 1.0, "aileron": 0.0, "rudder": 0.0, "flap": 0.0}, 0.0, 0.1)
+    >>> p = bank.update({"elevator": 1.0}, 0.0, 0.1)
     >>> round(float(np.degrees(p["elevator"])), 6)   # 0.1 s at 37 deg/s
     3.7
     """

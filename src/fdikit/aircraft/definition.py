@@ -12,6 +12,14 @@ included — and the aerodynamics, which run after the FCS, use that position. T
 writes the surface's normalised position (``…-pos-norm``) with the aircraft's own scaling, so models
 whose aerodynamics read the normalised value see the same deflection.
 
+JSBSim's B747 has no stabiliser (its pitch trim adds to the elevator); fdikit adds one — the
+elevator's lift and pitching-moment terms again, driven by ``fdikit/stabilizer-pos-rad`` and scaled
+by :data:`STABILIZER_GAIN` — so that the App. A stabiliser (−12…3 deg at 0.5 deg/s) exists and a
+locked elevator can be trimmed with it, as in Hallouzi §6.5.2. The landing gear's position is
+overridden the same way (it is where the ``gear`` command puts it, without transit), so that trim and
+linearisation see no gear moving. This is an approximation (the
+stabiliser's effectiveness is not in the JSBSim data).
+
 Written by hand because JSBSim has no hook for external surface positions; the XML is read and
 written with :mod:`xml.etree.ElementTree`.
 
@@ -30,7 +38,7 @@ from dataclasses import dataclass
 
 from fdikit.errors import DataError, ParameterError
 
-__all__ = ["SURFACES", "AircraftDefinition", "jsbsim_aircraft", "prepare_aircraft"]
+__all__ = ["STABILIZER_GAIN", "SURFACES", "AircraftDefinition", "jsbsim_aircraft", "prepare_aircraft"]
 
 #: The managed surfaces: fdikit name → JSBSim position-property stem (the right aileron mirrors the left).
 SURFACES: dict[str, str] = {
@@ -55,11 +63,20 @@ class AircraftDefinition:
         Surface name → ``(min, max)`` position in rad (flaps: deg) of the aircraft's own FCS scaling,
         used for the normalised position; ``None`` where the FCS writes no normalised position.
     surfaces : tuple of str
-        The surfaces the aircraft has (of ``elevator``, ``aileron``, ``rudder``, ``flap``).
+        The surfaces the aircraft has (of ``elevator``, ``aileron``, ``rudder``, ``flap``; the B747 also
+        ``stabilizer``).
     engines : int
         The number of engines.
+    gear : bool
+        Whether the landing gear's position is overridden (``gear/gear-pos-norm`` follows the command).
     payload : int
         Index of the point mass fdikit adds at the empty-weight CG (``inertia/pointmass-weight-lbs[i]``).
+
+    Examples
+    --------
+    >>> d = prepare_aircraft("737")
+    >>> d.surfaces, d.engines, d.gear
+    (('elevator', 'aileron', 'rudder'), 2, True)
     """
 
     name: str
@@ -67,6 +84,7 @@ class AircraftDefinition:
     ranges: dict
     surfaces: tuple
     engines: int
+    gear: bool
     payload: int
 
 
@@ -159,7 +177,7 @@ def prepare_aircraft(name: str, folder: str | None = None) -> AircraftDefinition
     --------
     >>> d = prepare_aircraft("B747")
     >>> d.surfaces, d.engines
-    (('elevator', 'aileron', 'rudder', 'flap'), 4)
+    (('elevator', 'aileron', 'rudder', 'flap', 'stabilizer'), 4)
     """
     import jsbsim
 
@@ -215,11 +233,48 @@ def prepare_aircraft(name: str, folder: str | None = None) -> AircraftDefinition
                 _fcn(channel, f"fdikit {norm.split('/')[-1]}", _normaliser(*rng, source), nsource)
                 _switch(channel, norm, nsource, flag)
         ranges.setdefault(surface, None)
+    if "gear/gear-pos-norm" in outputs:  # the gear sits where the command puts it (no transit)
+        for prop_name in ("fdikit/gear-override", "fdikit/gear-pos-norm"):
+            ET.SubElement(fcs, "property", value="0").text = prop_name
+        _switch(channel, "gear/gear-pos-norm", "fdikit/gear-pos-norm", "fdikit/gear-override")
+    if name == "B747":
+        _add_stabilizer(top, fcs)
+        surfaces.append("stabilizer")
+        ranges["stabilizer"] = None
     _atomic_xml(tree, path)
     engines = len(top.findall("propulsion/engine"))
     payload = len(top.findall("mass_balance/pointmass")) - 1
     return AircraftDefinition(name=name, root=root, ranges=ranges, surfaces=tuple(surfaces), engines=engines,
-                              payload=payload)
+                              gear="gear/gear-pos-norm" in outputs, payload=payload)
+
+
+#: Stabiliser over elevator effectiveness of the B747's horizontal tail, 1/τ with τ ≈ 0.5 the elevator
+#: effectiveness of a ~30 % chord elevator (the whole tail moves with the stabiliser).
+STABILIZER_GAIN = 2.0
+
+
+def _add_stabilizer(top: ET.Element, fcs: ET.Element) -> None:
+    """Give JSBSim's B747 (no stabiliser: its pitch trim moves the elevator) a trimmable stabiliser.
+
+    The elevator's lift and pitching-moment functions are copied with ``fdikit/stabilizer-pos-rad`` for
+    the elevator position and :data:`STABILIZER_GAIN` as a factor.
+    """
+    import copy
+
+    for prop_name in ("fdikit/stabilizer-override", "fdikit/stabilizer-pos-rad"):
+        ET.SubElement(fcs, "property", value="0").text = prop_name
+    for axis in top.iter("axis"):
+        for fn in list(axis.findall("function")):
+            uses = [p for p in fn.iter("property") if p.text and p.text.strip() == "fcs/elevator-pos-rad"]
+            if not uses or axis.get("name") not in ("LIFT", "PITCH"):
+                continue
+            twin = copy.deepcopy(fn)
+            twin.set("name", fn.get("name") + "-stabilizer")
+            for p in twin.iter("property"):
+                if p.text and p.text.strip() == "fcs/elevator-pos-rad":
+                    p.text = "fdikit/stabilizer-pos-rad"
+            ET.SubElement(twin.find("product"), "value").text = repr(STABILIZER_GAIN)
+            axis.append(twin)
 
 
 def _add_payload(top: ET.Element) -> None:

@@ -1,7 +1,8 @@
 """Numerical linearisation of a JSBSim aircraft around a trim, with trim offsets and locked surfaces.
 
 The model is Hallouzi's 10-state rigid body (Table 4.1, in SI units) with the inputs the aircraft
-has of ``aileron, elevator, rudder`` [rad] and the total ``thrust`` [N] (Hallouzi's ``δ_T``; the
+has of ``aileron, elevator, stabilizer, rudder`` [rad] (Table 4.1 without the spoilers, which
+JSBSim's B747 does not have) and the total ``thrust`` [N] (Hallouzi's ``δ_T``; the
 engines are taken at their steady state, so the thrust column is ``(∂f/∂throttle)/(∂T/∂throttle)``
 with both derivatives from JSBSim's engine model)::
 
@@ -32,9 +33,8 @@ from fdikit.errors import ParameterError
 __all__ = ["INPUTS", "AircraftLinearization", "linearize_aircraft"]
 
 #: The inputs of the linear models, in order (those the aircraft has).
-INPUTS = ("aileron", "elevator", "rudder", "thrust")
+INPUTS = ("aileron", "elevator", "stabilizer", "rudder", "thrust")
 
-_STEPS = {"aileron": 1e-3, "elevator": 1e-3, "rudder": 1e-3, "thrust": 1e-3}
 
 
 @dataclass(frozen=True)
@@ -51,6 +51,14 @@ class AircraftLinearization:
     f0 : ndarray
         ``f(x°, u°)`` (zero at an exact equilibrium).
     trim : AircraftTrim
+
+    Examples
+    --------
+    >>> from fdikit.aircraft import JSBSimAircraft, trim_aircraft, HALLOUZI_POINT
+    >>> ac = JSBSimAircraft("B747")
+    >>> lin = linearize_aircraft(ac, trim_aircraft(ac, HALLOUZI_POINT, {"rudder": 0.2}, require=False))
+    >>> bool(abs(lin.f0).max() > 0), lin.model.b("u")[:, 3].tolist() == [0.0] * 10  # off equilibrium, rudder column 0
+    (True, True)
     """
 
     model: object
@@ -97,7 +105,7 @@ def linearize_aircraft(aircraft, trim, outputs: Sequence[str] | None = None) -> 
     >>> ac = JSBSimAircraft("B747")
     >>> lin = linearize_aircraft(ac, trim_aircraft(ac, HALLOUZI_POINT))
     >>> lin.model.controls, lin.model.A.shape
-    (('aileron', 'elevator', 'rudder', 'thrust'), (10, 10))
+    (('aileron', 'elevator', 'stabilizer', 'rudder', 'thrust'), (10, 10))
     """
     from fdikit.aircraft.plant import STATES
     from fdikit.model import FaultModel
@@ -127,7 +135,7 @@ def linearize_aircraft(aircraft, trim, outputs: Sequence[str] | None = None) -> 
         return aircraft.derivatives(x, pos, trim.throttle + du[-1] if du[-1] else None)
 
     z0 = np.concatenate([x0, np.zeros(len(inputs))])
-    steps = np.concatenate([np.maximum(1e-6 * np.abs(x0), 1e-6), [_STEPS[s] for s in inputs]])
+    steps = np.concatenate([np.maximum(1e-6 * np.abs(x0), 1e-6), np.full(len(inputs), 1e-3)])
     f0 = f(z0)
     J = np.empty((10, z0.size))
     for j in range(z0.size):  # one column at a time: the throttle column re-spools the engines

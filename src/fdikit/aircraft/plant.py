@@ -83,11 +83,20 @@ class AircraftSnapshot:
     engines : ndarray
         Turbine spool speeds ``N1, N2`` [%] (piston engines keep their rpm on restore).
     properties : dict
-        Surface positions, override flags and commands.
+        Surface positions, override flags, commands, fuel and payload.
     actuators : object
         The actuator bank's state (:meth:`ActuatorBank.snapshot`).
     commands : dict
         The control commands (:attr:`JSBSimAircraft.commands`).
+
+    Examples
+    --------
+    >>> ac = JSBSimAircraft("B747")
+    >>> snap = ac.snapshot()
+    >>> ac.step(10)
+    >>> ac.restore(snap)
+    >>> ac.time == snap.time
+    True
     """
 
     time: float
@@ -177,12 +186,15 @@ class JSBSimAircraft:
         self.fdm["ic/vt-kts"] = 200.0
         self.fdm.run_ic()
         self.fdm["gear/gear-cmd-norm"] = 0.0
-        for s in self.surfaces:
+        for s in (*self.surfaces, "gear") if self.definition.gear else self.surfaces:
             self.fdm[f"fdikit/{s}-override"] = 1.0
         self.fdm["propulsion/set-running"] = -1
+        tanks = self.fdm.query_property_catalog("contents-lbs").splitlines()
+        self._mass_properties = ([line.split()[0] for line in tanks if "tank[" in line]
+                                 + [f"inertia/pointmass-weight-lbs[{self.definition.payload}]"])
         catalog = self.fdm.query_property_catalog("propulsion/engine")
-        self._spools = [f"propulsion/engine[{i}]/{n}" for i in range(self.engines) for n in ("n1", "n2")
-                        if f"propulsion/engine[{i}]/{n} " in catalog or (i == 0 and f"propulsion/engine/{n} " in catalog)]
+        turbine = "propulsion/engine/n1 " in catalog or "propulsion/engine[0]/n1 " in catalog
+        self._spools = [f"propulsion/engine[{i}]/{n}" for i in range(self.engines * turbine) for n in ("n1", "n2")]
 
     # ---------------------------------------------------------------- signals
     @property
@@ -320,7 +332,9 @@ class JSBSimAircraft:
             f[f"fcs/throttle-cmd-norm[{i}]"] = min(max(cmd, 0.0), 1.0)
             if i in self._cutoff and self._cutoff[i].active(t)[0]:
                 f[f"propulsion/engine[{i}]/set-running"] = 0
-        f["gear/gear-cmd-norm"] = self.commands["gear"]
+        f["gear/gear-cmd-norm"] = min(max(self.commands["gear"], 0.0), 1.0)
+        if self.definition.gear:
+            f["fdikit/gear-pos-norm"] = f["gear/gear-cmd-norm"]
 
     def _write_surfaces(self, positions: dict) -> None:
         for s in self.surfaces:
@@ -367,8 +381,8 @@ class JSBSimAircraft:
         """
         mass = validate.positive("mass", mass)
         f = self.fdm
-        slot = f"inertia/pointmass-weight-lbs[{self.definition.payload}]"
-        tanks = [line.split()[0] for line in f.query_property_catalog("contents-lbs").splitlines() if "tank[" in line]
+        slot = self._mass_properties[-1]
+        tanks = self._mass_properties[:-1]
         fuel = np.array([f[t] for t in tanks])
         dry = f["inertia/weight-lbs"] - f[slot] - fuel.sum()
         extra = mass / LBM - dry - fuel.sum()
@@ -390,7 +404,7 @@ class JSBSimAircraft:
         wind_20ft : float, optional
             Wind speed 20 ft above ground [m/s] for the low-altitude model (default 0).
         seed : int, optional
-            JSBSim's random seed, for reproducible turbulence.
+            The turbulence's random seed (JSBSim's ``atmosphere/randomseed``: a new generator).
 
         Raises
         ------
@@ -401,7 +415,7 @@ class JSBSimAircraft:
         validate.in_range("severity", severity, 0, 7)
         f = self.fdm
         if seed is not None:
-            f["simulation/randomseed"] = validate.integer("seed", seed, minimum=0)
+            f["atmosphere/randomseed"] = validate.integer("seed", seed, minimum=0)
         f["atmosphere/turb-type"] = 3 if severity else 0
         f["atmosphere/turbulence/milspec/severity"] = severity
         wind = validate.non_negative("wind_20ft", wind_20ft)
@@ -425,19 +439,26 @@ class JSBSimAircraft:
         unit = {s: "deg" if s == "flap" else "rad" for s in self.surfaces}
         return ([f"fdikit/{s}-pos-{unit[s]}" for s in self.surfaces] + [f"fdikit/{s}-override" for s in self.surfaces]
                 + [f"fcs/throttle-cmd-norm[{i}]" for i in range(self.engines)]
-                + [f"propulsion/engine[{i}]/set-running" for i in range(self.engines)] + ["gear/gear-cmd-norm"])
+                + [f"propulsion/engine[{i}]/set-running" for i in range(self.engines)] + ["gear/gear-cmd-norm"]
+                + (["fdikit/gear-pos-norm"] if self.definition.gear else []) + self._mass_properties)
 
     def restore(self, snap: AircraftSnapshot) -> None:
         """Put the aircraft back into a :meth:`snapshot` state.
+
+        JSBSim restarts from the restored state (its multi-step integrators and the turbulence filters
+        start afresh), so a restored flight repeats the original to rounding (1e-13 relative) when the
+        original also started from a restore.
 
         Parameters
         ----------
         snap : AircraftSnapshot
         """
         f = self.fdm
+        f.set_dt(self.dt)  # JSBSim's FGLinearization leaves the step at 0
+        self._set_body(snap.body)
+        f.reset_to_initial_conditions(0)  # also restarts the integrators' histories and the gust filters
         for k, v in snap.properties.items():
             f[k] = v
-        self._set_body(snap.body)
         for p, v in zip(self._spools, snap.engines, strict=True):
             f[p] = v
         f.run_ic()
@@ -454,6 +475,9 @@ class JSBSimAircraft:
     # ---------------------------------------------------------------- model
     def set_state(self, x, *, latitude: float | None = None, longitude: float | None = None) -> None:
         """Write the rigid-body state :data:`STATES` as the current state (``run_ic``).
+
+        JSBSim's multi-step integrators keep their history; to fly from the new state as from a
+        fresh start, follow with ``restore(snapshot())``.
 
         Parameters
         ----------

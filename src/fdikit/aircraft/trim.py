@@ -5,10 +5,12 @@ rates: the residuals ``ṗ, q̇, ṙ, V̇, α̇, β̇`` and ``ḣ − V sin γ``
 :meth:`fdikit.aircraft.plant.JSBSimAircraft.derivatives` are driven to zero by least squares
 (:func:`scipy.optimize.least_squares`, throttle bounded to 0…1). The unknowns are ``α, θ, β``, the
 throttle (all engines alike) and the free surfaces; wings are level (``φ = 0``) unless a lateral
-surface is locked, when ``φ`` is free too (a stuck rudder is held with bank and aileron). With the
-elevator locked (JSBSim's B747 has no separate stabiliser — its pitch trim adds to the elevator)
-the airspeed is freed: the aircraft settles at the speed the locked elevator trims. This is
-Hallouzi's "each fault model is trimmed at a slightly different equilibrium" (§4.3.1, (4.1)–(4.2)).
+surface is locked, when ``φ`` is free too (a stuck rudder is held with bank and aileron). Pitch is
+trimmed with the stabiliser where the aircraft has one (the B747 of :mod:`fdikit.aircraft.definition`;
+the elevator is then faired at 0) and with the elevator otherwise; with the pitch device locked
+or saturated at its limit, the airspeed is freed and the aircraft settles at the speed it trims
+at. This is Hallouzi's "each fault model is trimmed at a slightly different equilibrium"
+(§4.3.1, (4.1)–(4.2)).
 
 JSBSim's own trim (``do_trim``) moves the FCS *commands*; with the surfaces driven by fdikit's
 actuators it cannot be used, hence this solver.
@@ -97,6 +99,13 @@ class AircraftTrim:
         The trim residuals ``ṗ, q̇, ṙ, V̇/g, α̇, β̇, (ḣ − V sin γ)/V`` at the solution.
     locked : dict
         The surfaces held fixed.
+
+    Examples
+    --------
+    >>> from fdikit.aircraft.plant import JSBSimAircraft
+    >>> tr = trim_aircraft(JSBSimAircraft("737"), FlightCondition(3000.0, 150.0))
+    >>> tr.converged, round(float(np.degrees(tr.x[4])), 1)   # α at 150 m/s
+    (True, 3.1)
     """
 
     condition: FlightCondition
@@ -158,12 +167,14 @@ def trim_aircraft(aircraft, condition: FlightCondition, locked: Mapping | None =
     if condition.mass is not None:
         aircraft.set_mass(condition.mass)
     fixed = {**locked, **({"flap": condition.flaps} if "flap" in aircraft.surfaces else {})}
-    free = [s for s in ("elevator", "aileron", "rudder") if s in aircraft.surfaces and s not in locked]
-    lateral_free = sum(s in free for s in ("aileron", "rudder"))
+    pitch = [s for s in ("stabilizer", "elevator") if s in aircraft.surfaces and s not in locked][:1]
+    if "stabilizer" in pitch and "elevator" not in locked:
+        fixed["elevator"] = 0.0  # trimmed with the stabiliser, elevator faired
+    free = pitch + [s for s in ("aileron", "rudder") if s in aircraft.surfaces and s not in locked]
     names = ["alpha", "theta", "beta", "throttle", *free]
-    if lateral_free < 2:
+    if len(free) - len(pitch) < 2:
         names.append("phi")
-    if "elevator" not in free:
+    if not pitch:
         names.append("airspeed")
     V0, gam = condition.airspeed, condition.flight_path_angle
 
@@ -186,8 +197,19 @@ def trim_aircraft(aircraft, condition: FlightCondition, locked: Mapping | None =
     for s in free:
         lim = aircraft.actuators.limits[s]
         lo[s], hi[s] = lim.lower, lim.upper
-    sol = least_squares(residual, [z0[n] for n in names], bounds=([lo[n] for n in names], [hi[n] for n in names]),
-                        xtol=1e-12, ftol=1e-14, gtol=1e-14, max_nfev=400)
+    def solve(names):
+        return least_squares(residual, [z0[n] for n in names], bounds=([lo[n] for n in names],
+                             [hi[n] for n in names]), xtol=1e-12, ftol=1e-14, gtol=1e-14, max_nfev=400)
+
+    sol = solve(names)
+    if pitch and "airspeed" not in names and np.max(np.abs(sol.fun)) > 1e-6:
+        # the pitch device saturates: hold it at the limit it reached and let the airspeed settle instead
+        k = names.index(pitch[0])
+        fixed[pitch[0]] = float(sol.x[k])
+        z0.update(zip(names, sol.x, strict=True))
+        names = [n for n in names if n != pitch[0]] + ["airspeed"]
+        free.remove(pitch[0])
+        sol = solve(names)
     x, pos, thr = unpack(sol.x)
     res = residual(sol.x)  # also leaves the aircraft at the solution
     aircraft.set_inputs(**{s: pos[s] for s in aircraft.surfaces},
