@@ -513,6 +513,25 @@ class JSBSimAircraft:
         self.actuators.place(positions)
         self._write_surfaces(self.actuators.positions)
 
+    def set_engine_running(self, engine: int, running: bool) -> None:
+        """Start or cut off one engine at once (a cut engine gives no thrust).
+
+        Parameters
+        ----------
+        engine : int
+            Engine number, 1-based.
+        running : bool
+
+        Raises
+        ------
+        ParameterError
+            For an engine number the aircraft does not have.
+        """
+        engine = validate.integer("engine", engine, minimum=1)
+        if engine > self.engines:
+            raise ParameterError(f"the {self.name} has engines 1…{self.engines}; got engine {engine}.")
+        self.fdm[f"propulsion/engine[{engine - 1}]/set-running"] = 1 if running else 0
+
     def set_throttles(self, throttles, steady: bool = True) -> None:
         """Set every engine's throttle and (by default) bring the engines to their steady state.
 

@@ -123,7 +123,7 @@ class AircraftTrim:
 
 
 def trim_aircraft(aircraft, condition: FlightCondition, locked: Mapping | None = None, *,
-                  require: bool = True) -> AircraftTrim:
+                  require: bool = True, start: AircraftTrim | None = None) -> AircraftTrim:
     """Trim ``aircraft`` at ``condition`` and leave it there, ready to fly.
 
     Parameters
@@ -135,6 +135,8 @@ def trim_aircraft(aircraft, condition: FlightCondition, locked: Mapping | None =
     require : bool, optional
         Raise when the trim does not converge (default True); with False the best point is returned
         (its :attr:`AircraftTrim.residual` says how far from equilibrium it is).
+    start : AircraftTrim, optional
+        A nearby trim to start from (e.g. the previous lock position of a sweep).
 
     Returns
     -------
@@ -192,6 +194,9 @@ def trim_aircraft(aircraft, condition: FlightCondition, locked: Mapping | None =
 
     z0 = {"alpha": 0.05, "theta": 0.05 + gam, "beta": 0.0, "throttle": 0.5, "phi": 0.0, "airspeed": V0,
           **dict.fromkeys(free, 0.0)}
+    if start is not None:
+        z0.update(alpha=start.x[4], beta=start.x[5], phi=start.x[6], theta=start.x[7], throttle=start.throttle,
+                  **{s: start.positions[s] for s in free if s in start.positions})
     lo = {"alpha": -0.3, "theta": -0.8, "beta": -0.5, "throttle": 0.0, "phi": -1.0, "airspeed": 0.5 * V0}
     hi = {"alpha": 0.4, "theta": 0.8, "beta": 0.5, "throttle": 1.0, "phi": 1.0, "airspeed": 2.0 * V0}
     for s in free:
@@ -201,6 +206,7 @@ def trim_aircraft(aircraft, condition: FlightCondition, locked: Mapping | None =
         return least_squares(residual, [z0[n] for n in names], bounds=([lo[n] for n in names],
                              [hi[n] for n in names]), xtol=1e-12, ftol=1e-14, gtol=1e-14, max_nfev=400)
 
+    z0 = {k: min(max(v, lo.get(k, -np.inf)), hi.get(k, np.inf)) for k, v in z0.items()}
     sol = solve(names)
     if pitch and "airspeed" not in names and np.max(np.abs(sol.fun)) > 1e-6:
         # the pitch device saturates: hold it at the limit it reached and let the airspeed settle instead

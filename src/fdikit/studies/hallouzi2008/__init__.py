@@ -11,6 +11,8 @@ methods, Table 3.1 and the model-set comparison (Table 3.3), and the report comm
   (Hallouzi 2008, §3.6.2, Table 3.3, Figs 3.7–3.11).
 * :mod:`fdikit.studies.hallouzi2008.example_3_1` — Example 3.1: basis conditioning vs degree of observability of
   model pairs (Hallouzi 2008, §3.3.1, Table 3.1).
+* :mod:`fdikit.studies.hallouzi2008.aircraft_models` — B747 model sets around trim from the JSBSim aircraft: LIP
+  models, Tables 4.2–4.5 (Hallouzi 2008, Ch. 4).
 * :mod:`fdikit.studies.hallouzi2008.report` — One command for the multiple-model reproductions of Hallouzi 2008
   (§2.4, §3.3.1, §3.6).
 """
@@ -34,6 +36,10 @@ __getattr__, __dir__, __all__ = lazy.attach(
         ],
         "msd_model_sets": [
             "ModelSetRun", "msd_cp_model_set", "msd_lv_model_set", "msd_table_3_3", "run_msd_model_set",
+        ],
+        "aircraft_models": [
+            "LIP_RANGES", "LocalModel", "MEASURED", "MODEL_SET_I", "MODEL_SET_II", "b747_at_point",
+            "large_model_set", "local_model", "model_set",
         ],
         "example_3_1": [
             "Example31Result", "PAIRS", "example_3_1", "example_3_1_models",
