@@ -15,6 +15,15 @@ stabiliser act mainly on pitch acceleration (−1.2 and −2.4 rad/s² per rad) 
 α (−0.03 and −0.06 1/s per rad); each engine accelerates along V by 1/(3·10⁵ kg) per N and pitches
 nose-up by 6.7·10⁻⁸ rad/s² per N.  Fault models (Table 2.5): 2/3 zero the δ_c/δ_s column of B, 4/5
 zero the V/α entry of C ("total" faults).
+
+``b_source="jsbsim"`` replaces the substitute B (and C, the same selector) by the linearisation of JSBSim's
+B747 at the §2.4.1 point (:func:`fdikit.plants.b747_jsbsim.b747_jsbsim_matrices`: elevator, fdikit's
+stabiliser = elevator terms ×2, thrust per N of each engine); A stays the printed A (2.56), which is thesis
+data.  ``a_source="jsbsim"`` takes JSBSim's A as well.
+
+References
+----------
+Hallouzi 2008, §2.4.1, (2.54)–(2.61), Tables 2.5–2.6.
 """
 
 from __future__ import annotations
@@ -64,9 +73,22 @@ for _arr in (B747_NOISE["Q"], B747_NOISE["R"], B747_TRANSITION):
 _A35 = {"corrected": 6.83e-7, "printed": 6.83e-1}
 
 
-def _matrices(a35: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+_B_SOURCES = ("substitute", "jsbsim")
+_A_SOURCES = ("thesis", "jsbsim")
+
+
+def _matrices(a35: str, b_source: str = "substitute", a_source: str = "thesis"
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     if not isinstance(a35, str) or a35 not in _A35:
         raise ParameterError(f"a35 must be 'corrected' (6.83e-7) or 'printed' (6.83e-1), got {a35!r}")
+    validate.choice("b_source (where B and C come from)", b_source, _B_SOURCES)
+    validate.choice("a_source (where A comes from)", a_source, _A_SOURCES)
+    if a_source == "jsbsim" and a35 != "corrected":
+        raise ParameterError("a35 applies to the thesis's A only; use a_source='thesis' with a35='printed'")
+    if "jsbsim" in (a_source, b_source):
+        from fdikit.plants.b747_jsbsim import b747_jsbsim_matrices
+
+        lin = b747_jsbsim_matrices()
     A = np.array([
         [-5.91e-1, -1.56e-4, -1.36, 0.0, -1.23e-6],
         [-1.47e-1, -8.72e-3, 4.83, -9.81, 5.31e-5],
@@ -77,10 +99,15 @@ def _matrices(a35: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     thrust = np.array([6.7e-8, 1.0 / 3e5, 0.0, 0.0, 0.0])  # SUBSTITUTE, see module docstring
     B = np.column_stack([[-1.2, 0.0, -0.03, 0.0, 0.0], [-2.4, 0.0, -0.06, 0.0, 0.0]] + [thrust] * 4)
     C = np.eye(5)[[0, 1, 2, 4]]
+    if b_source == "jsbsim":
+        B, C = np.array(lin.B), np.array(lin.C)
+    if a_source == "jsbsim":
+        A = np.array(lin.A_jsbsim)
     return A, B, C
 
 
-def b747_longitudinal(model: str = "nominal", a35: str = "corrected", dt: float | None = None) -> FaultModel:
+def b747_longitudinal(model: str = "nominal", a35: str = "corrected", dt: float | None = None, *,
+                      b_source: str = "substitute", a_source: str = "thesis") -> FaultModel:
     """One model of Table 2.5 (Hallouzi 2008, §2.4.1) as a :class:`~fdikit.model.FaultModel`.
 
     Parameters
@@ -91,6 +118,11 @@ def b747_longitudinal(model: str = "nominal", a35: str = "corrected", dt: float 
         Value of ``A(3, 5)`` (see the module erratum).
     dt : float, optional
         ZOH sample time (the thesis uses 0.01 s); continuous if ``None``.
+    b_source : {"substitute", "jsbsim"}, default "substitute"
+        B and C: the labelled substitute, or the JSBSim B747 linearisation
+        (:func:`~fdikit.plants.b747_jsbsim.b747_jsbsim_matrices`).
+    a_source : {"thesis", "jsbsim"}, default "thesis"
+        A: the printed (2.56) with ``a35``, or the JSBSim B747's (then ``a35`` must stay "corrected").
 
     Returns
     -------
@@ -101,7 +133,7 @@ def b747_longitudinal(model: str = "nominal", a35: str = "corrected", dt: float 
     Raises
     ------
     ParameterError
-        On an unknown model name or ``a35``, or a ``dt`` that is not positive.
+        On an unknown model name, ``a35``, ``b_source`` or ``a_source``, or a ``dt`` that is not positive.
 
     References
     ----------
@@ -112,12 +144,14 @@ def b747_longitudinal(model: str = "nominal", a35: str = "corrected", dt: float 
     >>> m = b747_longitudinal("alpha_sensor")
     >>> m.C[2].tolist()
     [0.0, 0.0, 0.0, 0.0, 0.0]
+    >>> round(float(b747_longitudinal("nominal", b_source="jsbsim").Bu[0, 0]), 2)  # JSBSim q̇ per rad elevator
+    -1.14
     """
     if dt is not None:
         dt = validate.positive("dt", dt)
     if not isinstance(model, str) or model not in B747_MODEL_NAMES:
         raise ParameterError(f"unknown B747 model {model!r}; choose one of {', '.join(B747_MODEL_NAMES)}")
-    A, B, C = _matrices(a35)
+    A, B, C = _matrices(a35, b_source, a_source)
     if model == "delta_c_loss":
         B[:, 0] = 0.0
     elif model == "delta_s_loss":
@@ -130,7 +164,8 @@ def b747_longitudinal(model: str = "nominal", a35: str = "corrected", dt: float 
     return m if dt is None else m.discretize(dt)
 
 
-def b747_model_set(a35: str = "corrected", dt: float | None = 0.01) -> tuple[FaultModel, ...]:
+def b747_model_set(a35: str = "corrected", dt: float | None = 0.01, *, b_source: str = "substitute",
+                   a_source: str = "thesis") -> tuple[FaultModel, ...]:
     """The five models of Table 2.5 in order (ZOH at ``dt = 0.01`` s by default, §2.4.1).
 
     Parameters
@@ -139,6 +174,10 @@ def b747_model_set(a35: str = "corrected", dt: float | None = 0.01) -> tuple[Fau
         Value of ``A(3, 5)`` (see the module erratum).
     dt : float or None, default 0.01
         ZOH sample time [s]; ``None`` gives the continuous models.
+    b_source : {"substitute", "jsbsim"}, default "substitute"
+        Where B and C come from (:func:`b747_longitudinal`).
+    a_source : {"thesis", "jsbsim"}, default "thesis"
+        Where A comes from (:func:`b747_longitudinal`).
 
     Returns
     -------
@@ -148,7 +187,7 @@ def b747_model_set(a35: str = "corrected", dt: float | None = 0.01) -> tuple[Fau
     Raises
     ------
     ParameterError
-        On an unknown ``a35`` or a ``dt`` that is not positive.
+        On an unknown ``a35``, ``b_source`` or ``a_source``, or a ``dt`` that is not positive.
 
     References
     ----------
@@ -162,4 +201,5 @@ def b747_model_set(a35: str = "corrected", dt: float | None = 0.01) -> tuple[Fau
     """
     if dt is not None:
         dt = validate.positive("dt", dt)
-    return tuple(b747_longitudinal(name, a35=a35, dt=dt) for name in B747_MODEL_NAMES)
+    return tuple(b747_longitudinal(name, a35=a35, dt=dt, b_source=b_source, a_source=a_source)
+                 for name in B747_MODEL_NAMES)
