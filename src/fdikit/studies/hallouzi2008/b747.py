@@ -21,6 +21,12 @@ Thesis gaps filled here (Hallouzi 2008, §2.4.1 leaves them open), all **substit
   physical (the substitute B is weak and the model linear); they are the excitation level the thesis's SNR
   implies.  The earlier white noise (σ_δ = 0.3 rad, σ_T = 2 kN) gave 17 / 37 / 8.5 / 51 dB, and α then carried
   too little information to separate the α-sensor model (``input_tau=None``, ``input_std`` restore it).
+* ``b_source="jsbsim"`` (B and C of JSBSim's B747, :mod:`fdikit.plants.b747_jsbsim`; A stays (2.56)) has its own
+  control-noise default, derived the same way: the α SNR scales with σ_δ (α is driven by the surfaces; the
+  thrusts alone give α 8.7 dB), and σ_δ = 2 rad gives α 33.7 dB (mean of 5 runs) there, so
+  ``σ_δ = 2 · 10^((34.1 − 33.7)/20) ≈ 2.1`` rad matches the substitute's level; measured 43 / 47 / 34 / 56 dB.
+  The JSBSim surface columns are close to the substitute's (q̇ −1.14 / −2.28 per rad against −1.2 / −2.4), so
+  the noise barely changes; σ_T stays 10³ N.
 * Filters start at the true ``x_0 = 0`` with ``P_0 = 10⁻⁴ I``; IMM and both CM filters start from the nominal
   weights ``[1, 0, 0, 0, 0]``; EKF ``P^μ_0 = I/12``.
 * Run length 1000 samples (10 s).
@@ -78,19 +84,28 @@ INTERVALS: dict[str, tuple[int, int]] = {
     "nominal_5": (901, 999),
 }
 FAULT_INTERVALS = ("alpha_30", "delta_s_40", "delta_c_50", "V_TAS_20")
-_INPUT_STD = np.array([2.0, 2.0, 1e3, 1e3, 1e3, 1e3])
+#: Control-noise std per B source (δ_c, δ_s [rad], 4 thrusts [N]); module docstring.
+_INPUT_STD = {"substitute": np.array([2.0, 2.0, 1e3, 1e3, 1e3, 1e3]),
+              "jsbsim": np.array([2.1, 2.1, 1e3, 1e3, 1e3, 1e3])}
+for _v in _INPUT_STD.values():
+    _v.setflags(write=False)
 _INPUT_TAU = 0.5
 _P0 = 1e-4 * np.eye(5)
 _FILTERS = ("dual_cmf", "ekf", "imm")
 
 
-def b747_convex_set(a35: str = "corrected") -> ConvexModelSet:
+def b747_convex_set(a35: str = "corrected", *, b_source: str = "substitute", a_source: str = "thesis"
+                    ) -> ConvexModelSet:
     """The five models of Table 2.5 as a convex model set with ``Q``, ``R`` of §2.4.1 (ZOH, ``T_s = 0.01``).
 
     Parameters
     ----------
     a35 : {"corrected", "printed"}, default "corrected"
         ``A(3, 5)`` of the model (:func:`~fdikit.plants.b747.b747_longitudinal`).
+    b_source : {"substitute", "jsbsim"}, default "substitute"
+        B and C: the substitute or the JSBSim B747's (:func:`~fdikit.plants.b747.b747_longitudinal`).
+    a_source : {"thesis", "jsbsim"}, default "thesis"
+        A: the printed (2.56) or the JSBSim B747's.
 
     Returns
     -------
@@ -107,19 +122,21 @@ def b747_convex_set(a35: str = "corrected") -> ConvexModelSet:
     >>> ms.N, ms.varying
     (5, (False, True, True, False))
     """
-    models = b747_model_set(a35=a35, dt=TS)
+    models = b747_model_set(a35=a35, dt=TS, b_source=b_source, a_source=a_source)
     return convex_model_set(np.stack([m.A for m in models]), np.stack([m.Bu for m in models]),
                             np.stack([m.C for m in models]), Q=B747_NOISE["Q"], R=B747_NOISE["R"],
                             names=B747_MODEL_NAMES)
 
 
-def b747_lq_gain(a35: str = "corrected") -> np.ndarray:
+def b747_lq_gain(a35: str = "corrected", *, b_source: str = "substitute", a_source: str = "thesis") -> np.ndarray:
     """Discrete LQ gain ``K`` (6 x 5), ``u = −K x``, on the nominal ZOH model (substitute weights, module docstring).
 
     Parameters
     ----------
     a35 : {"corrected", "printed"}, default "corrected"
         ``A(3, 5)`` of the model.
+    b_source, a_source : str
+        Where B, C and A come from (:func:`b747_convex_set`).
 
     Returns
     -------
@@ -137,7 +154,7 @@ def b747_lq_gain(a35: str = "corrected") -> np.ndarray:
     >>> bool(np.max(np.abs(np.linalg.eigvals(ms.A[0] - ms.B[0] @ K))) < 1)
     True
     """
-    ms = b747_convex_set(a35)
+    ms = b747_convex_set(a35, b_source=b_source, a_source=a_source)
     A, B = ms.A[0], ms.B[0]
     Qlq, Rlq = np.eye(5), np.diag([1.0, 1.0] + [1e-10] * 4)
     P = solve_discrete_are(A, B, Qlq, Rlq)
@@ -187,7 +204,7 @@ def b747_weight_profile(n_samples: int = N_SAMPLES) -> tuple[np.ndarray, np.ndar
 
 
 def b747_trace(seed=None, n_samples: int = N_SAMPLES, *, a35: str = "corrected", input_std=None,
-               input_tau: float | None = _INPUT_TAU) -> Trace:
+               input_tau: float | None = _INPUT_TAU, b_source: str = "substitute", a_source: str = "thesis") -> Trace:
     """One run of the §2.4.1 fault scenario (Hallouzi 2008, (2.54)–(2.55), Table 2.6).
 
     ``u_k = −K x^nom_k + e_k`` with the fault-free closed-loop state ``x^nom`` and ``e_k ~ N(0, diag(σ²))``;
@@ -205,20 +222,26 @@ def b747_trace(seed=None, n_samples: int = N_SAMPLES, *, a35: str = "corrected",
     a35 : {"corrected", "printed"}, default "corrected"
         ``A(3, 5)`` of the model.
     input_std : array_like, optional
-        The 6 control-noise standard deviations (δ_c, δ_s [rad], four thrusts [N]); default 2, 2, 10³ × 4.
+        The 6 control-noise standard deviations (δ_c, δ_s [rad], four thrusts [N]); default per ``b_source``
+        (module docstring): 2, 2, 10³ × 4 for the substitute B, 2.1, 2.1, 10³ × 4 for the JSBSim B.
     input_tau : float or None, default 0.5
         Time constant [s] of the low-pass control noise; ``None`` for white noise.
+    b_source : {"substitute", "jsbsim"}, default "substitute"
+        B and C of the plant and the LQ design (:func:`b747_convex_set`).
+    a_source : {"thesis", "jsbsim"}, default "thesis"
+        A of the plant and the LQ design.
 
     Returns
     -------
     Trace
         Controls ``delta_c, delta_s, T_n1 … T_n4``; outputs ``q_meas, V_TAS_meas, alpha_meas, h_meas``;
-        the 5 true states; fault labels of :func:`b747_weight_profile`; ``meta["a35"]``.
+        the 5 true states; fault labels of :func:`b747_weight_profile`; ``meta["a35"]``, ``meta["b_source"]``,
+        ``meta["a_source"]``.
 
     Raises
     ------
     ParameterError
-        If ``input_std`` is not 6 non-negative values or ``input_tau`` is not positive.
+        If ``input_std`` is not 6 non-negative values, ``input_tau`` is not positive or a source is unknown.
 
     References
     ----------
@@ -231,11 +254,11 @@ def b747_trace(seed=None, n_samples: int = N_SAMPLES, *, a35: str = "corrected",
     ((50, 4), 'alpha_meas', 'none')
     """
     rng = np.random.default_rng(seed)
-    sig = _INPUT_STD if input_std is None else np.asarray(input_std, dtype=float).ravel()
+    ms = b747_convex_set(a35, b_source=b_source, a_source=a_source)
+    K = b747_lq_gain(a35, b_source=b_source, a_source=a_source)
+    sig = _INPUT_STD[b_source] if input_std is None else np.asarray(input_std, dtype=float).ravel()
     if sig.shape != (6,) or np.any(sig < 0):
         raise ParameterError(f"input_std must be 6 non-negative standard deviations (δ_c, δ_s, 4 thrusts), got {sig}")
-    ms = b747_convex_set(a35)
-    K = b747_lq_gain(a35)
     mu, labels = b747_weight_profile(n_samples)
     A, B0 = ms.A[0], ms.B[0]
     Lq, Lr = np.linalg.cholesky(ms.Q), np.linalg.cholesky(ms.R)
@@ -260,7 +283,8 @@ def b747_trace(seed=None, n_samples: int = N_SAMPLES, *, a35: str = "corrected",
     return Trace(t=TS * np.arange(n_samples), u=u, y=y, controls=("delta_c", "delta_s", "T_n1", "T_n2", "T_n3",
                                                                   "T_n4"),
                  outputs=("q_meas", "V_TAS_meas", "alpha_meas", "h_meas"), x=x, states=B747_STATES, fault=labels,
-                 meta={"plant": "b747_longitudinal", "source": "Hallouzi 2008, §2.4.1", "a35": a35})
+                 meta={"plant": "b747_longitudinal", "source": "Hallouzi 2008, §2.4.1", "a35": a35,
+                       "b_source": b_source, "a_source": a_source})
 
 
 def b747_snr(trace: Trace) -> np.ndarray:
@@ -288,7 +312,9 @@ def b747_snr(trace: Trace) -> np.ndarray:
     (4,)
     """
     mu, _ = b747_weight_profile(trace.t.size)
-    ms = b747_convex_set(trace.meta.get("a35", "corrected"))
+    meta = trace.meta
+    ms = b747_convex_set(meta.get("a35", "corrected"), b_source=meta.get("b_source", "substitute"),
+                         a_source=meta.get("a_source", "thesis"))
     ybar = np.stack([ms.blend(m)[2] @ xk for m, xk in zip(mu, trace.x)])
     noise = trace.y - ybar
     return 20 * np.log10(np.sqrt((ybar**2).mean(0)) / np.sqrt((noise**2).mean(0)))
@@ -343,7 +369,8 @@ class B747MonteCarloResult:
 
 def b747_monte_carlo(runs: int = 100, seed: int | None = 0, *, lam: float = 0.85, q_mu: float = 1e-2,
                      prior_std: float | None = 0.3, ekf_projection: str = "covariance",
-                     filters=_FILTERS, n_samples: int = N_SAMPLES, a35: str = "corrected") -> B747MonteCarloResult:
+                     filters=_FILTERS, n_samples: int = N_SAMPLES, a35: str = "corrected", b_source: str = "substitute",
+                     a_source: str = "thesis") -> B747MonteCarloResult:
     """Monte-Carlo comparison of the dual CMF, the augmented EKF and the IMM (Hallouzi 2008, §2.4.1).
 
     Parameters
@@ -372,6 +399,10 @@ def b747_monte_carlo(runs: int = 100, seed: int | None = 0, *, lam: float = 0.85
         Samples per run; intervals of :data:`INTERVALS` beyond the run are left out of ``summary``.
     a35 : {"corrected", "printed"}, default "corrected"
         ``A(3, 5)`` of the B747 model (:func:`~fdikit.plants.b747.b747_longitudinal`).
+    b_source : {"substitute", "jsbsim"}, default "substitute"
+        B and C of the plant, the filters and the LQ design; also picks the control-noise level (module docstring).
+    a_source : {"thesis", "jsbsim"}, default "thesis"
+        A of the plant, the filters and the LQ design.
 
     Returns
     -------
@@ -399,7 +430,7 @@ def b747_monte_carlo(runs: int = 100, seed: int | None = 0, *, lam: float = 0.85
         raise ParameterError(f"unknown filters {sorted(bad)}; choose from 'dual_cmf', 'ekf', 'imm'")
     if runs < 1:
         raise ParameterError(f"runs must be at least 1, got {runs}")
-    ms = b747_convex_set(a35)
+    ms = b747_convex_set(a35, b_source=b_source, a_source=a_source)
     mu_true, _ = b747_weight_profile(n_samples)
     mu_nom = np.eye(5)[0]
     imm = None
@@ -414,7 +445,7 @@ def b747_monte_carlo(runs: int = 100, seed: int | None = 0, *, lam: float = 0.85
     se_mu = {f: np.zeros(n_samples) for f in filters}
     wsum = {f: np.zeros((n_samples, 5)) for f in filters}
     for child in np.random.SeedSequence(seed).spawn(runs):
-        tr = b747_trace(np.random.default_rng(child), n_samples, a35=a35)
+        tr = b747_trace(np.random.default_rng(child), n_samples, a35=a35, b_source=b_source, a_source=a_source)
         for f in filters:
             if f == "dual_cmf":
                 r = dual_convex_filter(ms, tr.y, tr.u, np.zeros(5), _P0, mu0=mu_nom, lam=lam, prior_std=prior_std)
