@@ -360,6 +360,77 @@ def multiple_model(
     console.print(f"wrote {summary} and the plots in {time.perf_counter() - start:.0f} s")
 
 
+@app.command("b747")
+def b747(
+    out: Path = typer.Option(Path("out/b747"), help="Folder for table.md, rows.csv, report.html and the plots."),
+    step: float = typer.Option(0.5, help="Lock-position step of the sweep [deg] (thesis: 0.5; 81 + 61 + 101 runs)."),
+    hours: float = typer.Option(1.0, help="Fault-free flight for the false-alarm count [h]."),
+    seed: int = typer.Option(0, help="Base seed of the sweep and the fault-free flights."),
+    surfaces: str = typer.Option("elevator,aileron,rudder", help="Comma-separated surfaces to sweep."),
+    noise: str = typer.Option("thesis_cov", help="Sensor-noise preset: thesis_cov ((4.4) as covariances) or "
+                              "thesis_std (Table 6.2 as standard deviations)."),
+    turbulence: int = typer.Option(3, help="MIL-F-8785C turbulence severity 0-7 (3: light)."),
+    fresh: bool = _fresh_option(),
+) -> None:
+    """Hallouzi 2008 Table 4.8 on the nonlinear JSBSim B747: lock-in-place sweep, IMM with model set II.
+
+    Trims JSBSim's B747 at 980 m / 92.6 m/s / flaps 20 / 263 t, builds model set II from it, identifies
+    the IMM's process noise on a fault-free turbulent flight, counts false alarms on HOURS of fault-free
+    flight, then flies every lock position and writes the table next to the thesis's, the rows, the plots
+    and report.html.  Each run is kept in OUT as soon as it is done; rerunning resumes.
+    """
+    import numpy as np
+
+    from fdikit import validate
+    from fdikit.resume import RunStore, check_seed
+    from fdikit.studies.hallouzi2008.b747_lip import false_alarm_rate, fly_lip, lip_setup
+    from fdikit.studies.hallouzi2008.b747_report import write_b747_report
+    from fdikit.studies.hallouzi2008.table_4_8 import SWEEP_RANGES, table_4_8
+
+    start = time.perf_counter()
+    try:
+        names = [validate.choice("--surfaces", s.strip(), list(SWEEP_RANGES)) for s in surfaces.split(",")]
+        step = validate.positive("--step", step)
+        hours = validate.non_negative("--hours", hours)
+        check_seed(seed)
+        args = {"step": step, "hours": hours, "seed": seed, "surfaces": names, "noise": noise,
+                "turbulence": turbulence}
+        store = RunStore(out, "b747", args, fresh=fresh)
+        with console.status("trimming the B747, building model set II, identifying the process noise ..."):
+            setup = lip_setup(noise=noise, turbulence=turbulence)
+        fa = None
+        if hours > 0:
+            fa = store.load("false-alarms")
+            if fa is None:
+                with console.status(f"{hours:g} h of fault-free flight ..."):
+                    fa = false_alarm_rate(setup, hours, seed=seed * 1000 + 1)
+                store.save("false-alarms", list(fa))
+            fa = tuple(fa)
+        table = table_4_8(setup, step=step, surfaces=names, seed=seed, store=store, progress=True)
+        examples = []
+        for s in names:
+            rows = [r for r in table.rows if r.surface == s]
+            pick = min(rows, key=lambda r: abs(r.lock - (SWEEP_RANGES[s][1] * 0.5)))
+            examples.append(fly_lip(setup, s, pick.lock, seed=pick.seed))
+        write_b747_report(out, table, setup, examples, fa)
+    except (FdiError, OSError) as exc:
+        _fail(exc)
+    summary = Table(title="Hallouzi 2008 Table 4.8 on the JSBSim B747 (fdikit / thesis)")
+    summary.add_column("")
+    for s in table.summary():
+        summary.add_column(s)
+    from fdikit.studies.hallouzi2008.table_4_8 import THESIS_TABLE_4_8
+
+    for key in ("correct", "incorrect", "missed", "false alarm", "delay"):
+        unit = " s" if key == "delay" else " %"
+        summary.add_row(key, *(f"{e[key]:.1f}{unit} / {THESIS_TABLE_4_8[s][key]:.1f}{unit}"
+                               for s, e in table.summary().items()))
+    console.print(summary)
+    if fa is not None:
+        console.print(f"false alarms: {fa[0]} in {fa[1]:.2f} h of fault-free flight")
+    console.print(f"wrote {out} in {time.perf_counter() - start:.0f} s ({np.sum([1 for _ in table.rows])} runs)")
+
+
 def main() -> None:  # pragma: no cover
     app()
 

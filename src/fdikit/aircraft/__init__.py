@@ -8,6 +8,7 @@ limits and rates), on JSBSim's nonlinear aircraft (Berndt 2004).
 * :mod:`fdikit.aircraft.plant` — The aircraft as a plant: SI signals, steps, snapshots, turbulence.
 * :mod:`fdikit.aircraft.trim` — Trim in steady straight flight, surfaces free or locked.
 * :mod:`fdikit.aircraft.linearize` — Numerical linear models around a trim, with the trim offsets.
+* :mod:`fdikit.aircraft.autopilot` — An LQR autopilot holding the trim (stands in for the SPC of Ch. 6).
 """
 
 import lazy_loader as lazy
@@ -20,5 +21,6 @@ __getattr__, __dir__, __all__ = lazy.attach(
         "plant": ["FT", "KT", "LBF", "LBM", "SENSORS", "STATES", "AircraftSnapshot", "JSBSimAircraft"],
         "trim": ["HALLOUZI_POINT", "AircraftTrim", "FlightCondition", "trim_aircraft"],
         "linearize": ["INPUTS", "AircraftLinearization", "linearize_aircraft"],
+        "autopilot": ["BRYSON_INPUT", "BRYSON_STATE", "LQRAutopilot", "lqr_autopilot"],
     },
 )

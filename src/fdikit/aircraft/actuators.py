@@ -10,8 +10,9 @@ to the position limits, integrated exactly over a step for the lag and then rate
 * :class:`~fdikit.faults.Stuck` holds the position the surface had at the onset (or its value);
 * every other kind (loss of effectiveness, bias, scale factor …) changes the command.
 
-The B747 limits are Hallouzi's App. A (Table A.2, after Hanke & Nordwall 1970) lumped as in Ch. 4:
-elevator −23…17 deg at 37 deg/s, ailerons ±15 deg at 40/45 deg/s (down/up), rudder ±25 deg at
+The B747 limits are Hallouzi's App. A (Table A.2, after Hanke & Nordwall 1970), lumped: elevator
+−23…17 deg at 37 deg/s, ailerons ±20 deg at 40/45 deg/s (down/up; the inner ailerons' range, also
+JSBSim's own aileron range — Ch. 4 sweeps the aileron LIP over ±15 deg only), rudder ±25 deg at
 50 deg/s, flaps 0…25 deg at 1.8 deg/s, stabiliser −12…3 deg at 0.5 deg/s (App. A: 0.2 to 0.5).
 Other aircraft get their JSBSim FCS ranges and 60 deg/s.
 
@@ -73,7 +74,7 @@ def _deg(lo, hi, down, up) -> SurfaceLimits:
 #: Hallouzi 2008, App. A (Table A.2), lumped as in Ch. 4.
 B747_LIMITS = {
     "elevator": _deg(-23, 17, 37, 37),
-    "aileron": _deg(-15, 15, 40, 45),
+    "aileron": _deg(-20, 20, 40, 45),
     "rudder": _deg(-25, 25, 50, 50),
     "flap": _deg(0, 25, 1.8, 1.8),
     "stabilizer": _deg(-12, 3, 0.5, 0.5),

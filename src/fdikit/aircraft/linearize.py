@@ -51,6 +51,9 @@ class AircraftLinearization:
     f0 : ndarray
         ``f(x°, u°)`` (zero at an exact equilibrium).
     trim : AircraftTrim
+    thrust_slope : float
+        ``∂T/∂throttle`` [N] of all engines together at the trim (steady state), to turn a thrust
+        command into a throttle.
 
     Examples
     --------
@@ -66,6 +69,7 @@ class AircraftLinearization:
     u0: np.ndarray
     f0: np.ndarray
     trim: object
+    thrust_slope: float = float("nan")
 
     @property
     def offset(self) -> np.ndarray:
@@ -152,4 +156,4 @@ def linearize_aircraft(aircraft, trim, outputs: Sequence[str] | None = None) -> 
     C = np.eye(10)[[STATES.index(o) for o in outputs]]
     model = FaultModel(A, C, Bu=B, states=STATES, outputs=outputs, controls=inputs)
     u0 = np.array([*(base[s] for s in surfaces), trim.thrust])
-    return AircraftLinearization(model=model, x0=x0, u0=u0, f0=f0, trim=trim)
+    return AircraftLinearization(model=model, x0=x0, u0=u0, f0=f0, trim=trim, thrust_slope=float(dT))

@@ -189,8 +189,9 @@ class JSBSimAircraft:
         for s in (*self.surfaces, "gear") if self.definition.gear else self.surfaces:
             self.fdm[f"fdikit/{s}-override"] = 1.0
         self.fdm["propulsion/set-running"] = -1
-        tanks = self.fdm.query_property_catalog("contents-lbs").splitlines()
-        self._mass_properties = ([line.split()[0] for line in tanks if "tank[" in line]
+        tanks = [line.split()[0] for line in self.fdm.query_property_catalog("contents-lbs").splitlines()
+                 if line.startswith("propulsion/tank")]  # JSBSim lists tank 0 without its index
+        self._mass_properties = ([t.replace("propulsion/tank/", "propulsion/tank[0]/") for t in tanks]
                                  + [f"inertia/pointmass-weight-lbs[{self.definition.payload}]"])
         catalog = self.fdm.query_property_catalog("propulsion/engine")
         turbine = "propulsion/engine/n1 " in catalog or "propulsion/engine[0]/n1 " in catalog
@@ -439,7 +440,8 @@ class JSBSimAircraft:
         unit = {s: "deg" if s == "flap" else "rad" for s in self.surfaces}
         return ([f"fdikit/{s}-pos-{unit[s]}" for s in self.surfaces] + [f"fdikit/{s}-override" for s in self.surfaces]
                 + [f"fcs/throttle-cmd-norm[{i}]" for i in range(self.engines)]
-                + [f"propulsion/engine[{i}]/set-running" for i in range(self.engines)] + ["gear/gear-cmd-norm"]
+                + [f"propulsion/engine[{i}]/{k}" for i in range(self.engines) for k in ("set-running", "seized")]
+                + ["gear/gear-cmd-norm"]
                 + (["fdikit/gear-pos-norm"] if self.definition.gear else []) + self._mass_properties)
 
     def restore(self, snap: AircraftSnapshot) -> None:
@@ -514,7 +516,7 @@ class JSBSimAircraft:
         self._write_surfaces(self.actuators.positions)
 
     def set_engine_running(self, engine: int, running: bool) -> None:
-        """Start or cut off one engine at once (a cut engine gives no thrust).
+        """Start or cut off one engine at once (a cut engine is stopped and seized: no thrust at all).
 
         Parameters
         ----------
@@ -531,6 +533,8 @@ class JSBSimAircraft:
         if engine > self.engines:
             raise ParameterError(f"the {self.name} has engines 1…{self.engines}; got engine {engine}.")
         self.fdm[f"propulsion/engine[{engine - 1}]/set-running"] = 1 if running else 0
+        # seized too: JSBSim's run_ic gives a stopped, unseized turbine a windmill thrust of ~7.6 kN
+        self.fdm[f"propulsion/engine[{engine - 1}]/seized"] = 0 if running else 1
 
     def set_throttles(self, throttles, steady: bool = True) -> None:
         """Set every engine's throttle and (by default) bring the engines to their steady state.

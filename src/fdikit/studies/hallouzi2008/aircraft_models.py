@@ -234,6 +234,7 @@ def local_model(aircraft, fault: str, size: float | None = None, *, nominal: Loc
                                mass=mass - _SEPARATION_MASS)
         trim = trim_aircraft(aircraft, cond, require=False)
         model = _model(aircraft, trim, "engine_separation", fault, None)
+        aircraft.set_mass(mass)
         for engine in (3, 4):
             aircraft.set_engine_running(engine, True)
         aircraft.restore(snap)
