@@ -13,6 +13,13 @@ methods, Table 3.1 and the model-set comparison (Table 3.3), and the report comm
   model pairs (Hallouzi 2008, §3.3.1, Table 3.1).
 * :mod:`fdikit.studies.hallouzi2008.aircraft_models` — B747 model sets around trim from the JSBSim aircraft: LIP
   models, Tables 4.2–4.5 (Hallouzi 2008, Ch. 4).
+* :mod:`fdikit.studies.hallouzi2008.table_4_6` — Table 4.6 / Fig. 4.3: the linear simulation with model set I
+  (LQR, augmented EKF) and the Table 4.7 logic on it (Hallouzi 2008, §4.4.1).
+* :mod:`fdikit.studies.hallouzi2008.b747_lip` — LIP isolation on the nonlinear JSBSim B747: one closed-loop
+  flight with the IMM of model set II (Hallouzi 2008, §4.4.2).
+* :mod:`fdikit.studies.hallouzi2008.table_4_8` — Table 4.8 on the nonlinear B747: the lock-position sweep
+  (Hallouzi 2008, §4.4.2).
+* :mod:`fdikit.studies.hallouzi2008.b747_report` — Files of ``fdikit b747`` (Table 4.8, plots, HTML).
 * :mod:`fdikit.studies.hallouzi2008.report` — One command for the multiple-model reproductions of Hallouzi 2008
   (§2.4, §3.3.1, §3.6).
 """
@@ -41,6 +48,14 @@ __getattr__, __dir__, __all__ = lazy.attach(
             "LIP_RANGES", "LocalModel", "MEASURED", "MODEL_SET_I", "MODEL_SET_II", "b747_at_point",
             "large_model_set", "local_model", "model_set",
         ],
+        "table_4_6": [
+            "Table46Result", "Table46Scenario", "b747_lqr_gain", "build_table_4_6", "equivalent_lip_weight",
+            "model_set_i_logic", "noise_covariances", "plot_table_4_6", "run_table_4_6", "simulate_table_4_6",
+            "table_4_6_isolation",
+        ],
+        "b747_lip": ["NOISE_PRESETS", "T_FAULT", "LipRun", "LipSetup", "false_alarm_rate", "fly_lip", "lip_setup"],
+        "table_4_8": ["SWEEP_RANGES", "THESIS_TABLE_4_8", "LipRow", "Table48", "lock_positions", "table_4_8"],
+        "b747_report": ["plot_lip_run", "plot_sweep", "write_b747_report"],
         "example_3_1": [
             "Example31Result", "PAIRS", "example_3_1", "example_3_1_models",
         ],

@@ -203,7 +203,7 @@ def table_4_8(setup, *, step: float = 0.5, surfaces=("elevator", "aileron", "rud
     bar = _Bar(progress, len(jobs))
     with bar:
         for surface, lock in jobs:
-            key = f"{surface}{lock:+.1f}".replace(".", "p")
+            key = f"{surface}_{'m' if lock < 0 else 'p'}{abs(lock):.1f}"
             done = None if store is None else store.load(key)
             if done is None:
                 sd = _seed(seed, surface, lock)

@@ -1,0 +1,78 @@
+"""LIP isolation on the nonlinear JSBSim B747 (Hallouzi 2008, §4.4.2): one flight, the logic, Table 4.8 reduced."""
+
+import numpy as np
+import pytest
+
+from fdikit.errors import ParameterError
+from fdikit.studies.hallouzi2008.b747_lip import _confirmed, fly_lip, lip_setup
+from fdikit.studies.hallouzi2008.table_4_8 import (
+    THESIS_TABLE_4_8,
+    LipRow,
+    Table48,
+    lock_positions,
+)
+
+
+@pytest.fixture(scope="module")
+def setup():
+    # a shorter calibration flight than the command's 300 s: Q from 60 s of turbulence (6000 one-step errors
+    # for a 10 × 10 covariance) is within a few per cent of the long one
+    return lip_setup(calibration_seconds=60.0)
+
+
+def test_confirmation_needs_the_same_signature_for_the_whole_time():
+    raw = np.array(["none", "elevator", "elevator", "aileron", "aileron", "aileron", "none", "rudder"])
+    assert _confirmed(raw, 1).tolist() == raw.tolist()
+    assert _confirmed(raw, 2).tolist() == ["none", "none", "elevator", "elevator", "aileron", "aileron", "none",
+                                           "none"]
+    assert _confirmed(raw, 3).tolist() == ["none"] * 5 + ["aileron", "none", "none"]
+
+
+def test_sweep_sizes_are_the_thesis_run_counts():
+    assert {s: len(lock_positions(s)) for s in THESIS_TABLE_4_8} == {s: v["runs"] for s, v in THESIS_TABLE_4_8.items()}
+
+
+def test_lip_travels_to_the_lock_and_a_large_elevator_lock_is_isolated(setup):
+    run = fly_lip(setup, "elevator", -18.0, seed=5, duration=26.0)
+    k = np.searchsorted(run.t, 20.0)
+    # 37 deg/s (App. A): about −1 deg to −18 deg in 0.46 s, then the 0.05-s lag closes the rest
+    # (e^(−0.54/0.05) ≈ 2e-5 of the gap left after 1 s)
+    assert run.positions[k + 100] == pytest.approx(-18.0, abs=1e-3)
+    assert np.min(np.diff(run.positions)) / 0.01 == pytest.approx(-37.0, rel=1e-9)
+    assert run.false_alarms == 0
+    assert run.outcome == "correct"
+    assert run.first[1] < 2.0
+    groups = run.mu[:, [2, 4, 5]].sum(axis=1)  # the elevator models of model set II
+    assert groups[-1] > 0.9
+
+
+def test_outcome_rules():
+    t = np.arange(0.0, 1.0, 0.01)
+    from fdikit.studies.hallouzi2008.b747_lip import LipRun
+
+    def run(first, fa):
+        return LipRun(t, np.zeros((t.size, 8)), np.full(t.size, "none"), "rudder", 5.0, first, fa, t, t)
+
+    assert run(("rudder", 1.0), 0).outcome == "correct"
+    assert run(("aileron", 1.0), 0).outcome == "incorrect"
+    assert run((None, np.nan), 0).outcome == "missed"
+    assert run(("rudder", 1.0), 1).outcome == "false alarm"
+
+
+def test_table_summary_and_markdown():
+    rows = (LipRow("rudder", 0.0, 1, "missed", None, np.nan, "none", 0.0),
+            LipRow("rudder", 5.0, 2, "correct", "rudder", 3.0, "rudder", 0.0),
+            LipRow("rudder", 10.0, 3, "correct", "rudder", 1.0, "rudder", 0.0),
+            LipRow("rudder", 15.0, 4, "incorrect", "aileron", 2.0, "aileron", 0.0))
+    summ = Table48(rows, {}).summary()["rudder"]
+    assert summ == {"correct": 50.0, "incorrect": 25.0, "missed": 25.0, "false alarm": 0.0, "delay": 2.0, "runs": 4}
+    assert "75.2 %" in Table48(rows, {}).markdown()  # the thesis's rudder figure beside ours
+
+
+def test_bad_arguments(setup):
+    with pytest.raises(ParameterError, match="surface"):
+        fly_lip(setup, "spoiler", 1.0)
+    with pytest.raises(ParameterError, match="lock"):
+        fly_lip(setup, "elevator", 30.0)
+    with pytest.raises(ParameterError, match="noise"):
+        lip_setup(noise="datasheet")
