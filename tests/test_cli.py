@@ -129,6 +129,31 @@ def test_multiple_model_command(tmp_path):
         assert (out / png).stat().st_size > 10_000
 
 
+def test_b747_command_reduced_run_and_resume(tmp_path):
+    """`fdikit b747` on a reduced sweep (rudder at −25, −5, 15 deg; no fault-free hour): tables, plots, HTML."""
+    out = tmp_path / "b747"
+    args = ["b747", "--step", "20", "--hours", "0", "--surfaces", "rudder", "--out", str(out)]
+    res = runner.invoke(app, args)
+    assert res.exit_code == 0, res.output
+    rows = (out / "rows.csv").read_text().strip().splitlines()
+    assert [r.split(",")[1] for r in rows[1:]] == ["-25.0", "-5.0", "15.0"]
+    table = (out / "table.md").read_text()
+    assert "rudder (thesis)" in table and "75.2 %" in table  # side by side with Table 4.8
+    assert "Table 4.7 decision" in (out / "table_4_6.md").read_text()
+    for png in ("sweep.png", "table_4_6.png"):
+        assert (out / png).stat().st_size > 10_000
+    assert "<table>" in (out / "report.html").read_text()
+    again = runner.invoke(app, args)  # every run read back
+    assert again.exit_code == 0 and (out / "rows.csv").read_text().strip().splitlines() == rows
+
+
+def test_b747_command_refuses_bad_arguments(tmp_path):
+    for bad, word in ((["--surfaces", "spoiler"], "--surfaces"), (["--noise", "datasheet"], "--noise"),
+                      (["--turbulence", "9"], "--turbulence"), (["--step", "0"], "--step")):
+        res = runner.invoke(app, ["b747", "--out", str(tmp_path / "x"), *bad])
+        assert res.exit_code == 2 and word in res.output, res.output
+
+
 def test_simulate_reports_a_fault_that_never_acts_as_one_warning_line(tmp_path):
     res = runner.invoke(app, ["simulate", "path12", "-f", "bias:yaw_rate:0.02@50", "--duration", "5",
                                    "--out", str(tmp_path / "t.parquet")])

@@ -372,24 +372,27 @@ def b747(
     turbulence: int = typer.Option(3, help="MIL-F-8785C turbulence severity 0-7 (3: light)."),
     fresh: bool = _fresh_option(),
 ) -> None:
-    """Hallouzi 2008 Table 4.8 on the nonlinear JSBSim B747: lock-in-place sweep, IMM with model set II.
+    """Hallouzi 2008 Ch. 4 on the JSBSim B747: Table 4.8 (lock-in-place sweep, IMM with model set II) and Table 4.6.
 
     Trims JSBSim's B747 at 980 m / 92.6 m/s / flaps 20 / 263 t, builds model set II from it, identifies
     the IMM's process noise on a fault-free turbulent flight, counts false alarms on HOURS of fault-free
     flight, then flies every lock position and writes the table next to the thesis's, the rows, the plots
-    and report.html.  Each run is kept in OUT as soon as it is done; rerunning resumes.
+    (surface position, mode probabilities, altitude of one run per surface) and report.html; then the
+    linear §4.4.1 run with model set I (Table 4.6, Fig. 4.3).  Each run is kept in OUT as soon as it is
+    done; rerunning resumes.
     """
-    import numpy as np
-
     from fdikit import validate
     from fdikit.resume import RunStore, check_seed
-    from fdikit.studies.hallouzi2008.b747_lip import false_alarm_rate, fly_lip, lip_setup
+    from fdikit.studies.hallouzi2008.b747_lip import NOISE_PRESETS, false_alarm_rate, fly_lip, lip_setup
     from fdikit.studies.hallouzi2008.b747_report import write_b747_report
+    from fdikit.studies.hallouzi2008.table_4_6 import run_table_4_6
     from fdikit.studies.hallouzi2008.table_4_8 import SWEEP_RANGES, table_4_8
 
     start = time.perf_counter()
     try:
         names = [validate.choice("--surfaces", s.strip(), list(SWEEP_RANGES)) for s in surfaces.split(",")]
+        validate.choice("--noise", noise, sorted(NOISE_PRESETS))
+        validate.in_range("--turbulence", validate.integer("--turbulence", turbulence, minimum=0), 0, 7)
         step = validate.positive("--step", step)
         hours = validate.non_negative("--hours", hours)
         check_seed(seed)
@@ -412,7 +415,9 @@ def b747(
             rows = [r for r in table.rows if r.surface == s]
             pick = min(rows, key=lambda r: abs(r.lock - (SWEEP_RANGES[s][1] * 0.5)))
             examples.append(fly_lip(setup, s, pick.lock, seed=pick.seed))
-        write_b747_report(out, table, setup, examples, fa)
+        with console.status("Table 4.6: the linear run with model set I ..."):
+            linear = run_table_4_6(seed=seed)
+        write_b747_report(out, table, setup, examples, fa, linear)
     except (FdiError, OSError) as exc:
         _fail(exc)
     summary = Table(title="Hallouzi 2008 Table 4.8 on the JSBSim B747 (fdikit / thesis)")
@@ -428,7 +433,7 @@ def b747(
     console.print(summary)
     if fa is not None:
         console.print(f"false alarms: {fa[0]} in {fa[1]:.2f} h of fault-free flight")
-    console.print(f"wrote {out} in {time.perf_counter() - start:.0f} s ({np.sum([1 for _ in table.rows])} runs)")
+    console.print(f"wrote {out} in {time.perf_counter() - start:.0f} s ({len(table.rows)} runs)")
 
 
 def main() -> None:  # pragma: no cover

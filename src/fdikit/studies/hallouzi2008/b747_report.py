@@ -1,4 +1,4 @@
-"""Files of ``fdikit b747``: Table 4.8 next to the thesis, per-run rows, plots and an HTML page.
+"""Files of ``fdikit b747``: Tables 4.6 and 4.8 next to the thesis, per-run rows, plots and an HTML page.
 
 Hallouzi 2008, §4.4.2 (Table 4.8) on fdikit's JSBSim B747: the sweep's table and rows, the outcome
 and delay over the lock position, and for one run per surface the flown trajectory, the surface
@@ -16,7 +16,11 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["plot_lip_run", "plot_sweep", "write_b747_report"]
+__all__ = ["THESIS_FIG_4_3", "plot_lip_run", "plot_sweep", "table_4_6_markdown", "write_b747_report"]
+
+#: Hallouzi 2008, Fig. 4.3 as read in the text (§4.4.1): the weight each fault interval should show.
+THESIS_FIG_4_3 = {"elevator": "μ(3) ≈ 0.7", "alpha_sensor": "μ(6) ≈ 0.5, μ(8) ≈ 0.5", "rudder": "μ(2) ≈ 0.55",
+                  "hydraulic": "μ(7) → 1", "engine": "μ(5) → ≈ 1", "none": "μ(8) ≈ 1"}
 
 _COLOURS = {"correct": "tab:green", "incorrect": "tab:red", "missed": "tab:orange", "false alarm": "tab:purple"}
 
@@ -116,7 +120,50 @@ def plot_sweep(table, ax=None, path=None):
     return finish_plot(fig, ax, path)
 
 
-def write_b747_report(out, table, setup, examples=(), false_alarms=None) -> dict:
+def table_4_6_markdown(result) -> str:
+    """Table 4.6 / Fig. 4.3 of a linear run: mean weights per interval, the Table 4.7 decision, the thesis's figure.
+
+    Parameters
+    ----------
+    result : Table46Result
+        From :func:`fdikit.studies.hallouzi2008.table_4_6.run_table_4_6`.
+
+    Returns
+    -------
+    str
+        Markdown: one row per interval (1 s after each switch skipped), then the state VAFs.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.studies.hallouzi2008.table_4_6 import Table46Result
+    >>> t = np.arange(300) * 0.01
+    >>> mu = np.tile(np.eye(8)[7], (300, 1))
+    >>> "none_1" in table_4_6_markdown(Table46Result(t, np.array(["none"] * 300), mu, mu, None, None, None, {}))
+    True
+    """
+    from fdikit.studies.hallouzi2008.table_4_6 import table_4_6_isolation
+
+    decided = table_4_6_isolation(result)
+    lines = ["| interval | mean weights μ(1) … μ(8) | Table 4.7 decision (share of samples) | thesis (Fig. 4.3) |",
+             "|---|---|---|---|"]
+    for name, (label, share) in decided.items():
+        base = name.rsplit("_", 1)[0] if name.startswith("none") else name
+        rows = result.labels == base
+        if base == "none":  # the k-th fault-free stretch
+            k = int(name.rsplit("_", 1)[1])
+            edges = np.flatnonzero(np.diff(np.r_[0, rows.astype(int)]) == 1)
+            stop = np.r_[np.flatnonzero(np.diff(np.r_[rows.astype(int), 0]) == -1)]
+            rows = np.zeros_like(rows)
+            rows[edges[k - 1]:stop[k - 1] + 1] = True
+        mu = result.mu[rows][100:] if rows.sum() > 100 else result.mu[rows]
+        weights = " ".join(f"{v:.2f}" for v in mu.mean(axis=0))
+        lines.append(f"| {name} | {weights} | {label} ({100 * share:.0f} %) | {THESIS_FIG_4_3.get(base, '')} |")
+    vaf = ", ".join(f"{k} {v:.1f} %" for k, v in result.vaf.items())
+    return "\n".join(lines) + f"\n\nState VAF: {vaf}\n"
+
+
+def write_b747_report(out, table, setup, examples=(), false_alarms=None, linear=None) -> dict:
     """Write ``table.md``, ``rows.csv``, ``sweep.png``, one ``run_<surface>.png`` per example and ``report.html``.
 
     Parameters
@@ -129,6 +176,8 @@ def write_b747_report(out, table, setup, examples=(), false_alarms=None) -> dict
         Runs to plot.
     false_alarms : tuple, optional
         ``(count, hours)`` of the fault-free flights (:func:`fdikit.studies.hallouzi2008.b747_lip.false_alarm_rate`).
+    linear : Table46Result, optional
+        The §4.4.1 linear run with model set I: ``table_4_6.md`` and ``table_4_6.png``.
 
     Returns
     -------
@@ -155,6 +204,13 @@ def write_b747_report(out, table, setup, examples=(), false_alarms=None) -> dict
     files["rows"] = write_text(out / "rows.csv", header + body)
     plot_sweep(table, path=out / "sweep.png")
     files["sweep"] = out / "sweep.png"
+    if linear is not None:
+        from fdikit.studies.hallouzi2008.table_4_6 import plot_table_4_6
+
+        files["table_4_6"] = write_text(out / "table_4_6.md", "# Table 4.6 / Fig. 4.3: the linear run with model "
+                                        "set I (augmented EKF)\n\n" + table_4_6_markdown(linear))
+        plot_table_4_6(linear, path=out / "table_4_6.png")
+        files["table_4_6_plot"] = out / "table_4_6.png"
     for run in examples:
         p = out / f"run_{run.surface}_{run.lock:+.1f}.png"
         plot_lip_run(run, names, path=p)
@@ -172,5 +228,8 @@ def write_b747_report(out, table, setup, examples=(), false_alarms=None) -> dict
             f"<table><tr>{heads}</tr>{rows_html}</table><p>{html.escape(fa_line)}</p>"
             f"<p>Settings: {html.escape(settings)}</p>{images}"
             "<p>Rows: <a href='rows.csv'>rows.csv</a>; table: <a href='table.md'>table.md</a>.</p></body></html>")
+    if linear is not None:
+        page = page.replace("<figure>", "<h2>Table 4.6 (linear, model set I)</h2><pre>"
+                            + html.escape(table_4_6_markdown(linear)) + "</pre><figure>", 1)
     files["html"] = write_text(out / "report.html", page)
     return files

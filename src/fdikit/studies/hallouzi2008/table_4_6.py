@@ -103,7 +103,7 @@ SCENARIO = (
 )
 #: (4.3), thesis units (deg, deg/s, m/s, m) for p q r V α β φ θ ψ h; β and φ (not printed) as the other angles.
 Q_S_THESIS = np.array([1e-8, 1e-8, 1e-8, 1e-1, 1e-4, 1e-4, 1e-4, 1e-4, 1e-4, 1e-1])
-#: (4.4), thesis units, for the measured p q r V α θ ψ h (Breeman 2006 sensor covariances).
+#: (4.4), thesis units, for the measured p q r V α θ ψ h ("realistic B747 sensor covariances" in the thesis).
 R_S_THESIS = np.array([1.73e-4, 1.73e-4, 1.73e-4, 1e-1, 1.73e-4, 1.73e-4, 1.73e-4, 1e-1])
 _ANGLE_STATES = np.array([1, 1, 1, 0, 1, 1, 1, 1, 1, 0], bool)
 _ANGLE_MEASURED = np.array([1, 1, 1, 0, 1, 1, 1, 0], bool)
@@ -543,7 +543,7 @@ def table_4_6_isolation(result: Table46Result, threshold: float = 0.2, settle: f
     return out
 
 
-def plot_table_4_6(result: Table46Result, ax=None):
+def plot_table_4_6(result: Table46Result, ax=None, path=None):
     """Estimated weights μ(1) … μ(8) against time, with the fault intervals shaded (Hallouzi 2008, Fig. 4.3).
 
     Parameters
@@ -551,10 +551,12 @@ def plot_table_4_6(result: Table46Result, ax=None):
     result : Table46Result
     ax : matplotlib.axes.Axes, optional
         Axes to draw on (a new figure when omitted).
+    path : str or Path, optional
+        Write the figure there (atomically).
 
     Returns
     -------
-    matplotlib.figure.Figure
+    The given axes, or the new figure.
 
     Examples
     --------
@@ -564,18 +566,15 @@ def plot_table_4_6(result: Table46Result, ax=None):
     >>> len(fig.axes[0].lines)
     8
     """
-    import matplotlib.pyplot as plt
+    from fdikit.plots import axes_or_new, finish_plot
 
-    if ax is None:
-        fig, ax = plt.subplots(figsize=(9, 4))
-    else:
-        fig = ax.figure
+    fig, (a,) = axes_or_new(ax, 1, figsize=(9, 4))
     for i in range(result.mu.shape[1]):
-        ax.plot(result.t, result.mu[:, i], lw=1.0, label=f"μ({i + 1})")
+        a.plot(result.t, result.mu[:, i], lw=1.0, label=f"μ({i + 1})")
     for name, start, end in _intervals(result.t):
         if not name.startswith("none"):
-            ax.axvspan(start, end, color="0.9", zorder=0)
-            ax.text(0.5 * (start + end), 1.02, name, ha="center", va="bottom", fontsize=7)
-    ax.set(xlabel="time [s]", ylabel="weight", ylim=(-0.02, 1.1), xlim=(result.t[0], result.t[-1]))
-    ax.legend(ncol=8, fontsize=7, loc="lower center", bbox_to_anchor=(0.5, 1.08))
-    return fig
+            a.axvspan(start, end, color="0.9", zorder=0)
+            a.text(0.5 * (start + end), 1.02, name, ha="center", va="bottom", fontsize=7)
+    a.set(xlabel="time [s]", ylabel="weight", ylim=(-0.02, 1.1), xlim=(result.t[0], result.t[-1]))
+    a.legend(ncol=8, fontsize=7, loc="lower center", bbox_to_anchor=(0.5, 1.08))
+    return finish_plot(fig, ax, path)
