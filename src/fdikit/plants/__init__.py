@@ -40,6 +40,8 @@ Examples
   al. 2006b).
 * :mod:`fdikit.plants.b747` — Boeing 747 linear longitudinal FDI example: Hallouzi 2008, §2.4.1, (2.54)–(2.61),
   Tables 2.5–2.6.
+* :mod:`fdikit.plants.b747_jsbsim` — B and C of the §2.4.1 B747 example from JSBSim's B747, in place of the lost
+  (2.57)–(2.61): Hallouzi 2008, §2.4.1.
 * :mod:`fdikit.plants.target_tracking` — The maneuvering-target tracking benchmark of Hallouzi 2008, §2.4.2,
   (2.65)–(2.68).
 """
@@ -82,6 +84,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
             "B747_FAULT_SCHEDULE", "B747_MODEL_NAMES", "B747_NOISE", "B747_STATES", "B747_TRANSITION",
             "b747_longitudinal", "b747_model_set",
         ],
+        "b747_jsbsim": ["B747JSBSimMatrices", "b747_jsbsim_matrices"],
         "target_tracking": [
             "PI_TRACKING", "Q_TRACKING", "R_TRACKING", "TRACKING_MODES", "TS", "X0_TRACKING", "tracking_A",
             "tracking_B",

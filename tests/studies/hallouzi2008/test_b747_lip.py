@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from fdikit.errors import ParameterError
-from fdikit.studies.hallouzi2008.b747_lip import _confirmed, fly_lip, lip_setup
+from fdikit.studies.hallouzi2008.b747_lip import _persistent, fly_lip, lip_setup
 from fdikit.studies.hallouzi2008.table_4_8 import (
     THESIS_TABLE_4_8,
     LipRow,
@@ -20,12 +20,13 @@ def setup():
     return lip_setup(calibration_seconds=60.0)
 
 
-def test_confirmation_needs_the_same_signature_for_the_whole_time():
-    raw = np.array(["none", "elevator", "elevator", "aileron", "aileron", "aileron", "none", "rudder"])
-    assert _confirmed(raw, 1).tolist() == raw.tolist()
-    assert _confirmed(raw, 2).tolist() == ["none", "none", "elevator", "elevator", "aileron", "aileron", "none",
-                                           "none"]
-    assert _confirmed(raw, 3).tolist() == ["none"] * 5 + ["aileron", "none", "none"]
+def test_persistence_declares_a_signature_held_k_of_n_samples():
+    raw = np.array(["none", "elevator", "elevator", "none", "elevator", "aileron", "aileron", "aileron", "none"])
+    assert _persistent(raw, 1, 1).tolist() == raw.tolist()
+    assert _persistent(raw, 2, 3).tolist() == ["none", "none", "elevator", "elevator", "elevator", "none",
+                                               "aileron", "aileron", "aileron"]
+    assert _persistent(raw, 3, 3).tolist() == ["none"] * 7 + ["aileron", "none"]
+    assert _persistent(np.array(["none"] * 4), 2, 3).tolist() == ["none"] * 4
 
 
 def test_sweep_sizes_are_the_thesis_run_counts():
