@@ -77,3 +77,22 @@ def test_bad_arguments(setup):
         fly_lip(setup, "elevator", 30.0)
     with pytest.raises(ParameterError, match="noise"):
         lip_setup(noise="datasheet")
+
+
+def test_reduced_table_4_8_is_within_sampling_tolerance_of_the_full_sweep(setup):
+    """Every 10 deg (15 runs, the full sweep's own seeds) against the recorded 243-run sweep.
+
+    A reduced sweep is a sample of the full one's lock positions: its share of correct runs is within
+    three binomial standard deviations of the full share (plus one run, for the rounding of a small n),
+    and its mean delay within three standard errors of the full mean (the full runs' delay spread).
+    """
+    from fdikit.studies.hallouzi2008.table_4_8 import FDIKIT_TABLE_4_8, table_4_8
+
+    summary = table_4_8(setup, step=10.0).summary()
+    for surface, full in FDIKIT_TABLE_4_8.items():
+        got, n = summary[surface], summary[surface]["runs"]
+        assert n == len(lock_positions(surface, 10.0))
+        p = full["correct"] / 100
+        assert abs(got["correct"] / 100 - p) <= 3 * np.sqrt(p * (1 - p) / n) + 1 / n, (surface, got)
+        n_correct = round(got["correct"] * n / 100)
+        assert abs(got["delay"] - full["delay"]) <= 3 * full["delay_std"] / np.sqrt(n_correct), (surface, got)

@@ -54,8 +54,10 @@ __getattr__, __dir__, __all__ = lazy.attach(
             "table_4_6_isolation",
         ],
         "b747_lip": ["NOISE_PRESETS", "T_FAULT", "LipRun", "LipSetup", "false_alarm_rate", "fly_lip", "lip_setup"],
-        "table_4_8": ["SWEEP_RANGES", "THESIS_TABLE_4_8", "LipRow", "Table48", "lock_positions", "table_4_8"],
-        "b747_report": ["plot_lip_run", "plot_sweep", "write_b747_report"],
+        "table_4_8": [
+            "FDIKIT_TABLE_4_8", "SWEEP_RANGES", "THESIS_TABLE_4_8", "LipRow", "Table48", "lock_positions", "table_4_8",
+        ],
+        "b747_report": ["THESIS_FIG_4_3", "plot_lip_run", "plot_sweep", "table_4_6_markdown", "write_b747_report"],
         "example_3_1": [
             "Example31Result", "PAIRS", "example_3_1", "example_3_1_models",
         ],

@@ -25,15 +25,14 @@ THESIS_FIG_4_3 = {"elevator": "μ(3) ≈ 0.7", "alpha_sensor": "μ(6) ≈ 0.5, �
 _COLOURS = {"correct": "tab:green", "incorrect": "tab:red", "missed": "tab:orange", "false alarm": "tab:purple"}
 
 
-def plot_lip_run(run, names, ax=None, path=None, t_fault: float = 20.0):
-    """One LIP flight: surface position, mode probabilities, altitude.
+def plot_lip_run(run, ax=None, path=None, t_fault: float = 20.0):
+    """One LIP flight: surface position, the Table 4.7 group weights (0.5-s mean; the IMM's probabilities
+    jump between models from one sample to the next at this signal-to-noise ratio), the declaration, altitude.
 
     Parameters
     ----------
     run : LipRun
-        From :func:`fdikit.studies.hallouzi2008.b747_lip.fly_lip`.
-    names : sequence of str
-        The mode names (the setup's model names).
+        From :func:`fdikit.studies.hallouzi2008.b747_lip.fly_lip` (model set II plus nominal).
     ax : sequence of 3 Axes, optional
         Where to draw (a new figure when omitted).
     path : str or Path, optional
@@ -50,9 +49,9 @@ def plot_lip_run(run, names, ax=None, path=None, t_fault: float = 20.0):
     >>> import numpy as np
     >>> from fdikit.studies.hallouzi2008.b747_lip import LipRun
     >>> t = np.arange(0, 4, 0.01)
-    >>> run = LipRun(t, np.full((t.size, 2), 0.5), np.full(t.size, "none"), "rudder", 5.0, (None, np.nan), 0,
+    >>> run = LipRun(t, np.full((t.size, 8), 0.125), np.full(t.size, "none"), "rudder", 5.0, (None, np.nan), 0,
     ...              np.zeros(t.size), np.full(t.size, 980.0))
-    >>> len(plot_lip_run(run, ["a", "b"]).axes)
+    >>> len(plot_lip_run(run).axes)
     3
     """
     from fdikit.plots import axes_or_new, finish_plot
@@ -63,9 +62,19 @@ def plot_lip_run(run, names, ax=None, path=None, t_fault: float = 20.0):
         a0.axhline(run.lock, color="tab:red", ls=":", label=f"lock {run.lock:+.1f} deg")
         a0.legend(loc="best", fontsize=8)
     a0.set_ylabel(f"{run.surface or 'surface'} [deg]")
-    for j, name in enumerate(names):
-        a1.plot(run.t, run.mu[:, j], label=name, lw=1.2 if name == "nominal" else 0.9)
-    a1.set_ylabel("mode probability")
+    from fdikit.multimodel.isolation import table_4_7_logic
+
+    logic = table_4_7_logic(0.2)
+    width = max(1, int(round(0.5 / max(run.t[1] - run.t[0], 1e-9)))) if run.t.size > 1 else 1
+    kernel = np.ones(width) / width
+    groups = {**{g: list(idx) for g, idx in logic.groups.items()}, "nominal": [logic.nominal]}
+    for g, idx in groups.items():
+        w = run.mu[:, idx].sum(axis=1) if run.mu.shape[1] > max(idx) else np.zeros(run.t.size)
+        a1.plot(run.t, np.convolve(w, kernel, mode="same"), label=g, lw=1.2)
+    on = run.declared != "none"
+    if on.any():
+        a1.fill_between(run.t, 0, 1, where=on, color="tab:red", alpha=0.1, label=f"declared ({run.declared[on][0]})")
+    a1.set_ylabel("group weight (0.5-s mean)")
     a1.set_ylim(-0.02, 1.02)
     a1.legend(loc="center left", fontsize=7, ncol=2)
     a2.plot(run.t, run.altitude, color="tab:blue")
@@ -82,7 +91,8 @@ def plot_lip_run(run, names, ax=None, path=None, t_fault: float = 20.0):
 
 
 def plot_sweep(table, ax=None, path=None):
-    """Outcome and isolation delay over the lock position, one panel per surface.
+    """Outcome and isolation delay over the lock position, one panel per surface (grey: the surface's
+    position when it locked, right axis; a miss at delay 0).
 
     Parameters
     ----------
@@ -99,8 +109,8 @@ def plot_sweep(table, ax=None, path=None):
     --------
     >>> from fdikit.studies.hallouzi2008.table_4_8 import LipRow, Table48
     >>> t = Table48((LipRow("rudder", 5.0, 1, "correct", "rudder", 2.0, "rudder", 0.0),), {})
-    >>> len(plot_sweep(t).axes)
-    1
+    >>> len(plot_sweep(t).axes)   # the panel and its twin (position at injection)
+    2
     """
     from fdikit.plots import axes_or_new, finish_plot
 
@@ -113,9 +123,11 @@ def plot_sweep(table, ax=None, path=None):
             if sel:
                 d = [r.delay if np.isfinite(r.delay) else 0.0 for r in sel]
                 a.scatter([r.lock for r in sel], d, c=colour, s=14, label=outcome)
-        a.plot([r.lock for r in rows], [r.start for r in rows], color="0.6", lw=0.8, label="position at injection")
         a.set_ylabel(f"{s}: delay [s]")
-        a.legend(loc="upper right", fontsize=7)
+        a.legend(loc="upper left", fontsize=7)
+        twin = a.twinx()
+        twin.plot([r.lock for r in rows], [r.start for r in rows], color="0.6", lw=0.8)
+        twin.set_ylabel("position at injection [deg]", color="0.5", fontsize=8)
     panels[-1].set_xlabel("lock position [deg]")
     return finish_plot(fig, ax, path)
 
@@ -188,7 +200,6 @@ def write_b747_report(out, table, setup, examples=(), false_alarms=None, linear=
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    names = [m.name for m in setup.models]
     files = {}
     md = table.markdown()
     fa_line = ""
@@ -213,7 +224,7 @@ def write_b747_report(out, table, setup, examples=(), false_alarms=None, linear=
         files["table_4_6_plot"] = out / "table_4_6.png"
     for run in examples:
         p = out / f"run_{run.surface}_{run.lock:+.1f}.png"
-        plot_lip_run(run, names, path=p)
+        plot_lip_run(run, path=p)
         files[f"run_{run.surface}"] = p
     rows_html = "".join(
         "<tr>" + "".join(f"<td>{html.escape(c.strip())}</td>" for c in line.strip("|").split("|")) + "</tr>"

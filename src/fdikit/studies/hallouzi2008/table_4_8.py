@@ -25,7 +25,7 @@ import numpy as np
 
 from fdikit import validate
 
-__all__ = ["SWEEP_RANGES", "THESIS_TABLE_4_8", "LipRow", "Table48", "lock_positions", "table_4_8"]
+__all__ = ["FDIKIT_TABLE_4_8", "SWEEP_RANGES", "THESIS_TABLE_4_8", "LipRow", "Table48", "lock_positions", "table_4_8"]
 
 #: Lock-position ranges [deg] of the §4.4.2 sweep.
 SWEEP_RANGES = {"elevator": (-23.0, 17.0), "aileron": (-15.0, 15.0), "rudder": (-25.0, 25.0)}
@@ -34,6 +34,17 @@ THESIS_TABLE_4_8 = {
     "elevator": {"correct": 91.4, "incorrect": 8.6, "missed": 0.0, "false alarm": 0.0, "delay": 1.9, "runs": 81},
     "aileron": {"correct": 93.4, "incorrect": 6.6, "missed": 0.0, "false alarm": 0.0, "delay": 4.5, "runs": 61},
     "rudder": {"correct": 75.2, "incorrect": 3.0, "missed": 21.8, "false alarm": 0.0, "delay": 3.8, "runs": 101},
+}
+#: fdikit's full sweep (``fdikit b747``, seed 0, step 0.5 deg, the default setup: ``thesis_cov`` noise,
+#: light turbulence, Q identified and ×4, 75 % of 2 s persistence), measured 2026-12-02: the same keys,
+#: plus the standard deviation of the correct runs' delays [s]. 0 false alarms in 1 h of fault-free flight.
+FDIKIT_TABLE_4_8 = {
+    "elevator": {"correct": 98.8, "incorrect": 0.0, "missed": 1.2, "false alarm": 0.0, "delay": 2.55, "runs": 81,
+                 "delay_std": 2.31},
+    "aileron": {"correct": 98.4, "incorrect": 0.0, "missed": 1.6, "false alarm": 0.0, "delay": 4.10, "runs": 61,
+                "delay_std": 4.18},
+    "rudder": {"correct": 59.4, "incorrect": 0.0, "missed": 40.6, "false alarm": 0.0, "delay": 2.43, "runs": 101,
+               "delay_std": 1.96},
 }
 OUTCOMES = ("correct", "incorrect", "missed", "false alarm")
 
