@@ -109,6 +109,16 @@ def lqr_autopilot(linearization, state_max: Mapping | None = None, input_max: Ma
     ------
     ParameterError
         For an input the linear model does not have.
+
+    Examples
+    --------
+    >>> from fdikit.aircraft import JSBSimAircraft, trim_aircraft, linearize_aircraft, HALLOUZI_POINT
+    >>> ac = JSBSimAircraft("B747")
+    >>> lin = linearize_aircraft(ac, trim_aircraft(ac, HALLOUZI_POINT))
+    >>> ap = lqr_autopilot(lin)
+    >>> closed = lin.model.A - lin.model.B[:, [0, 1, 3, 4]] @ ap.K
+    >>> bool(np.linalg.eigvals(closed).real.max() < 0)   # the loop is stable
+    True
     """
     from scipy.linalg import solve_continuous_are
 

@@ -76,6 +76,10 @@ class B747JSBSimMatrices:
     >>> lin = b747_jsbsim_matrices()
     >>> lin.B.shape, lin.C.shape, lin.trim.converged
     ((5, 6), (4, 5), True)
+
+    References
+    ----------
+    Hallouzi 2008, §2.4.1, (2.54)–(2.61).
     """
 
     A_jsbsim: np.ndarray

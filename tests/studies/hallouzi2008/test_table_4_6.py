@@ -14,6 +14,7 @@ import pytest
 
 from fdikit.errors import ParameterError
 from fdikit.metrics import vaf
+from fdikit.studies.hallouzi2008.b747_report import plot_table_4_6
 from fdikit.studies.hallouzi2008.table_4_6 import (
     NOMINAL,
     Q_S_THESIS,
@@ -23,7 +24,6 @@ from fdikit.studies.hallouzi2008.table_4_6 import (
     equivalent_lip_weight,
     model_set_i_logic,
     noise_covariances,
-    plot_table_4_6,
     run_table_4_6,
     simulate_table_4_6,
     table_4_6_isolation,
@@ -217,7 +217,7 @@ def test_plot(result):
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots()
-    assert plot_table_4_6(result, ax=ax) is fig
+    assert plot_table_4_6(result, ax=ax) is ax  # the plot convention: the caller's axes back
     assert len(ax.lines) == 8
     plt.close(fig)
 

@@ -50,14 +50,16 @@ __getattr__, __dir__, __all__ = lazy.attach(
         ],
         "table_4_6": [
             "Table46Result", "Table46Scenario", "b747_lqr_gain", "build_table_4_6", "equivalent_lip_weight",
-            "model_set_i_logic", "noise_covariances", "plot_table_4_6", "run_table_4_6", "simulate_table_4_6",
+            "model_set_i_logic", "noise_covariances", "run_table_4_6", "scenario_intervals", "simulate_table_4_6",
             "table_4_6_isolation",
         ],
         "b747_lip": ["NOISE_PRESETS", "T_FAULT", "LipRun", "LipSetup", "false_alarm_rate", "fly_lip", "lip_setup"],
         "table_4_8": [
             "FDIKIT_TABLE_4_8", "SWEEP_RANGES", "THESIS_TABLE_4_8", "LipRow", "Table48", "lock_positions", "table_4_8",
         ],
-        "b747_report": ["THESIS_FIG_4_3", "plot_lip_run", "plot_sweep", "table_4_6_markdown", "write_b747_report"],
+        "b747_report": [
+            "THESIS_FIG_4_3", "plot_lip_run", "plot_sweep", "plot_table_4_6", "table_4_6_markdown", "write_b747_report",
+        ],
         "example_3_1": [
             "Example31Result", "PAIRS", "example_3_1", "example_3_1_models",
         ],

@@ -93,6 +93,10 @@ class LocalModel:
     >>> m = local_model(ac, "alpha_sensor", 0.5, nominal=nominal)
     >>> m.C[4, 4], m.name
     (np.float64(0.5), 'alpha_sensor_0.5')
+
+    References
+    ----------
+    Hallouzi 2008, §4.2, §4.3.1–§4.3.4, Tables 4.2–4.5, (4.1)–(4.2).
     """
 
     name: str
@@ -152,6 +156,10 @@ def b747_at_point(dt: float = 0.01):
     >>> ac, nominal = b747_at_point()
     >>> nominal.linearization.trim.converged
     True
+
+    References
+    ----------
+    Hallouzi 2008, §4.2, §4.3.1–§4.3.4, Tables 4.2–4.5, (4.1)–(4.2).
     """
     from fdikit.aircraft import HALLOUZI_POINT, JSBSimAircraft, trim_aircraft
 
@@ -199,6 +207,17 @@ def local_model(aircraft, fault: str, size: float | None = None, *, nominal: Loc
     ------
     ParameterError
         For an unknown fault, a missing size or nominal model, or a lock position outside the range.
+
+    Examples
+    --------
+    >>> ac, nominal = b747_at_point()
+    >>> m = local_model(ac, "rudder", 10.0)
+    >>> m.name, bool(m.linearization.trim.converged)
+    ('rudder_lip_+10', True)
+
+    References
+    ----------
+    Hallouzi 2008, §4.2, §4.3.1–§4.3.4, Tables 4.2–4.5, (4.1)–(4.2).
     """
     from fdikit.aircraft import HALLOUZI_POINT, FlightCondition, trim_aircraft
 
@@ -264,6 +283,16 @@ def large_model_set(aircraft, nominal: LocalModel, which: str = "II", step: floa
     ------
     ParameterError
         For ``which`` other than "I" or "II".
+
+    Examples
+    --------
+    >>> ac, nominal = b747_at_point()
+    >>> len(large_model_set(ac, nominal, "II", step=10.0))   # rudder 6, elevator 5, aileron 4
+    15
+
+    References
+    ----------
+    Hallouzi 2008, §4.2, §4.3.1–§4.3.4, Tables 4.2–4.5, (4.1)–(4.2).
     """
     if which not in ("I", "II"):
         raise ParameterError(f"which must be 'I' (Table 4.2) or 'II' (Table 4.4), got {which!r}.")
@@ -302,6 +331,16 @@ def model_set(aircraft, nominal: LocalModel, which: str = "II") -> list[LocalMod
     ------
     ParameterError
         For ``which`` other than "I" or "II".
+
+    Examples
+    --------
+    >>> ac, nominal = b747_at_point()
+    >>> [m.name for m in model_set(ac, nominal, "II")][:3]
+    ['rudder_lip_+25', 'rudder_lip_-25', 'elevator_lip_-23']
+
+    References
+    ----------
+    Hallouzi 2008, §4.2, §4.3.1–§4.3.4, Tables 4.2–4.5, (4.1)–(4.2).
     """
     if which not in ("I", "II"):
         raise ParameterError(f"which must be 'I' (Table 4.3) or 'II' (Table 4.5), got {which!r}.")

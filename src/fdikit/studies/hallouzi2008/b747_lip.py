@@ -95,6 +95,10 @@ class LipSetup:
     Examples
     --------
     >>> setup = lip_setup(calibration_seconds=20.0)  # doctest: +SKIP
+
+    References
+    ----------
+    Hallouzi 2008, §4.4.2, Tables 4.5 and 4.7.
     """
 
     aircraft: object
@@ -145,6 +149,10 @@ class LipRun:
     >>> run = fly_lip(lip_setup(calibration_seconds=20.0), "rudder", -15.0, duration=25.0)  # doctest: +SKIP
     >>> run.outcome  # doctest: +SKIP
     'correct'
+
+    References
+    ----------
+    Hallouzi 2008, §4.4.2, Tables 4.5 and 4.7.
     """
 
     t: np.ndarray
@@ -293,6 +301,16 @@ def lip_setup(*, noise: str = "thesis_cov", turbulence: int = 3, q_inflation: fl
     ------
     ParameterError
         For an unknown noise preset or a non-positive number.
+
+    Examples
+    --------
+    >>> setup = lip_setup(calibration_seconds=30.0)  # doctest: +SKIP
+    >>> [m.name for m in setup.models][-1]  # doctest: +SKIP
+    'nominal'
+
+    References
+    ----------
+    Hallouzi 2008, §4.4.2, Tables 4.5 and 4.7.
     """
     from fdikit.aircraft import lqr_autopilot
     from fdikit.aircraft.plant import STATES
@@ -369,6 +387,16 @@ def fly_lip(setup: LipSetup, surface: str | None = None, lock: float | None = No
     ------
     ParameterError
         For an unknown surface or a lock position outside the limits.
+
+    Examples
+    --------
+    >>> run = fly_lip(lip_setup(calibration_seconds=30.0), "elevator", -18.0, duration=25.0)  # doctest: +SKIP
+    >>> run.outcome  # doctest: +SKIP
+    'correct'
+
+    References
+    ----------
+    Hallouzi 2008, §4.4.2, Tables 4.5 and 4.7.
     """
     from fdikit.actuator_faults import LockInPlace
     from fdikit.aircraft import B747_LIMITS
@@ -423,6 +451,15 @@ def false_alarm_rate(setup: LipSetup, hours: float = 1.0, *, seed: int = 1, flig
         Declarations (rising edges) on the fault-free flights.
     hours : float
         The fault-free time flown.
+
+    Examples
+    --------
+    >>> false_alarm_rate(lip_setup(calibration_seconds=30.0), hours=0.05, flight=180.0)  # doctest: +SKIP
+    (0, 0.05)
+
+    References
+    ----------
+    Hallouzi 2008, §4.4.2, Tables 4.5 and 4.7.
     """
     hours = validate.positive("hours", hours)
     n = max(1, int(np.ceil(hours * 3600.0 / flight)))

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["THESIS_FIG_4_3", "plot_lip_run", "plot_sweep", "table_4_6_markdown", "write_b747_report"]
+__all__ = ["THESIS_FIG_4_3", "plot_lip_run", "plot_sweep", "plot_table_4_6", "table_4_6_markdown", "write_b747_report"]
 
 #: Hallouzi 2008, Fig. 4.3 as read in the text (§4.4.1): the weight each fault interval should show.
 THESIS_FIG_4_3 = {"elevator": "μ(3) ≈ 0.7", "alpha_sensor": "μ(6) ≈ 0.5, μ(8) ≈ 0.5", "rudder": "μ(2) ≈ 0.55",
@@ -53,6 +53,10 @@ def plot_lip_run(run, ax=None, path=None, t_fault: float = 20.0):
     ...              np.zeros(t.size), np.full(t.size, 980.0))
     >>> len(plot_lip_run(run).axes)
     3
+
+    References
+    ----------
+    Hallouzi 2008, §4.4.1–§4.4.2, Tables 4.6 and 4.8.
     """
     from fdikit.plots import axes_or_new, finish_plot
 
@@ -111,6 +115,10 @@ def plot_sweep(table, ax=None, path=None):
     >>> t = Table48((LipRow("rudder", 5.0, 1, "correct", "rudder", 2.0, "rudder", 0.0),), {})
     >>> len(plot_sweep(t).axes)   # the panel and its twin (position at injection)
     2
+
+    References
+    ----------
+    Hallouzi 2008, §4.4.1–§4.4.2, Tables 4.6 and 4.8.
     """
     from fdikit.plots import axes_or_new, finish_plot
 
@@ -153,6 +161,10 @@ def table_4_6_markdown(result) -> str:
     >>> mu = np.tile(np.eye(8)[7], (300, 1))
     >>> "none_1" in table_4_6_markdown(Table46Result(t, np.array(["none"] * 300), mu, mu, None, None, None, {}))
     True
+
+    References
+    ----------
+    Hallouzi 2008, §4.4.1–§4.4.2, Tables 4.6 and 4.8.
     """
     from fdikit.studies.hallouzi2008.table_4_6 import table_4_6_isolation
 
@@ -175,6 +187,49 @@ def table_4_6_markdown(result) -> str:
     return "\n".join(lines) + f"\n\nState VAF: {vaf}\n"
 
 
+def plot_table_4_6(result, ax=None, path=None):
+    """Estimated weights μ(1) … μ(8) against time, with the fault intervals shaded (Hallouzi 2008, Fig. 4.3).
+
+    Parameters
+    ----------
+    result : Table46Result
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw on (a new figure when omitted).
+    path : str or Path, optional
+        Write the figure there (atomically).
+
+    Returns
+    -------
+    The given axes, or the new figure.
+
+    Examples
+    --------
+    >>> from fdikit.studies.hallouzi2008.table_4_6 import Table46Result
+    >>> t = np.arange(200) * 0.01
+    >>> mu = np.tile(np.eye(8)[7], (200, 1))
+    >>> fig = plot_table_4_6(Table46Result(t, np.array(["none"] * 200), mu, mu, None, None, None, {}))
+    >>> len(fig.axes[0].lines)
+    8
+
+    References
+    ----------
+    Hallouzi 2008, §4.4.1, Table 4.6, Fig. 4.3.
+    """
+    from fdikit.plots import axes_or_new, finish_plot
+    from fdikit.studies.hallouzi2008.table_4_6 import scenario_intervals
+
+    fig, (a,) = axes_or_new(ax, 1, figsize=(9, 4))
+    for i in range(result.mu.shape[1]):
+        a.plot(result.t, result.mu[:, i], lw=1.0, label=f"μ({i + 1})")
+    for name, start, end in scenario_intervals(result.t):
+        if not name.startswith("none"):
+            a.axvspan(start, end, color="0.9", zorder=0)
+            a.text(0.5 * (start + end), 1.02, name, ha="center", va="bottom", fontsize=7)
+    a.set(xlabel="time [s]", ylabel="weight", ylim=(-0.02, 1.1), xlim=(result.t[0], result.t[-1]))
+    a.legend(ncol=8, fontsize=7, loc="lower center", bbox_to_anchor=(0.5, 1.08))
+    return finish_plot(fig, ax, path)
+
+
 def write_b747_report(out, table, setup, examples=(), false_alarms=None, linear=None) -> dict:
     """Write ``table.md``, ``rows.csv``, ``sweep.png``, one ``run_<surface>.png`` per example and ``report.html``.
 
@@ -195,6 +250,14 @@ def write_b747_report(out, table, setup, examples=(), false_alarms=None, linear=
     -------
     dict
         File role → path.
+
+    Examples
+    --------
+    >>> write_b747_report("out/b747", table, setup, examples, (0, 1.0), linear)  # doctest: +SKIP
+
+    References
+    ----------
+    Hallouzi 2008, §4.4.1–§4.4.2, Tables 4.6 and 4.8.
     """
     from fdikit.atomic import write_text
 
@@ -216,8 +279,6 @@ def write_b747_report(out, table, setup, examples=(), false_alarms=None, linear=
     plot_sweep(table, path=out / "sweep.png")
     files["sweep"] = out / "sweep.png"
     if linear is not None:
-        from fdikit.studies.hallouzi2008.table_4_6 import plot_table_4_6
-
         files["table_4_6"] = write_text(out / "table_4_6.md", "# Table 4.6 / Fig. 4.3: the linear run with model "
                                         "set I (augmented EKF)\n\n" + table_4_6_markdown(linear))
         plot_table_4_6(linear, path=out / "table_4_6.png")

@@ -68,23 +68,9 @@ from fdikit import validate
 from fdikit.errors import ParameterError
 
 __all__ = [
-    "T_S",
-    "NOMINAL",
-    "DURATION",
-    "SCENARIO",
-    "Q_S_THESIS",
-    "R_S_THESIS",
-    "Table46Scenario",
-    "Table46Result",
-    "noise_covariances",
-    "b747_lqr_gain",
-    "build_table_4_6",
-    "simulate_table_4_6",
-    "run_table_4_6",
-    "equivalent_lip_weight",
-    "model_set_i_logic",
-    "table_4_6_isolation",
-    "plot_table_4_6",
+    "T_S", "NOMINAL", "DURATION", "SCENARIO", "Q_S_THESIS", "R_S_THESIS", "Table46Scenario", "Table46Result",
+    "noise_covariances", "b747_lqr_gain", "build_table_4_6", "simulate_table_4_6", "run_table_4_6",
+    "equivalent_lip_weight", "model_set_i_logic", "table_4_6_isolation", "scenario_intervals",
 ]
 
 #: Sample time [s] (100 Hz, §4.4.1).
@@ -202,6 +188,16 @@ class Table46Scenario:
         :func:`noise_covariances`.
     dt : float
         Sample time [s].
+
+    Examples
+    --------
+    >>> scenario = build_table_4_6()  # doctest: +SKIP
+    >>> len(scenario.models)  # doctest: +SKIP
+    8
+
+    References
+    ----------
+    Hallouzi 2008, §4.4.1, Table 4.6, Fig. 4.3.
     """
 
     models: tuple
@@ -235,6 +231,16 @@ class Table46Result:
         (K, 5) inputs applied (commands after saturation).
     vaf : dict of str to float
         State name → VAF (3.53) of ``x_hat`` against ``x`` over the run [%].
+
+    Examples
+    --------
+    >>> res = run_table_4_6(seed=1, duration=2.0)  # doctest: +SKIP
+    >>> res.mu.shape  # doctest: +SKIP
+    (200, 8)
+
+    References
+    ----------
+    Hallouzi 2008, §4.4.1, Table 4.6, Fig. 4.3.
     """
 
     t: np.ndarray
@@ -270,6 +276,10 @@ def build_table_4_6(aircraft=None, nominal=None) -> Table46Scenario:
     >>> sc = build_table_4_6()
     >>> [m.name for m in sc.models][:3], sorted(sc.truths)[:3]
     (['rudder_lip_+25', 'rudder_lip_-25', 'elevator_lip_+17'], ['alpha_sensor', 'elevator', 'engine'])
+
+    References
+    ----------
+    Hallouzi 2008, §4.4.1, Table 4.6, Fig. 4.3.
     """
     from fdikit.studies.hallouzi2008.aircraft_models import b747_at_point, local_model, model_set
 
@@ -335,6 +345,10 @@ def simulate_table_4_6(scenario: Table46Scenario, seed=None, duration: float = D
     >>> sim = simulate_table_4_6(build_table_4_6(), seed=1, duration=1.0)
     >>> sim["x"].shape, sim["y"].shape
     ((100, 10), (100, 8))
+
+    References
+    ----------
+    Hallouzi 2008, §4.4.1, Table 4.6, Fig. 4.3.
     """
     from fdikit.aircraft.actuators import B747_LIMITS
 
@@ -394,6 +408,10 @@ def run_table_4_6(scenario: Table46Scenario | None = None, seed=0, duration: flo
     >>> res = run_table_4_6(seed=1, duration=2.0)
     >>> res.mu.shape, bool(res.mu[-1, 7] > 0.8)
     ((200, 8), True)
+
+    References
+    ----------
+    Hallouzi 2008, §4.4.1, Table 4.6, Fig. 4.3.
     """
     from fdikit.aircraft.plant import STATES
     from fdikit.metrics import vaf
@@ -418,8 +436,27 @@ def run_table_4_6(scenario: Table46Scenario | None = None, seed=0, duration: flo
                          dict(zip(STATES, map(float, vaf(sim["x"], res.x)))))
 
 
-def _intervals(t: np.ndarray) -> list[tuple[str, float, float]]:
-    """The fault intervals of :data:`SCENARIO` and the fault-free ones between them (``"none_1"``, …)."""
+def scenario_intervals(t) -> list[tuple[str, float, float]]:
+    """The fault intervals of :data:`SCENARIO` and the fault-free ones between them (``"none_1"``, …).
+
+    Parameters
+    ----------
+    t : ndarray
+        Sample times of a run [s].
+
+    Returns
+    -------
+    list of (name, start, end)
+
+    Examples
+    --------
+    >>> [name for name, _, _ in scenario_intervals(np.arange(0.0, 45.0, 0.01))]
+    ['none_1', 'elevator', 'none_2', 'alpha_sensor', 'none_3']
+
+    References
+    ----------
+    Hallouzi 2008, §4.4.1, Table 4.6.
+    """
     out, last, i = [], 0.0, 1
     end_t = float(t[-1]) + (t[1] - t[0] if t.size > 1 else T_S)
     for label, _, start, end in SCENARIO:
@@ -462,6 +499,10 @@ def equivalent_lip_weight(result: Table46Result, label: str) -> float:
     ...                   np.zeros((2, 5)), {})
     >>> round(equivalent_lip_weight(r, "elevator"), 3)
     0.588
+
+    References
+    ----------
+    Hallouzi 2008, §4.4.1, Table 4.6, Fig. 4.3.
     """
     validate.choice("label", label, ("elevator", "rudder"))
     lock, model, col = (10.0, 17.0, 1) if label == "elevator" else (-15.0, -25.0, 3)
@@ -529,11 +570,15 @@ def table_4_6_isolation(result: Table46Result, threshold: float = 0.2, settle: f
     >>> r = Table46Result(t, np.array(["none"] * 300), mu, mu, None, None, None, {})
     >>> table_4_6_isolation(r)
     {'none_1': ('none', 1.0)}
+
+    References
+    ----------
+    Hallouzi 2008, §4.4.1, Table 4.6, Fig. 4.3.
     """
     settle = validate.non_negative("settle", settle)
     decided = model_set_i_logic(threshold).isolate(result.mu)
     out = {}
-    for name, start, end in _intervals(result.t):
+    for name, start, end in scenario_intervals(result.t):
         rows = (result.t >= start + settle - 1e-9) & (result.t < end - 1e-9)
         if not rows.any():
             continue
@@ -541,40 +586,3 @@ def table_4_6_isolation(result: Table46Result, threshold: float = 0.2, settle: f
         best = int(np.argmax(counts))
         out[name] = (str(names[best]), float(counts[best] / rows.sum()))
     return out
-
-
-def plot_table_4_6(result: Table46Result, ax=None, path=None):
-    """Estimated weights μ(1) … μ(8) against time, with the fault intervals shaded (Hallouzi 2008, Fig. 4.3).
-
-    Parameters
-    ----------
-    result : Table46Result
-    ax : matplotlib.axes.Axes, optional
-        Axes to draw on (a new figure when omitted).
-    path : str or Path, optional
-        Write the figure there (atomically).
-
-    Returns
-    -------
-    The given axes, or the new figure.
-
-    Examples
-    --------
-    >>> t = np.arange(200) * 0.01
-    >>> mu = np.tile(np.eye(8)[7], (200, 1))
-    >>> fig = plot_table_4_6(Table46Result(t, np.array(["none"] * 200), mu, mu, None, None, None, {}))
-    >>> len(fig.axes[0].lines)
-    8
-    """
-    from fdikit.plots import axes_or_new, finish_plot
-
-    fig, (a,) = axes_or_new(ax, 1, figsize=(9, 4))
-    for i in range(result.mu.shape[1]):
-        a.plot(result.t, result.mu[:, i], lw=1.0, label=f"μ({i + 1})")
-    for name, start, end in _intervals(result.t):
-        if not name.startswith("none"):
-            a.axvspan(start, end, color="0.9", zorder=0)
-            a.text(0.5 * (start + end), 1.02, name, ha="center", va="bottom", fontsize=7)
-    a.set(xlabel="time [s]", ylabel="weight", ylim=(-0.02, 1.1), xlim=(result.t[0], result.t[-1]))
-    a.legend(ncol=8, fontsize=7, loc="lower center", bbox_to_anchor=(0.5, 1.08))
-    return finish_plot(fig, ax, path)

@@ -74,6 +74,10 @@ class LipRow:
     --------
     >>> LipRow("rudder", 5.0, 1, "missed", None, float("nan"), "none", 4.2).outcome
     'missed'
+
+    References
+    ----------
+    Hallouzi 2008, §4.4.2, Table 4.8.
     """
 
     surface: str
@@ -101,6 +105,10 @@ class Table48:
     >>> t = Table48((LipRow("rudder", 5.0, 1, "correct", "rudder", 2.0, "rudder", 0.0),), {})
     >>> t.summary()["rudder"]["correct"], t.summary()["rudder"]["delay"]
     (100.0, 2.0)
+
+    References
+    ----------
+    Hallouzi 2008, §4.4.2, Table 4.8.
     """
 
     rows: tuple
@@ -165,6 +173,10 @@ def lock_positions(surface: str, step: float = 0.5) -> np.ndarray:
     --------
     >>> [len(lock_positions(s)) for s in ("elevator", "aileron", "rudder")]
     [81, 61, 101]
+
+    References
+    ----------
+    Hallouzi 2008, §4.4.2, Table 4.8.
     """
     validate.choice("surface", surface, list(SWEEP_RANGES))
     step = validate.positive("step", step)
@@ -205,6 +217,16 @@ def table_4_8(setup, *, step: float = 0.5, surfaces=("elevator", "aileron", "rud
     ------
     ParameterError
         For an unknown surface or a non-positive step or duration.
+
+    Examples
+    --------
+    >>> table = table_4_8(lip_setup(), step=10.0)  # doctest: +SKIP
+    >>> table.summary()["elevator"]["runs"]  # doctest: +SKIP
+    5
+
+    References
+    ----------
+    Hallouzi 2008, §4.4.2, Table 4.8.
     """
     from fdikit.studies.hallouzi2008.b747_lip import fly_lip
 
