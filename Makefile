@@ -35,6 +35,7 @@ docs: $(VENV)/.installed-docs
 bench: $(VENV)/.installed-dev
 	$(BIN)/python benchmarks/bench_simulate.py
 	$(BIN)/python benchmarks/bench_vehicle.py
+	$(BIN)/python benchmarks/bench_aircraft.py
 
 clean:
 	rm -rf $(VENV) out site .pytest_cache

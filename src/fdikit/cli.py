@@ -381,10 +381,12 @@ def b747(
     linear §4.4.1 run with model set I (Table 4.6, Fig. 4.3).  Each run is kept in OUT as soon as it is
     done; rerunning resumes.
     """
+    import base64
+
     from fdikit import validate
     from fdikit.resume import RunStore, check_seed
     from fdikit.studies.hallouzi2008.b747_lip import NOISE_PRESETS, false_alarm_rate, fly_lip, lip_setup
-    from fdikit.studies.hallouzi2008.b747_report import write_b747_report
+    from fdikit.studies.hallouzi2008.b747_report import table_4_6_files, write_b747_report
     from fdikit.studies.hallouzi2008.table_4_6 import run_table_4_6
     from fdikit.studies.hallouzi2008.table_4_8 import SWEEP_RANGES, table_4_8
 
@@ -415,9 +417,13 @@ def b747(
             rows = [r for r in table.rows if r.surface == s]
             pick = min(rows, key=lambda r: abs(r.lock - (SWEEP_RANGES[s][1] * 0.5)))
             examples.append(fly_lip(setup, s, pick.lock, seed=pick.seed))
-        with console.status("Table 4.6: the linear run with model set I ..."):
-            linear = run_table_4_6(seed=seed)
-        write_b747_report(out, table, setup, examples, fa, linear)
+        linear = store.load("table-4-6")
+        if linear is None:
+            with console.status("Table 4.6: the linear run with model set I ..."):
+                md, png = table_4_6_files(run_table_4_6(seed=seed))
+            linear = {"markdown": md, "png": base64.b64encode(png).decode("ascii")}
+            store.save("table-4-6", linear)
+        write_b747_report(out, table, setup, examples, fa, (linear["markdown"], base64.b64decode(linear["png"])))
     except (FdiError, OSError) as exc:
         _fail(exc)
     summary = Table(title="Hallouzi 2008 Table 4.8 on the JSBSim B747 (fdikit / thesis)")

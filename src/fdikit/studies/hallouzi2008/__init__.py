@@ -58,7 +58,8 @@ __getattr__, __dir__, __all__ = lazy.attach(
             "FDIKIT_TABLE_4_8", "SWEEP_RANGES", "THESIS_TABLE_4_8", "LipRow", "Table48", "lock_positions", "table_4_8",
         ],
         "b747_report": [
-            "THESIS_FIG_4_3", "plot_lip_run", "plot_sweep", "plot_table_4_6", "table_4_6_markdown", "write_b747_report",
+            "THESIS_FIG_4_3", "plot_lip_run", "plot_sweep", "plot_table_4_6", "table_4_6_files", "table_4_6_markdown",
+            "write_b747_report",
         ],
         "example_3_1": [
             "Example31Result", "PAIRS", "example_3_1", "example_3_1_models",

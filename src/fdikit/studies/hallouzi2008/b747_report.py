@@ -16,7 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["THESIS_FIG_4_3", "plot_lip_run", "plot_sweep", "plot_table_4_6", "table_4_6_markdown", "write_b747_report"]
+__all__ = ["THESIS_FIG_4_3", "plot_lip_run", "plot_sweep", "plot_table_4_6", "table_4_6_files",
+           "table_4_6_markdown", "write_b747_report"]
 
 #: Hallouzi 2008, Fig. 4.3 as read in the text (§4.4.1): the weight each fault interval should show.
 THESIS_FIG_4_3 = {"elevator": "μ(3) ≈ 0.7", "alpha_sensor": "μ(6) ≈ 0.5, μ(8) ≈ 0.5", "rudder": "μ(2) ≈ 0.55",
@@ -230,6 +231,42 @@ def plot_table_4_6(result, ax=None, path=None):
     return finish_plot(fig, ax, path)
 
 
+def table_4_6_files(result) -> tuple[str, bytes]:
+    """The markdown (:func:`table_4_6_markdown`) and the PNG (:func:`plot_table_4_6`) of a linear run.
+
+    Parameters
+    ----------
+    result : Table46Result
+
+    Returns
+    -------
+    markdown : str
+    png : bytes
+
+    Examples
+    --------
+    >>> from fdikit.studies.hallouzi2008.table_4_6 import Table46Result
+    >>> t = np.arange(300) * 0.01
+    >>> mu = np.tile(np.eye(8)[7], (300, 1))
+    >>> md, png = table_4_6_files(Table46Result(t, np.array(["none"] * 300), mu, mu, None, None, None, {}))
+    >>> png[:4]
+    b'\\x89PNG'
+
+    References
+    ----------
+    Hallouzi 2008, §4.4.1, Table 4.6, Fig. 4.3.
+    """
+    import matplotlib.pyplot as plt
+
+    from fdikit.plots import figure_bytes
+
+    fig = plot_table_4_6(result)
+    try:
+        return table_4_6_markdown(result), figure_bytes(fig)
+    finally:
+        plt.close(fig)
+
+
 def write_b747_report(out, table, setup, examples=(), false_alarms=None, linear=None) -> dict:
     """Write ``table.md``, ``rows.csv``, ``sweep.png``, one ``run_<surface>.png`` per example and ``report.html``.
 
@@ -243,8 +280,9 @@ def write_b747_report(out, table, setup, examples=(), false_alarms=None, linear=
         Runs to plot.
     false_alarms : tuple, optional
         ``(count, hours)`` of the fault-free flights (:func:`fdikit.studies.hallouzi2008.b747_lip.false_alarm_rate`).
-    linear : Table46Result, optional
-        The §4.4.1 linear run with model set I: ``table_4_6.md`` and ``table_4_6.png``.
+    linear : tuple, optional
+        ``(markdown, png_bytes)`` of the §4.4.1 linear run with model set I (:func:`table_4_6_files`):
+        ``table_4_6.md`` and ``table_4_6.png``.
 
     Returns
     -------
@@ -279,10 +317,12 @@ def write_b747_report(out, table, setup, examples=(), false_alarms=None, linear=
     plot_sweep(table, path=out / "sweep.png")
     files["sweep"] = out / "sweep.png"
     if linear is not None:
+        from fdikit.atomic import write_bytes
+
+        linear_md, png = linear
         files["table_4_6"] = write_text(out / "table_4_6.md", "# Table 4.6 / Fig. 4.3: the linear run with model "
-                                        "set I (augmented EKF)\n\n" + table_4_6_markdown(linear))
-        plot_table_4_6(linear, path=out / "table_4_6.png")
-        files["table_4_6_plot"] = out / "table_4_6.png"
+                                        "set I (augmented EKF)\n\n" + linear_md)
+        files["table_4_6_plot"] = write_bytes(out / "table_4_6.png", png)
     for run in examples:
         p = out / f"run_{run.surface}_{run.lock:+.1f}.png"
         plot_lip_run(run, path=p)
@@ -302,6 +342,6 @@ def write_b747_report(out, table, setup, examples=(), false_alarms=None, linear=
             "<p>Rows: <a href='rows.csv'>rows.csv</a>; table: <a href='table.md'>table.md</a>.</p></body></html>")
     if linear is not None:
         page = page.replace("<figure>", "<h2>Table 4.6 (linear, model set I)</h2><pre>"
-                            + html.escape(table_4_6_markdown(linear)) + "</pre><figure>", 1)
+                            + html.escape(linear[0]) + "</pre><figure>", 1)
     files["html"] = write_text(out / "report.html", page)
     return files
