@@ -250,3 +250,14 @@ def test_bad_input_is_refused():
         ac.set_mass(1000.0)
     with pytest.raises(ParameterError, match="no signal named .canard"):
         ac.inject([LockInPlace("canard", position=0.0)])
+
+
+def test_limits_given_for_some_surfaces_keep_the_others():
+    from fdikit.aircraft import SurfaceLimits
+
+    narrow = SurfaceLimits(*np.radians([-15, 15, 40, 45]).tolist())
+    ac = JSBSimAircraft("B747", limits={"aileron": narrow})
+    assert ac.actuators.limits["aileron"] is narrow
+    assert ac.actuators.limits["rudder"] == B747_LIMITS["rudder"]
+    # with ±15° ailerons (Ch. 4's lumped range) a 25° rudder cannot be trimmed straight; with ±20° it can
+    assert not trim_aircraft(ac, HALLOUZI_POINT, {"rudder": np.radians(25)}, require=False).converged

@@ -132,8 +132,8 @@ class JSBSimAircraft:
     dt : float, optional
         The step [s] (default 1/120: 120 Hz, JSBSim's usual rate).
     limits : mapping, optional
-        Surface → :class:`fdikit.aircraft.actuators.SurfaceLimits`; default
-        :func:`fdikit.aircraft.actuators.default_limits` (Hallouzi App. A for the B747).
+        Surface → :class:`fdikit.aircraft.actuators.SurfaceLimits` for the surfaces to change; the others
+        keep :func:`fdikit.aircraft.actuators.default_limits` (Hallouzi App. A for the B747).
     folder : str, optional
         Where to build the prepared aircraft root (a temporary directory when omitted).
 
@@ -176,7 +176,7 @@ class JSBSimAircraft:
         self.fdm.set_dt(self.dt)
         self.engines = self.definition.engines
         self.surfaces = self.definition.surfaces
-        self.actuators = ActuatorBank(limits if limits is not None else default_limits(self.definition))
+        self.actuators = ActuatorBank({**default_limits(self.definition), **(limits or {})})
         self.controls = (*self.surfaces, "pitch_trim", *(f"throttle_{i + 1}" for i in range(self.engines)), "gear")
         self.commands = dict.fromkeys(self.controls, 0.0)
         self.sensor_faults: tuple = ()
