@@ -62,7 +62,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import solve_continuous_are
 
 from fdikit import validate
 from fdikit.errors import ParameterError
@@ -162,12 +161,14 @@ def b747_lqr_gain(nominal) -> np.ndarray:
     ----------
     Hallouzi 2008, §4.4.1 (an LQ controller because the fault models are unstable).
     """
+    from fdikit.aircraft.autopilot import lqr_autopilot
+    from fdikit.aircraft.plant import STATES
+
     m = nominal.linearization.model
     xmax = np.where(_ANGLE_STATES, np.radians(_X_MAX), _X_MAX)
     umax = np.concatenate([np.radians(_U_MAX[:4]), _U_MAX[4:]])
-    Qlq, Rlq = np.diag(1.0 / xmax ** 2), np.diag(1.0 / umax ** 2)
-    P = solve_continuous_are(m.A, m.B, Qlq, Rlq)
-    return np.linalg.solve(Rlq, m.B.T @ P)
+    return lqr_autopilot(nominal.linearization, dict(zip(STATES, xmax, strict=True)),
+                         dict(zip(m.controls, umax, strict=True)), inputs=m.controls).K
 
 
 @dataclass(frozen=True)
