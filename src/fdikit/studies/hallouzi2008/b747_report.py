@@ -72,10 +72,11 @@ def plot_lip_run(run, ax=None, path=None, t_fault: float = 20.0):
     logic = table_4_7_logic(0.2)
     width = max(1, int(round(0.5 / max(run.t[1] - run.t[0], 1e-9)))) if run.t.size > 1 else 1
     kernel = np.ones(width) / width
+    cover = np.convolve(np.ones(run.t.size), kernel, mode="same")  # the mean over the samples there are at the ends
     groups = {**{g: list(idx) for g, idx in logic.groups.items()}, "nominal": [logic.nominal]}
     for g, idx in groups.items():
         w = run.mu[:, idx].sum(axis=1) if run.mu.shape[1] > max(idx) else np.zeros(run.t.size)
-        a1.plot(run.t, np.convolve(w, kernel, mode="same"), label=g, lw=1.2)
+        a1.plot(run.t, np.convolve(w, kernel, mode="same") / cover, label=g, lw=1.2)
     on = run.declared != "none"
     if on.any():
         a1.fill_between(run.t, 0, 1, where=on, color="tab:red", alpha=0.1, label=f"declared ({run.declared[on][0]})")
