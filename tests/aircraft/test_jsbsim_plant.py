@@ -44,7 +44,7 @@ def b747():
     return ac, trim, ac.snapshot()
 
 
-def fly(ac, seconds, record=("state",)):
+def fly(ac, seconds):
     out = []
     for _ in range(int(round(seconds / ac.dt))):
         ac.step()

@@ -29,7 +29,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from fdikit import validate
+from fdikit.actuator_faults import TravelFault
 from fdikit.errors import ParameterError
+from fdikit.faults import Stuck
 
 __all__ = ["B747_LIMITS", "ActuatorBank", "SurfaceLimits", "default_limits"]
 
@@ -190,9 +192,6 @@ class ActuatorBank:
         dict
             The new positions (also in :attr:`positions`).
         """
-        from fdikit.actuator_faults import TravelFault
-        from fdikit.faults import Stuck
-
         tt = np.array([t])
         for s, lim in self.limits.items():
             cmd, rate_cap = float(commands.get(s, self.positions[s])), np.inf

@@ -230,15 +230,6 @@ class JSBSimAircraft:
         """
         return self.outputs()[:10]
 
-    def surface_positions(self) -> dict:
-        """Surface positions [rad] as JSBSim's aerodynamics read them.
-
-        Returns
-        -------
-        dict
-        """
-        return {s: self.actuators.positions[s] for s in self.surfaces}
-
     def thrust(self) -> np.ndarray:
         """Thrust per engine [N].
 
@@ -344,6 +335,18 @@ class JSBSimAircraft:
             else:
                 self.fdm[f"fdikit/{s}-pos-rad"] = positions[s]
 
+    def surface_commands(self) -> dict:
+        """The position each surface actuator is commanded to [rad] (``pitch_trim`` added to the elevator).
+
+        Returns
+        -------
+        dict
+        """
+        surf = {s: self.commands[s] for s in self.surfaces}
+        if "elevator" in surf:
+            surf["elevator"] += self.commands["pitch_trim"]
+        return surf
+
     def step(self, n: int = 1) -> None:
         """Advance ``n`` steps of :attr:`dt`: actuators, then one JSBSim step each.
 
@@ -358,10 +361,7 @@ class JSBSimAircraft:
             If JSBSim stops (a crash, or the simulation terminated).
         """
         for _ in range(validate.integer("n", n, minimum=0)):
-            surf = {s: self.commands[s] for s in self.surfaces}
-            if "elevator" in surf:
-                surf["elevator"] += self.commands["pitch_trim"]
-            self._write_surfaces(self.actuators.update(surf, self.time, self.dt))
+            self._write_surfaces(self.actuators.update(self.surface_commands(), self.time, self.dt))
             self._write_commands()
             if not self.fdm.run():
                 raise DataError(f"JSBSim stopped at t = {self.time:.2f} s (crash or terminate).")

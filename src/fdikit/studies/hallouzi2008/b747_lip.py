@@ -48,18 +48,21 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fdikit import validate
+from fdikit.studies.hallouzi2008.table_4_6 import R_S_THESIS
 
 __all__ = ["NOISE_PRESETS", "T_FAULT", "LipSetup", "LipRun", "lip_setup", "fly_lip", "false_alarm_rate"]
 
 #: Injection time [s] (§4.4.2).
 T_FAULT = 20.0
 _D2R = np.pi / 180.0
+_ANGLE = np.array([1, 1, 1, 0, 1, 1, 1, 1, 1, 0], bool)  # rates and angles of p q r V α β φ θ ψ h
 #: Sensor-noise standard deviations (SI) of the ten states ``p q r V α β φ θ ψ h``: ``"thesis_cov"``
 #: reads (4.4) as covariances in deg², (m/s)², m² (β, φ as the other angles); ``"thesis_std"`` reads
 #: Table 6.2 as standard deviations (φ θ ψ 1.73e-4 deg, α β 1.73e-3 deg, V 0.1 m/s, h 0.1 m; the
 #: rates as the attitudes).
 NOISE_PRESETS = {
-    "thesis_cov": np.sqrt(np.array([1.73e-4 * _D2R**2] * 3 + [1e-1] + [1.73e-4 * _D2R**2] * 5 + [1e-1])),
+    "thesis_cov": np.sqrt(np.array([R_S_THESIS[i] for i in (0, 1, 2, 3, 4, 4, 5, 5, 6, 7)])
+                          * np.where(_ANGLE, _D2R**2, 1.0)),
     "thesis_std": np.array([1.73e-4 * _D2R] * 3 + [0.1] + [1.73e-3 * _D2R] * 2 + [1.73e-4 * _D2R] * 3 + [0.1]),
 }
 
@@ -181,7 +184,7 @@ class LipRun:
         return "correct" if label == self.surface else "incorrect"
 
 
-def _imm(models, Q, R, transition, x0, measured):
+def _imm(models, Q, R, transition, x0, measured, dt):
     from fdikit.aircraft.plant import STATES
     from fdikit.gaussian import LinearGaussianModel
     from fdikit.multimodel.imm import IMMFilter
@@ -189,7 +192,7 @@ def _imm(models, Q, R, transition, x0, measured):
     C = np.eye(10)[[STATES.index(s) for s in measured]]  # model set II has no sensor-fault models
     modes = []
     for m in models:
-        Ad, Bd, _ = m.discrete(0.01)
+        Ad, Bd, _ = m.discrete(dt)
         modes.append(LinearGaussianModel(A=Ad, B=Bd, C=C, Q=Q, R=R, name=m.name))
     M = len(modes)
     mu0 = np.full(M, 1e-3 / (M - 1))
@@ -231,7 +234,7 @@ def _fly(setup, seconds: float, seed: int, fault=None, record_states: bool = Fal
         c = ap.commands(y)
         ac.set_inputs(aileron=c["aileron"], elevator=c["elevator"], rudder=c["rudder"],
                       **dict.fromkeys(throttles, c["throttle"]))
-        pos = healthy.update({s: ac.commands[s] for s in ac.surfaces}, t, ac.dt)
+        pos = healthy.update(ac.surface_commands(), t, ac.dt)
         u = np.array([pos["aileron"], pos["elevator"], pos["stabilizer"], pos["rudder"], ac.thrust().sum(), 1.0])
         yield t, y, u, (ac.state() if record_states else None)
         ac.step()
@@ -342,7 +345,7 @@ def lip_setup(*, noise: str = "thesis_cov", turbulence: int = 3, q_inflation: fl
                      settings=settings)
     setup._snap = ac.snapshot()
     setup.Q = q_inflation * identify_process_noise(setup, calibration_seconds, calibration_seed)
-    setup._imm = _imm(models, setup.Q, R, setup.transition, nominal.linearization.x0, measured)
+    setup._imm = _imm(models, setup.Q, R, setup.transition, nominal.linearization.x0, measured, ac.dt)
     return setup
 
 

@@ -168,22 +168,18 @@ def table_4_6_markdown(result) -> str:
     ----------
     Hallouzi 2008, §4.4.1–§4.4.2, Tables 4.6 and 4.8.
     """
-    from fdikit.studies.hallouzi2008.table_4_6 import table_4_6_isolation
+    from fdikit.studies.hallouzi2008.table_4_6 import scenario_intervals, table_4_6_isolation
 
-    decided = table_4_6_isolation(result)
+    settle = 1.0  # as table_4_6_isolation: the weights' transient after each switch is skipped
+    decided = table_4_6_isolation(result, settle=settle)
+    spans = {name: (start, end) for name, start, end in scenario_intervals(result.t)}
     lines = ["| interval | mean weights μ(1) … μ(8) | Table 4.7 decision (share of samples) | thesis (Fig. 4.3) |",
              "|---|---|---|---|"]
     for name, (label, share) in decided.items():
-        base = name.rsplit("_", 1)[0] if name.startswith("none") else name
-        rows = result.labels == base
-        if base == "none":  # the k-th fault-free stretch
-            k = int(name.rsplit("_", 1)[1])
-            edges = np.flatnonzero(np.diff(np.r_[0, rows.astype(int)]) == 1)
-            stop = np.r_[np.flatnonzero(np.diff(np.r_[rows.astype(int), 0]) == -1)]
-            rows = np.zeros_like(rows)
-            rows[edges[k - 1]:stop[k - 1] + 1] = True
-        mu = result.mu[rows][100:] if rows.sum() > 100 else result.mu[rows]
-        weights = " ".join(f"{v:.2f}" for v in mu.mean(axis=0))
+        base = "none" if name.startswith("none") else name
+        start, end = spans[name]
+        rows = (result.t >= start + settle - 1e-9) & (result.t < end - 1e-9)
+        weights = " ".join(f"{v:.2f}" for v in result.mu[rows].mean(axis=0))
         lines.append(f"| {name} | {weights} | {label} ({100 * share:.0f} %) | {THESIS_FIG_4_3.get(base, '')} |")
     vaf = ", ".join(f"{k} {v:.1f} %" for k, v in result.vaf.items())
     return "\n".join(lines) + f"\n\nState VAF: {vaf}\n"
