@@ -53,6 +53,8 @@ import time  # noqa: E402
 
 import numpy as np  # noqa: E402
 
+import timing  # noqa: E402 (benchmarks/timing.py, run from the repository root)
+
 RATE = 120.0  # Hz
 FT = 0.3048
 KT = 1852.0 / 3600.0
@@ -63,18 +65,6 @@ NOISE_STD = np.array([1e-3, 1e-3, 1e-3, 0.1, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3, 1.0, 
 #: JSBSim's FGLinearization state names in the order of fdikit's STATES, and the factor of each to SI.
 JSBSIM_STATES = ("P", "Q", "R", "Vt", "Alpha", "Beta", "Phi", "Theta", "Psi", "Alt")
 JSBSIM_SCALE = np.array([1, 1, 1, FT, 1, 1, 1, 1, 1, FT])
-
-
-def cpu_name() -> str:
-    """The CPU model from /proc/cpuinfo (Linux), else ``platform.processor()``."""
-    try:
-        with open("/proc/cpuinfo") as fh:
-            for line in fh:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown CPU"
 
 
 def stock_b747(dt: float):
@@ -292,7 +282,7 @@ def main() -> None:
     stock_t = raw["inertia/weight-lbs"] * 0.45359237 / 1e3
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     print(f"fdikit {fdikit.__version__}, JSBSim {jsbsim.__version__}, numpy {np.__version__}, scipy "
-          f"{scipy.__version__}, Python {platform.python_version()}, {platform.machine()}, {cpu_name()}, "
+          f"{scipy.__version__}, Python {platform.python_version()}, {platform.machine()}, {timing.cpu_name()}, "
           f"{os.cpu_count()} cores, one thread, load average {load:.2f}; {time.strftime('%Y-%m-%d')}")
     print(f"B747 at the Hallouzi trim (980 m, 92.6 m/s, flaps 20°, fdikit 263 t / stock {stock_t:.2f} t); "
           f"{args.duration:g} s at {RATE:g} Hz ({n} steps), best of {args.repeat}; "

@@ -68,18 +68,6 @@ def python_rk4(car, op, duration: float, road=None) -> np.ndarray:
     return x
 
 
-def cpu_name() -> str:
-    """The CPU model from /proc/cpuinfo (Linux), else ``platform.processor()``."""
-    try:
-        with open("/proc/cpuinfo") as fh:
-            for line in fh:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown CPU"
-
-
 def interpreted_peer(duration: float) -> None:
     """Child-process entry (``NUMBA_DISABLE_JIT=1``): time the Python RK4 loop on the interpreted model."""
     from fdikit.vehicle import Sedan
@@ -112,7 +100,7 @@ def main() -> None:
     from fdikit.studies.path1996.demo import SENSOR_NOISE_STD
     from fdikit.vehicle import Sedan
     from fdikit.vehicle.road import robson_road
-    from timing import best
+    from timing import best, cpu_name
 
     car = Sedan()
     op = car.operating_point(throttle=THROTTLE)
