@@ -228,13 +228,13 @@ def table_4_8(setup, *, step: float = 0.5, surfaces=("elevator", "aileron", "rud
     ----------
     Hallouzi 2008, §4.4.2, Table 4.8.
     """
+    from fdikit.progress import progress_bar
     from fdikit.studies.hallouzi2008.b747_lip import fly_lip
 
     surfaces = [validate.choice("surface", s, list(SWEEP_RANGES)) for s in surfaces]
     jobs = [(s, float(lock)) for s in surfaces for lock in lock_positions(s, step)]
     rows = []
-    bar = _Bar(progress, len(jobs))
-    with bar:
+    with progress_bar(progress, len(jobs), "Table 4.8") as tick:
         for surface, lock in jobs:
             key = f"{surface}_{'m' if lock < 0 else 'p'}{abs(lock):.1f}"
             done = None if store is None else store.load(key)
@@ -247,29 +247,5 @@ def table_4_8(setup, *, step: float = 0.5, surfaces=("elevator", "aileron", "rud
                 if store is not None:
                     store.save(key, done)
             rows.append(LipRow(**done))
-            bar.tick(f"{surface} {lock:+.1f} deg: {done['outcome']}")
+            tick(f"{surface} {lock:+.1f} deg: {done['outcome']}")
     return Table48(tuple(rows), {**setup.settings, "step": step, "seed": seed, "duration": duration})
-
-
-class _Bar:
-    """A rich progress bar, or nothing."""
-
-    def __init__(self, show: bool, total: int) -> None:
-        self.show, self.total = show, total
-
-    def __enter__(self):
-        if self.show:
-            from rich.progress import Progress
-
-            self.bar = Progress()
-            self.bar.start()
-            self.task = self.bar.add_task("Table 4.8", total=self.total)
-        return self
-
-    def tick(self, text: str) -> None:
-        if self.show:
-            self.bar.update(self.task, advance=1, description=text)
-
-    def __exit__(self, *exc) -> None:
-        if self.show:
-            self.bar.stop()

@@ -422,6 +422,7 @@ def path_evaluation_table(setup=None, *, roads=("smooth", "rough"), faults=None,
     """
     from fdikit import validate
     from fdikit.metrics import score
+    from fdikit.progress import progress_bar
     from fdikit.studies.path1996.nonlinear_evaluation import (
         evaluation_setup,
         fault_run,
@@ -441,7 +442,7 @@ def path_evaluation_table(setup=None, *, roads=("smooth", "rough"), faults=None,
     all_seeds = np.random.default_rng(args["seed"]).integers(2**31, size=per_road * len(roads))
     rows, false_alarms, runs = [], {}, {}
     steps = len(roads) * (2 + (2 if train else 1) * len(faults))
-    with _progress(progress, steps) as tick:
+    with progress_bar(progress, steps, "PATH evaluation") as tick:
         for k_road, road in enumerate(roads):
             seeds = [int(v) for v in all_seeds[k_road * per_road:(k_road + 1) * per_road]]
             key = f"road-{road}"
@@ -489,25 +490,3 @@ def path_evaluation_table(setup=None, *, roads=("smooth", "rough"), faults=None,
     off_run = off_nominal_run(setup)
     off = {b: off_nominal_peaks(setup, bank=b, run=off_run) for b in banks if setup.banks[b].scales}  # scaled only
     return EvaluationTable(rows, false_alarms, off, dict(setup.nominal), runs)
-
-
-class _progress:
-    """A rich progress bar (or nothing) with a ``tick(description, steps=1)`` callback."""
-
-    def __init__(self, show: bool, total: int):
-        self.show, self.total = show, total
-
-    def __enter__(self):
-        if not self.show:
-            return lambda *a, **k: None
-        from rich.progress import Progress
-
-        self.bar = Progress()
-        self.bar.start()
-        task = self.bar.add_task("PATH evaluation", total=self.total)
-        return lambda desc, n=1: self.bar.update(task, advance=n, description=desc)
-
-    def __exit__(self, *exc):
-        if self.show:
-            self.bar.stop()
-        return False
