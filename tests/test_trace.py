@@ -74,8 +74,9 @@ def test_to_pandas_columns_and_values():
     tr = _trace()
     df = tr.to_pandas()
     assert list(df.columns) == [
-        "u:throttle", "u:steer", "y:yaw_rate", "y:speed", "y:t", "x:v", "x:r", "d:gust", "fault",
+        "u:throttle", "u:steer", "y:yaw_rate", "y:speed", "y:t", "x:v", "x:r", "d:gust", "fault", "valid",
     ]
+    assert df["valid"].dtype == bool and df["valid"].all()
     assert df.index.name == "t"
     np.testing.assert_array_equal(df.index.to_numpy(), tr.t)
     np.testing.assert_array_equal(df["y:speed"].to_numpy(), tr.y[:, 1])
@@ -221,3 +222,21 @@ def test_loaded_arrays_are_writable(tmp_path):
     back = Trace.load(_trace().save(tmp_path / "w.parquet"))
     for attr in ("t", "u", "y", "x", "d"):
         assert getattr(back, attr).flags.writeable, attr
+
+
+def test_valid_defaults_to_all_true_and_is_checked():
+    tr = _trace()
+    assert tr.valid.dtype == bool and tr.valid.shape == (N,) and tr.valid.all() and tr.gaps == []
+    flags = np.ones(N, dtype=bool)
+    flags[[3, 4, 5, 20, N - 1]] = False
+    tr = _trace(valid=flags)
+    flags[0] = False  # the trace holds its own copy
+    assert tr.valid[0]
+    assert tr.gaps == [(tr.t[3], tr.t[5]), (tr.t[20], tr.t[20]), (tr.t[N - 1], tr.t[N - 1])]
+    assert _trace(valid=[True] * N).valid.all()
+    with pytest.raises(DataError, match=rf"valid flags have shape \(3,\), need \({N},\)"):
+        _trace(valid=[True, False, True])
+    with pytest.raises(DataError, match="valid flags must be booleans.*dtype int64"):
+        _trace(valid=np.ones(N, dtype=np.int64))
+    with pytest.raises(DataError, match="valid flags must be booleans.*dtype object"):
+        _trace(valid=[True] * (N - 1) + [None])

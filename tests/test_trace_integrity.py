@@ -8,8 +8,9 @@ seeded generator and require :meth:`Trace.load` to refuse the file with a ``Data
 from __future__ import annotations
 
 import errno
+import hashlib
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import pyarrow as pa
@@ -33,6 +34,7 @@ def _trace(n: int = 400, seed: int = 3) -> Trace:
         outputs=["yaw_rate", "speed", "lateral_error"], states=["v", "r"], disturbances=["gust"],
         fault=np.select([k >= 300, k >= 150], ["steer_bias+speed_scale", "steer_bias"], "none"),
         meta={"plant": "toy", "seed": seed, "faults": ["Bias('steer', 0.1)"]},
+        valid=(k % 37) != 5,
     )
 
 
@@ -41,7 +43,7 @@ def _same(a: Trace, b: Trace) -> bool:
     return (
         all(getattr(a, k).shape == getattr(b, k).shape
             and np.array_equal(getattr(a, k).view(np.uint64), getattr(b, k).view(np.uint64)) for k in "tuyxd")
-        and np.array_equal(a.fault, b.fault) and a.meta == b.meta
+        and np.array_equal(a.fault, b.fault) and a.meta == b.meta and np.array_equal(a.valid, b.valid)
         and all(getattr(a, k) == getattr(b, k) for k in ("controls", "outputs", "states", "disturbances"))
     )
 
@@ -332,8 +334,8 @@ def test_save_replaces_an_existing_file_with_the_new_trace(tmp_path):
 
 # ---------------------------------------------------------------------- files without a digest
 def _old_format(tr: Trace, path) -> None:
-    """The layout of fdikit before the digest: pandas columns and the 'fdikit' JSON, no checksums."""
-    table = pa.Table.from_pandas(tr.to_pandas().reset_index(), preserve_index=False)
+    """The layout of fdikit before the digest: pandas columns and the 'fdikit' JSON, no checksums, no valid flags."""
+    table = pa.Table.from_pandas(tr.to_pandas().drop(columns="valid").reset_index(), preserve_index=False)
     info = {"controls": list(tr.controls), "outputs": list(tr.outputs), "states": list(tr.states),
             "disturbances": list(tr.disturbances), "meta": tr.meta}
     table = table.replace_schema_metadata({**(table.schema.metadata or {}), b"fdikit": json.dumps(info).encode()})
@@ -347,4 +349,63 @@ def test_a_file_without_digest_needs_verify_false(tmp_path):
     with pytest.raises(DataError, match=r"old\.parquet has no content digest.*verify=False"):
         Trace.load(path)
     back = Trace.load(path, verify=False)  # the old layout stored NaN as null: it reads as NaN again
-    assert np.isnan(back.y[17, 1]) and _same(back, tr)
+    assert np.isnan(back.y[17, 1]) and _same(back, replace(tr, valid=None))
+    assert back.valid.all()
+
+
+def _v1_digest(info: bytes, table: pa.Table) -> str:
+    """The content digest as the module docstring specifies it, for a file without the 'valid' column."""
+    h = hashlib.sha256(b"fdikit-trace-sha256-v1\x00")
+    h.update(len(info).to_bytes(8, "little") + info)
+    for name in table.schema.names[:-1]:
+        col = table.column(name).to_numpy()
+        h.update(len(name.encode()).to_bytes(8, "little") + name.encode())
+        h.update(len(col).to_bytes(8, "little") + np.ascontiguousarray(col, dtype="<f8").tobytes())
+    labels = table.column("fault").to_pylist()
+    distinct = list(dict.fromkeys(labels))
+    h.update(len(distinct).to_bytes(8, "little"))
+    for label in distinct:
+        h.update(len(label.encode()).to_bytes(8, "little") + label.encode())
+    h.update(np.array([distinct.index(x) for x in labels], dtype="<i8").tobytes())
+    return h.hexdigest()
+
+
+def test_a_file_with_digest_but_without_valid_flags_loads_all_valid(tmp_path):
+    """Files saved before the 'valid' column existed: same digest (v1) without it; they load with every sample valid."""
+    tr = _trace()
+    path = tr.save(tmp_path / "new.parquet")
+    table = pq.read_table(path)
+    old = table.drop_columns(["valid"])
+    info = table.schema.metadata[b"fdikit"]
+    md = {b"fdikit": info, b"fdikit.sha256": _v1_digest(info, old).encode()}
+    pq.write_table(old.replace_schema_metadata(md), tmp_path / "v1.parquet", write_page_checksum=True)
+    back = Trace.load(tmp_path / "v1.parquet")  # verify=True: the v1 digest is checked and matches
+    assert back.valid.dtype == bool and back.valid.all() and _same(back, replace(tr, valid=None))
+    # dropping the column from a file saved WITH flags breaks its digest: never a silent "all valid"
+    pq.write_table(old.replace_schema_metadata(table.schema.metadata), tmp_path / "cut.parquet")
+    with pytest.raises(DataError, match="content digest"):
+        Trace.load(tmp_path / "cut.parquet")
+
+
+def test_valid_flags_round_trip_and_a_changed_flag_is_refused(tmp_path):
+    tr = _trace()
+    assert (~tr.valid).sum() == 11  # k % 37 == 5 for k in 0..399: 5, 42, ..., 375 -> 11 samples
+    path = tr.save(tmp_path / "run.parquet")
+    back = Trace.load(path)
+    assert _same(back, tr) and np.array_equal(back.valid, tr.valid)
+    table = pq.read_table(path)
+    flipped = tr.valid.copy()
+    flipped[0] = not flipped[0]
+    bad = table.set_column(table.schema.get_field_index("valid"), "valid", pa.array(flipped))
+    pq.write_table(bad, tmp_path / "bad.parquet")
+    with pytest.raises(DataError, match="content digest"):
+        Trace.load(tmp_path / "bad.parquet")
+    ints = table.set_column(table.schema.get_field_index("valid"), "valid", pa.array(flipped.astype(np.int8)))
+    pq.write_table(ints, tmp_path / "ints.parquet")
+    with pytest.raises(DataError, match="column 'valid' has type int8"):
+        Trace.load(tmp_path / "ints.parquet")
+    nulls = table.set_column(table.schema.get_field_index("valid"), "valid",
+                             pa.array([None] + tr.valid[1:].tolist(), type=pa.bool_()))
+    pq.write_table(nulls, tmp_path / "nulls.parquet")
+    with pytest.raises(DataError, match="null flag at sample 0"):
+        Trace.load(tmp_path / "nulls.parquet", verify=False)

@@ -146,6 +146,23 @@ def _fault(fault, n: int) -> np.ndarray:
     return arr.astype(str) if n else np.full(0, NO_FAULT)
 
 
+def _valid(valid, n: int) -> np.ndarray:
+    """The per-sample validity flags as a bool array (all True when None); never coerces a number."""
+    if valid is None:
+        return np.ones(n, dtype=bool)
+    arr = np.asarray(valid)
+    if arr.shape != (n,):
+        raise DataError(f"trace valid flags have shape {arr.shape}, need ({n},): one True/False per sample")
+    if arr.dtype.kind == "O" and all(isinstance(v, bool | np.bool_) for v in arr.tolist()):
+        arr = arr.astype(bool)
+    if arr.dtype.kind != "b":
+        raise DataError(
+            f"trace valid flags must be booleans (True where the sample is valid), got an array of dtype {arr.dtype}; "
+            "convert a status column explicitly, e.g. valid=(status == 0)"
+        )
+    return np.array(arr, dtype=bool)  # a copy: the trace owns its flags
+
+
 def _json_value(v, where: str, depth: int = 0):
     """``v`` as plain JSON values (dict with str keys, list, str, int, float, bool, None)."""
     if depth > 64:
@@ -210,6 +227,10 @@ class Trace:
     meta : dict of JSON-serialisable metadata (plant, seed, scenario label ...).  It is stored
         as plain JSON values: tuples become lists and numpy scalars and numeric arrays become
         numbers and lists; dict keys must be strings.
+    valid : (N,) bool, default all True.  False marks a sample the source flagged invalid: a
+        grid point missing from an imported log (inserted by :meth:`from_pandas` with NaN
+        values) or a sample whose status column says invalid.  Residual generators treat such
+        a sample as a dropout.  Numbers are refused, never converted.
 
     Raises
     ------
@@ -236,6 +257,7 @@ class Trace:
     disturbances: tuple[str, ...] = ()
     fault: np.ndarray | None = None
     meta: dict = field(default_factory=dict)
+    valid: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         t = _numbers("trace time t", self.t)
@@ -256,6 +278,7 @@ class Trace:
         set_(self, "d", _block("d", np.zeros((n, 0)) if self.d is None else self.d, n, self.disturbances))
         set_(self, "fault", _fault(self.fault, n))
         set_(self, "meta", json_meta(self.meta))
+        set_(self, "valid", _valid(self.valid, n))
 
     # ------------------------------------------------------------------ access
     def __len__(self) -> int:
@@ -303,6 +326,22 @@ class Trace:
                 )
 
     @property
+    def gaps(self) -> list[tuple[float, float]]:
+        """The runs of invalid samples as ``(start, stop)`` times (first and last invalid sample of each run).
+
+        Examples
+        --------
+        >>> tr = Trace(t=np.arange(6.0), u=np.zeros((6, 0)), y=np.zeros((6, 0)), controls=[], outputs=[],
+        ...            valid=np.array([True, False, False, True, False, True]))
+        >>> tr.gaps
+        [(1.0, 2.0), (4.0, 4.0)]
+        """
+        bad = np.concatenate(([0], (~self.valid).astype(np.int8), [0]))
+        edges = np.diff(bad)
+        starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
+        return [(float(self.t[a]), float(self.t[b])) for a, b in zip(starts, stops, strict=True)]
+
+    @property
     def fault_onset(self) -> float | None:
         """Time of the first faulty sample, or None for a fault-free trace."""
         idx = np.flatnonzero(self.fault != NO_FAULT)
@@ -310,7 +349,7 @@ class Trace:
 
     # ------------------------------------------------------------------ export and I/O
     def to_pandas(self):
-        """A DataFrame indexed by time with columns ``u:<name>``, ``y:<name>``, ``x:...``, ``d:...``, ``fault``."""
+        """A DataFrame indexed by time, columns ``u:<name>``, ``y:<name>``, ``x:..``, ``d:..``, ``fault``, ``valid``."""
         import pandas as pd
 
         data = {}
@@ -319,6 +358,7 @@ class Trace:
             for j, nm in enumerate(names):
                 data[COLUMN_PREFIX[kind] + nm] = block[:, j]
         data["fault"] = self.fault
+        data["valid"] = self.valid
         return pd.DataFrame(data, index=pd.Index(self.t, name="t"))
 
     def plot(self, ax=None, **kwargs):

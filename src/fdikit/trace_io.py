@@ -8,8 +8,10 @@ Columns
 -------
 One Parquet file holds, in this order, the float64 (double) columns ``t``, ``u:<name>`` for
 each control, ``y:<name>`` for each output, ``x:<name>`` for each state, ``d:<name>`` for each
-disturbance (:data:`COLUMN_PREFIX`), and the string column ``fault`` with one label per sample.
-Floats are stored as they are: NaN (with its payload), infinities and signed zeros, never null.
+disturbance (:data:`COLUMN_PREFIX`), the string column ``fault`` with one label per sample and
+the boolean column ``valid`` (:attr:`Trace.valid <fdikit.trace.Trace.valid>`).  Floats are
+stored as they are: NaN (with its payload), infinities and signed zeros, never null.  A file
+without the ``valid`` column (written before it existed) loads with every sample valid.
 
 Schema metadata
 ---------------
@@ -20,7 +22,9 @@ Schema metadata
     Hex SHA-256 content digest: over a version tag, the ``fdikit`` bytes, every float column
     (its name, its length and its values as little-endian float64) and the fault labels (their
     distinct values in order of first appearance, UTF-8 with lengths, and the per-sample index
-    into them as little-endian int64).  Every piece is preceded by its length.
+    into them as little-endian int64), then, when the file has the ``valid`` column, the name
+    ``valid``, its length and its flags as one byte each (0 or 1).  Every piece is preceded by
+    its length.
 
 Integrity
 ---------
@@ -40,7 +44,8 @@ a folder, a missing, unreadable, non-regular or empty file; a file pyarrow canno
 Parquet, truncated, a page checksum that does not match); no ``fdikit`` metadata, or metadata
 that is not UTF-8 JSON object text, lacks a names list or ``meta``, or holds bad names;
 duplicate, missing or unexpected columns, a signal column that is not float64, a ``fault``
-column that is not text or holds a null or a label ending with NUL; a missing digest (unless
+column that is not text or holds a null or a label ending with NUL; a ``valid`` column that
+is not boolean or holds a null; a missing digest (unless
 ``verify=False``); a null in a signal column of a file with a digest; a digest that does not
 match; and anything the :class:`~fdikit.trace.Trace` constructor refuses.  Files without a
 digest (read only with ``verify=False``) may hold nulls, read as NaN.  The round trip is exact:
@@ -59,7 +64,7 @@ Example
 ...     schema = pq.read_schema(path)
 ...     back = read_trace(path)
 >>> schema.names, sorted(schema.metadata)
-(['t', 'u:u1', 'y:y1', 'fault'], [b'fdikit', b'fdikit.sha256'])
+(['t', 'u:u1', 'y:y1', 'fault', 'valid'], [b'fdikit', b'fdikit.sha256'])
 >>> back.y.tolist(), back.fault.tolist(), back.meta
 ([[0.5], [nan]], ['none', 'none'], {'seed': 1})
 """
@@ -92,6 +97,7 @@ _BLOCKS = (("u", "controls"), ("y", "outputs"), ("x", "states"), ("d", "disturba
 _META_KEY = b"fdikit"
 _DIGEST_KEY = b"fdikit.sha256"
 _DIGEST_TAG = b"fdikit-trace-sha256-v1\x00"
+_VALID = "valid"
 
 
 def _as_path(path) -> Path:
@@ -103,8 +109,9 @@ def _as_path(path) -> Path:
         raise ParameterError(f"path must be a file name (str or pathlib.Path): {exc}") from None
 
 
-def _digest(info: bytes, columns: Sequence[tuple[str, np.ndarray]], labels: Sequence[str], codes) -> str:
-    """SHA-256 over the fdikit metadata bytes, the float64 columns (little-endian) and the fault labels.
+def _digest(info: bytes, columns: Sequence[tuple[str, np.ndarray]], labels: Sequence[str], codes,
+            valid: np.ndarray | None = None) -> str:
+    """SHA-256 over the fdikit metadata bytes, the float64 columns (little-endian), the fault labels and the flags.
 
     The labels enter as their distinct values in order of first appearance (UTF-8, each with its
     length) and the per-sample index into them, which is what :func:`pyarrow.compute.dictionary_encode`
@@ -125,6 +132,11 @@ def _digest(info: bytes, columns: Sequence[tuple[str, np.ndarray]], labels: Sequ
         h.update(len(raw).to_bytes(8, "little"))
         h.update(raw)
     h.update(np.ascontiguousarray(codes, dtype="<i8"))
+    if valid is not None:  # absent from files written before the valid flags: their digest stays as it was
+        h.update(len(_VALID).to_bytes(8, "little"))
+        h.update(_VALID.encode("ascii"))
+        h.update(len(valid).to_bytes(8, "little"))
+        h.update(np.ascontiguousarray(valid, dtype=np.uint8))
     return h.hexdigest()
 
 
@@ -210,10 +222,12 @@ def write_trace(trace: Trace, path: str | Path) -> Path:
                     "text (it holds a lone surrogate)"
                 ) from None
         raise
+    valid = np.ascontiguousarray(trace.valid, dtype=bool)
+    digest = _digest(info, columns, *_encode_labels(labels, pa, pc), valid)
     table = pa.Table.from_arrays(
-        [pa.array(col, type=pa.float64()) for _, col in columns] + [labels],
-        names=[name for name, _ in columns] + ["fault"],
-        metadata={_META_KEY: info, _DIGEST_KEY: _digest(info, columns, *_encode_labels(labels, pa, pc)).encode()},
+        [pa.array(col, type=pa.float64()) for _, col in columns] + [labels, pa.array(valid, type=pa.bool_())],
+        names=[name for name, _ in columns] + ["fault", _VALID],
+        metadata={_META_KEY: info, _DIGEST_KEY: digest.encode()},
     )
     with atomic_path(path, suffix=".parquet") as tmp:  # its own failures are DataErrors naming the file
         try:
@@ -306,7 +320,7 @@ def read_trace(path: str | Path, *, verify: bool = True, cls: type[Trace] | None
     missing = [c for c in expected if c not in set(present)]
     if missing:
         raise DataError(f"{path} is missing the column(s) {missing} that its fdikit metadata lists")
-    unexpected = [c for c in present if c not in set(expected)]
+    unexpected = [c for c in present if c not in set(expected) | {_VALID}]
     if unexpected:
         raise DataError(f"{path} has unexpected column(s) {unexpected} that its fdikit metadata does not list")
     for c in expected[:-1]:
@@ -314,6 +328,7 @@ def read_trace(path: str | Path, *, verify: bool = True, cls: type[Trace] | None
             raise DataError(f"{path}: column {c!r} has type {table.schema.field(c).type}; trace signals must be "
                             "float64 (double)")
     _check_label_column(path, table.column("fault"), pa, pc)
+    valid = _valid_from(path, table.column(_VALID), pa, pc) if _VALID in present else None
 
     # ---- integrity: the content digest must be there (unless verify=False) and match
     stored = md.get(_DIGEST_KEY)
@@ -334,7 +349,7 @@ def read_trace(path: str | Path, *, verify: bool = True, cls: type[Trace] | None
         # nulls (only in files without a digest: fdikit before the digest stored NaN as null) read as NaN
         arrays[c] = np.asarray(col.to_numpy(), dtype=float)
     fault, labels, codes = _labels_from(path, table.column("fault"), pa, pc)
-    if stored is not None and stored != _digest(raw, list(arrays.items()), labels, codes).encode("ascii"):
+    if stored is not None and stored != _digest(raw, list(arrays.items()), labels, codes, valid).encode("ascii"):
         raise DataError(
             f"trace file {path} is corrupted: its content digest (SHA-256 over the metadata and every column) "
             "does not match the stored one, so the file changed after it was written; restore it from a copy"
@@ -347,7 +362,7 @@ def read_trace(path: str | Path, *, verify: bool = True, cls: type[Trace] | None
         blocks[kind] = np.column_stack(cols) if cols else np.zeros((n, 0))
     try:
         return cls(t=np.array(arrays["t"]), u=blocks["u"], y=blocks["y"], x=blocks["x"], d=blocks["d"], fault=fault,
-                   meta=meta, **names)
+                   meta=meta, valid=valid, **names)
     except DataError as exc:
         raise DataError(f"trace file {path}: {exc}") from None
 
@@ -394,6 +409,19 @@ def _check_label_column(path: Path, col, pa, pc) -> None:
             f"{path}: column 'fault' has a null label at sample {first} ({col.null_count} nulls in all); "
             f"every sample needs a label ({NO_FAULT!r} where healthy)"
         )
+
+
+def _valid_from(path: Path, col, pa, pc) -> np.ndarray:
+    """The (checked) 'valid' column: boolean, no null."""
+    if not pa.types.is_boolean(col.type):
+        raise DataError(f"{path}: column 'valid' has type {col.type}; the validity flags must be booleans")
+    if col.null_count:
+        first = int(np.flatnonzero(pc.is_null(col).to_numpy(zero_copy_only=False))[0])
+        raise DataError(
+            f"{path}: column 'valid' has a null flag at sample {first} ({col.null_count} nulls in all); every "
+            "sample needs True or False"
+        )
+    return np.asarray(col.to_numpy(zero_copy_only=False), dtype=bool)
 
 
 def _labels_from(path: Path, col, pa, pc) -> tuple[np.ndarray, list[str], np.ndarray]:
