@@ -240,3 +240,28 @@ def test_valid_defaults_to_all_true_and_is_checked():
         _trace(valid=np.ones(N, dtype=np.int64))
     with pytest.raises(DataError, match="valid flags must be booleans.*dtype object"):
         _trace(valid=[True] * (N - 1) + [None])
+
+
+@pytest.mark.parametrize(
+    "t",
+    [
+        np.array(["2024-01-01T00:00:00", "2024-01-01T00:00:01"], dtype="datetime64[ns]"),
+        np.array([0, 1], dtype="timedelta64[s]"),
+        np.array([0.0, 1.0], dtype=object),
+        np.array(["0.0", "1.0"]),
+    ],
+    ids=["datetime64", "timedelta64", "object", "text"],
+)
+def test_clock_times_are_refused_with_the_importer_named(t):
+    # (datetime64 read as float would give nanoseconds: a step of 1e9 "seconds")
+    with pytest.raises(DataError, match=r"trace time t holds .*Trace\.from_pandas"):
+        Trace(t=t, u=np.zeros((2, 0)), y=np.zeros((2, 0)), controls=[], outputs=[])
+
+
+def test_pandas_datetimes_are_refused_too():
+    pd = pytest.importorskip("pandas")
+    for t in (pd.date_range("2024-01-01", periods=3, freq="100ms"),
+              pd.date_range("2024-01-01", periods=3, freq="100ms", tz="Europe/Paris"),
+              pd.Series(pd.date_range("2024-01-01", periods=3, freq="100ms"))):
+        with pytest.raises(DataError, match=r"Trace\.from_pandas"):
+            Trace(t=t, u=np.zeros((3, 0)), y=np.zeros((3, 0)), controls=[], outputs=[])

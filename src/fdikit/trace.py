@@ -59,6 +59,22 @@ def _numbers(what: str, value) -> np.ndarray:
     raise DataError(f"{what} has dtype {arr.dtype}; it must hold numbers (float)")
 
 
+def _time(value) -> np.ndarray:
+    """The sample times as floats; refuses clock times, durations and text, which need :meth:`Trace.from_pandas`."""
+    try:
+        arr = np.asarray(value)
+    except (TypeError, ValueError):
+        arr = None
+    if arr is not None and arr.dtype.kind in "MmOUS":
+        what = {"M": "datetimes", "m": "durations (timedelta64)", "O": "Python objects", "U": "text", "S": "bytes"}
+        raise DataError(
+            f"trace time t holds {what[arr.dtype.kind]} (dtype {arr.dtype}); Trace() takes numbers (float seconds). "
+            "Import a log with clock times through Trace.from_pandas(df, time=...) or Trace.from_csv(path, time=...), "
+            "which convert them to seconds from the first sample and check the sampling grid"
+        )
+    return _numbers("trace time t", value)
+
+
 def _block(name: str, value, n: int, names: Sequence[str]) -> np.ndarray:
     arr = _numbers(f"trace signal block {name!r}", value)
     if arr.ndim == 1 and len(names) == 1:
@@ -214,7 +230,9 @@ class Trace:
 
     Attributes
     ----------
-    t : (N,) sample times, finite and strictly increasing.
+    t : (N,) sample times in seconds (float), finite and strictly increasing.  Datetimes,
+        durations, text and object arrays are refused: :meth:`from_pandas` and :meth:`from_csv`
+        convert clock times to seconds.
     u, y : (N, m) controls as commanded, (N, p) measurements as recorded (NaN marks a dropout).
     x : (N, n) true states, or an (N, 0) array when unknown.
     d : (N, nd) disturbances, or (N, 0).
@@ -260,7 +278,7 @@ class Trace:
     valid: np.ndarray | None = None
 
     def __post_init__(self) -> None:
-        t = _numbers("trace time t", self.t)
+        t = _time(self.t)
         if t.ndim == 2 and 1 in t.shape:
             t = t.ravel()
         if t.ndim != 1:
