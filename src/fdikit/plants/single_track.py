@@ -20,6 +20,20 @@ stiffnesses ``C_f, C_r`` are **negative** (Table 4-1; the tyre force is ``F_y = 
 with physical stiffness ``-C > 0``), which is the sign convention under which (B.8) as
 printed is the standard, stable bicycle model.
 
+Production cars also measure the lateral acceleration and (on test vehicles) the side slip;
+``outputs=`` selects among :data:`SENSORS` (default :data:`OUTPUTS`, as before)::
+
+    a_y  = V_y' + V_x r = V_x (β' + r)          (β = V_y / V_x at constant V_x)
+         = (C_f + C_r)/(m V_x) V_y + (C_f l_f - C_r l_r)/(m V_x) r - C_f/m delta + g sin(phi)
+    beta = V_y / V_x
+
+``a_y`` is the first row of the state equation plus ``V_x r``, so it has the feedthrough
+``D = -C_f/m`` from the steering and ``g`` from ``sin(phi)`` — the kinematic acceleration of the
+path, as the ``lateral_acceleration`` of the nonlinear car (:mod:`fdikit.vehicle.dynamics`).  A body-fixed
+accelerometer on a banked road reads the specific force ``a_y - g sin(phi)`` (the tyre forces over
+``m``): drop the bank column if you model it.  Being an output equation, ``a_y`` is the same for the
+continuous and the ZOH-sampled model.
+
 Provenance: (B.8)–(B.11) of the thesis; (B.12) itself is garbled in the seed (``B``
 printed with 5 entries and without ``/I_z``, ``B_d`` missing a zero, ``C`` printed 4 x 4
 with a repeated row).  The matrices above are a reconstruction (fdikit's) that agrees with (B.8)–(B.11): heading
@@ -36,6 +50,7 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -51,14 +66,20 @@ __all__ = [
     "single_track",
     "single_track_lpv",
     "understeer_gradient",
+    "sensor_selection",
     "STATES",
     "OUTPUTS",
+    "SENSORS",
     "CONTROLS",
     "DISTURBANCES",
 ]
 
 STATES: tuple[str, ...] = ("lateral_velocity", "yaw_rate", "lateral_error", "heading_error")
+#: The default outputs: yaw rate and the camera's lane errors (eq. (B.12)).
 OUTPUTS: tuple[str, ...] = ("yaw_rate", "lateral_error", "heading_error")
+#: Every output ``outputs=`` may select: :data:`OUTPUTS`, the lateral acceleration ``a_y = V_x (β' + r)`` [m/s²]
+#: and the side-slip angle ``β = V_y / V_x`` [rad] (the names of :mod:`fdikit.plants.varrier_lateral`).
+SENSORS: tuple[str, ...] = OUTPUTS + ("lateral_acceleration", "sideslip")
 CONTROLS: tuple[str, ...] = ("steering",)
 #: Road curvature kappa (1/m) and the sine of the road bank angle (sin(phi), dimensionless).
 DISTURBANCES: tuple[str, ...] = ("curvature", "bank")
@@ -170,7 +191,10 @@ def understeer_gradient(params: SingleTrackParameters = PRIUS_2010) -> float:
     return m_f / -params.C_f - m_r / -params.C_r
 
 
-def single_track(speed: float, params: SingleTrackParameters = PRIUS_2010, dt: float | None = None) -> FaultModel:
+def single_track(
+    speed: float, params: SingleTrackParameters = PRIUS_2010, dt: float | None = None, *,
+    outputs: Sequence[str] | None = None,
+) -> FaultModel:
     """Single-track lateral model with lane errors at a constant speed (van der Ploeg 2018, (B.12)).
 
     Parameters
@@ -182,19 +206,25 @@ def single_track(speed: float, params: SingleTrackParameters = PRIUS_2010, dt: f
     dt : float, optional
         If given, the model is sampled with a zero-order hold at this period (s), as the
         thesis does in (4.5) with ``h = 0.01``; otherwise it is continuous.
+    outputs : sequence of str, optional
+        Measured signals, in this order, from :data:`SENSORS`: ``yaw_rate`` [rad/s],
+        ``lateral_error`` [m], ``heading_error`` [rad], ``lateral_acceleration`` [m/s²]
+        (``a_y = V_x (β' + r)``, with feedthrough from ``steering`` and ``bank``) and
+        ``sideslip`` [rad] (``β = V_y / V_x``).  Default :data:`OUTPUTS` (the thesis' three).
 
     Returns
     -------
     FaultModel
         States ``lateral_velocity`` (m/s), ``yaw_rate`` (rad/s), ``lateral_error`` (m),
-        ``heading_error`` (rad); outputs ``yaw_rate, lateral_error, heading_error``;
-        control ``steering`` (rad); disturbances ``curvature`` (1/m) and ``bank``
+        ``heading_error`` (rad); the selected outputs (default ``yaw_rate, lateral_error,
+        heading_error``); control ``steering`` (rad); disturbances ``curvature`` (1/m) and ``bank``
         (= sin of the bank angle).
 
     Raises
     ------
     ParameterError
-        If ``speed`` is not a positive finite number (the model has ``1/V_x`` terms).
+        If ``speed`` is not a positive finite number (the model has ``1/V_x`` terms), or ``outputs``
+        is empty, repeats a name or names a signal not in :data:`SENSORS`.
 
     References
     ----------
@@ -208,13 +238,18 @@ def single_track(speed: float, params: SingleTrackParameters = PRIUS_2010, dt: f
     ('yaw_rate', 'lateral_error', 'heading_error')
     >>> round(float(single_track(70 / 3.6, dt=0.01).A[0, 0]), 6)
     0.919689
+    >>> m = single_track(20.0, outputs=["yaw_rate", "lateral_acceleration", "sideslip"])
+    >>> round(float(m.Du[1, 0]), 3), float(m.Dd[1, 1]), float(m.C[2, 0])   # -C_f/m, g, 1/V_x
+    (72.0, 9.81, 0.05)
     """
     v = _speed(speed)
     if not isinstance(params, SingleTrackParameters):
         raise ParameterError(f"params must be a SingleTrackParameters, got {type(params).__name__}")
-    A, Bu, Bd, C = _continuous_matrices(v, params)
+    names = sensor_selection(outputs)
+    A, Bu, Bd, _ = _continuous_matrices(v, params)
+    C, Du, Dd = _output_matrices(v, params, names)
     model = FaultModel(
-        A, C, Bu=Bu, Bd=Bd, states=STATES, outputs=OUTPUTS, controls=CONTROLS, disturbances=DISTURBANCES
+        A, C, Bu=Bu, Bd=Bd, Du=Du, Dd=Dd, states=STATES, outputs=names, controls=CONTROLS, disturbances=DISTURBANCES
     )
     return model if dt is None else model.discretize(dt)
 
@@ -249,6 +284,64 @@ def _continuous_matrices(v, p: SingleTrackParameters) -> tuple[np.ndarray, np.nd
     Bd[..., 0, 1], Bd[..., 3, 0] = p.g, v
     C = np.broadcast_to(np.array([[0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]]), v.shape + (3, 4))
     return A, Bu, Bd, np.array(C)
+
+
+def sensor_selection(outputs: Sequence[str] | None = None) -> tuple[str, ...]:
+    """The checked output names of a single-track model: ``outputs`` as a tuple, or :data:`OUTPUTS` if None.
+
+    Parameters
+    ----------
+    outputs : sequence of str, optional
+        Names from :data:`SENSORS` (a single string is one name).
+
+    Returns
+    -------
+    tuple of str
+
+    Raises
+    ------
+    ParameterError
+        If the selection is empty, repeats a name or names an unknown signal.
+
+    References
+    ----------
+    van der Ploeg 2018, App. B-2, (B.12) (the default outputs).
+
+    Examples
+    --------
+    >>> sensor_selection(), sensor_selection("lateral_acceleration")
+    (('yaw_rate', 'lateral_error', 'heading_error'), ('lateral_acceleration',))
+    """
+    if outputs is None:
+        return OUTPUTS
+    names = (outputs,) if isinstance(outputs, str) else tuple(outputs)
+    if not names:
+        raise ParameterError(f"outputs must name at least one signal of {list(SENSORS)}; omit it for {list(OUTPUTS)}")
+    for name in names:
+        validate.choice("outputs", name, SENSORS)
+    if len(set(names)) != len(names):
+        raise ParameterError(f"outputs repeats a signal: {list(names)}; name each of {list(SENSORS)} at most once")
+    return names
+
+
+def _output_matrices(v, p: SingleTrackParameters, names: tuple[str, ...]) -> tuple[np.ndarray, ...]:
+    """``C, D_u, D_d`` of the outputs ``names`` at speed ``v`` (a float or an array for stacks).
+
+    ``a_y = V_y' + V_x r`` is row 0 of ``[A B B_d]`` plus ``V_x`` on ``r``; ``β = V_y / V_x``.
+    """
+    v = np.asarray(v, dtype=float)
+    shape = v.shape + (len(names),)
+    C, Du, Dd = np.zeros(shape + (4,)), np.zeros(shape + (1,)), np.zeros(shape + (2,))
+    for i, name in enumerate(names):
+        if name in STATES:
+            C[..., i, STATES.index(name)] = 1.0
+        elif name == "lateral_acceleration":
+            C[..., i, 0] = (p.C_f + p.C_r) / (p.m * v)
+            C[..., i, 1] = (p.C_f * p.l_f - p.C_r * p.l_r) / (p.m * v)
+            Du[..., i, 0], Dd[..., i, 1] = -p.C_f / p.m, p.g
+        else:  # sideslip
+            C[..., i, 0] = 1.0 / v
+    return C, Du, Dd
 
 
 def _expm(M: np.ndarray) -> np.ndarray:
@@ -316,6 +409,15 @@ class SingleTrackLPV:
         Sample time ``h`` in s (default 0.01, as in the thesis).
     steering_fault : bool
         Add the additive steering fault input ``steering_actuator`` (default True).
+    outputs : tuple of str
+        The measured signals, from :data:`SENSORS` (default :data:`OUTPUTS`); with
+        ``lateral_acceleration`` the members have the feedthrough ``D`` of :func:`single_track`.
+
+    Raises
+    ------
+    ParameterError
+        On construction: ``params`` not a :class:`SingleTrackParameters`, ``dt`` not positive, or
+        a bad ``outputs`` selection (see :func:`single_track`).
 
     References
     ----------
@@ -329,11 +431,14 @@ class SingleTrackLPV:
     (('steering_actuator',), 0.01)
     >>> round(float(model.A[0, 0]), 6)
     0.919689
+    >>> single_track_lpv(outputs=("yaw_rate", "lateral_acceleration"))(20.0).outputs
+    ('yaw_rate', 'lateral_acceleration')
     """
 
     params: SingleTrackParameters = PRIUS_2010
     dt: float = 0.01
     steering_fault: bool = True
+    outputs: tuple[str, ...] = OUTPUTS
 
     def __post_init__(self) -> None:
         if not isinstance(self.params, SingleTrackParameters):
@@ -342,10 +447,23 @@ class SingleTrackLPV:
         if not dt > 0:
             raise ParameterError(f"dt must be a positive sample time in s (the thesis uses 0.01), got {self.dt!r}")
         object.__setattr__(self, "dt", dt)
+        object.__setattr__(self, "outputs", sensor_selection(self.outputs))
 
     def matrices(self, speed: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Read-only ``(𝒜, ℬ, ℬ_d, C)`` at ``speed`` (m/s): the sampled (4.5) matrices, cached."""
-        return _sampled_matrices(_speed(speed), self.params, self.dt)
+        """Read-only ``(𝒜, ℬ, ℬ_d, C)`` at ``speed`` (m/s): the sampled (4.5) matrices, cached.
+
+        ``C`` of the selected :attr:`outputs`; their feedthrough is :meth:`feedthrough`.
+        """
+        v = _speed(speed)
+        A, Bu, Bd, _ = _sampled_matrices(v, self.params, self.dt)
+        return A, Bu, Bd, self._outputs_at(v)[0]
+
+    def feedthrough(self, speed: float) -> tuple[np.ndarray, np.ndarray]:
+        """Read-only ``(D_u, D_d)`` of the selected :attr:`outputs` at ``speed`` (m/s) (zero for the default three)."""
+        return self._outputs_at(_speed(speed))[1:]
+
+    def _outputs_at(self, v: float) -> tuple[np.ndarray, ...]:
+        return _output_rows(v, self.params, self.outputs)
 
     def state_space(self, speed) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Stacks ``(𝒜, [ℬ ℬ_d], C, 0)`` at every speed of an array (m/s), in one batched exponential.
@@ -357,45 +475,62 @@ class SingleTrackLPV:
         v = np.atleast_1d(np.asarray(speed, dtype=float))
         if v.ndim != 1 or not np.all(np.isfinite(v) & (v > 0)):
             raise ParameterError("speeds must be a 1-D array of positive finite longitudinal speeds in m/s")
-        A, Bu, Bd, C = _zoh(v, self.params, self.dt)
-        return A, np.concatenate([Bu, Bd], axis=-1), C, np.zeros(C.shape[:-1] + (3,))
+        A, Bu, Bd, _ = _zoh(v, self.params, self.dt)
+        C, Du, Dd = _output_matrices(v, self.params, self.outputs)
+        return A, np.concatenate([Bu, Bd], axis=-1), C, np.concatenate([Du, Dd], axis=-1)
 
     def __call__(self, speed: float) -> FaultModel:
         """The discrete model at ``speed`` (m/s)."""
         A, Bu, Bd, C = self.matrices(speed)
-        faults = {"Bf": Bu, "faults": [actuator_fault_name(c) for c in CONTROLS]} if self.steering_fault else {}
+        Du, Dd = self.feedthrough(speed)
+        faults = ({"Bf": Bu, "Df": Du, "faults": [actuator_fault_name(c) for c in CONTROLS]}
+                  if self.steering_fault else {})
         return FaultModel(
-            A, C, Bu=Bu, Bd=Bd, states=STATES, outputs=OUTPUTS, controls=CONTROLS, disturbances=DISTURBANCES,
-            dt=self.dt, **faults,
+            A, C, Bu=Bu, Bd=Bd, Du=Du, Dd=Dd, states=STATES, outputs=self.outputs, controls=CONTROLS,
+            disturbances=DISTURBANCES, dt=self.dt, **faults,
         )
 
     def dae_matrices(self, speed: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """``(H_0, H_1, L, F)`` of the DAE (4.17) at ``speed`` (m/s): ``(H_0 + H_1 q) x + L z + F f = 0``.
 
-        ``x = [V_y, r, y_e, ψ_e, κ, sin φ]``, ``z = [r, y_e, ψ_e, δ_set]`` (outputs, then the
-        steering command), ``f`` the steering fault (``f_a``, or ``(f_m − 1) δ_set``)::
+        ``x = [V_y, r, y_e, ψ_e, κ, sin φ]``, ``z = [y; δ_set]`` (the selected outputs, then the
+        steering command; default ``[r, y_e, ψ_e, δ_set]``), ``f`` the steering fault (``f_a``, or
+        ``(f_m − 1) δ_set``)::
 
-            H_0 = [[𝒜, ℬ_d], [C, 0]],  H_1 = [[−I, 0], [0, 0]],  L = [[0, ℬ], [−I, 0]],  F = [ℬ; 0]
+            H_0 = [[𝒜, ℬ_d], [C, D_d]],  H_1 = [[−I, 0], [0, 0]],  L = [[0, ℬ], [−I, D_u]],  F = [ℬ; D_u]
+
+        (``D_u = D_d = 0`` for the default outputs, as printed in (4.17)).
         """
-        return _dae_matrices(_speed(speed), self.params, self.dt)
+        return _dae_matrices(_speed(speed), self.params, self.dt, self.outputs)
 
 
 @functools.lru_cache(maxsize=8192)
-def _dae_matrices(v: float, p: SingleTrackParameters, dt: float) -> tuple[np.ndarray, ...]:
-    A, Bu, Bd, C = _sampled_matrices(v, p, dt)
+def _output_rows(v: float, p: SingleTrackParameters, names: tuple[str, ...]) -> tuple[np.ndarray, ...]:
+    out = _output_matrices(np.float64(v), p, names)
+    for arr in out:
+        arr.setflags(write=False)
+    return out
+
+
+@functools.lru_cache(maxsize=8192)
+def _dae_matrices(v: float, p: SingleTrackParameters, dt: float, names: tuple[str, ...] = OUTPUTS
+                  ) -> tuple[np.ndarray, ...]:
+    A, Bu, Bd, _ = _sampled_matrices(v, p, dt)
+    C, Du, Dd = _output_rows(v, p, names)
     n, ny, nd = A.shape[0], C.shape[0], Bd.shape[1]
     H0, H1 = np.zeros((n + ny, n + nd)), np.zeros((n + ny, n + nd))
-    H0[:n, :n], H0[:n, n:], H0[n:, :n] = A, Bd, C
+    H0[:n, :n], H0[:n, n:], H0[n:, :n], H0[n:, n:] = A, Bd, C, Dd
     H1[:n, :n] = -np.eye(n)
     L, F = np.zeros((n + ny, ny + 1)), np.zeros((n + ny, 1))
-    L[:n, ny:], L[n:, :ny], F[:n] = Bu, -np.eye(ny), Bu
+    L[:n, ny:], L[n:, :ny], L[n:, ny:], F[:n], F[n:] = Bu, -np.eye(ny), Du, Bu, Du
     for arr in (H0, H1, L, F):
         arr.setflags(write=False)
     return H0, H1, L, F
 
 
 def single_track_lpv(
-    params: SingleTrackParameters = PRIUS_2010, dt: float = 0.01, steering_fault: bool = True
+    params: SingleTrackParameters = PRIUS_2010, dt: float = 0.01, steering_fault: bool = True, *,
+    outputs: Sequence[str] | None = None,
 ) -> SingleTrackLPV:
     """The speed-scheduled single-track family ``speed (m/s) -> discrete FaultModel`` (van der Ploeg 2018, (4.17)).
 
@@ -410,6 +545,8 @@ def single_track_lpv(
         Sample time ``h`` [s].
     steering_fault : bool, default True
         Give each member the additive steering fault input ``steering_actuator``.
+    outputs : sequence of str, optional
+        Measured signals from :data:`SENSORS` (default :data:`OUTPUTS`), as in :func:`single_track`.
 
     Returns
     -------
@@ -419,7 +556,8 @@ def single_track_lpv(
     Raises
     ------
     ParameterError
-        If ``params`` is not a :class:`SingleTrackParameters` or ``dt`` is not a positive number.
+        If ``params`` is not a :class:`SingleTrackParameters`, ``dt`` is not a positive number or
+        ``outputs`` is a bad selection.
 
     References
     ----------
@@ -431,4 +569,4 @@ def single_track_lpv(
     >>> family(20.0).dt, family.dae_matrices(20.0)[0].shape
     (0.02, (7, 6))
     """
-    return SingleTrackLPV(params, dt, steering_fault)
+    return SingleTrackLPV(params, dt, steering_fault, sensor_selection(outputs))
