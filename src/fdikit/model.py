@@ -32,6 +32,7 @@ import scipy.linalg
 
 from fdikit import validate
 from fdikit.errors import ModelError, ParameterError
+from fdikit.operating_point import OperatingPoint
 
 __all__ = [
     "FaultModel",
@@ -147,6 +148,10 @@ class FaultModel:
         ``f0, ...``, ``w0, ...``.
     dt : float, optional
         Sample time for a discrete model; ``None`` (default) for continuous time.
+    operating_point : OperatingPoint, optional
+        The absolute ``(x0, u0, y0)`` the deviation model holds about
+        (:class:`fdikit.operating_point.OperatingPoint`; :meth:`with_operating_point` sets it).
+        Generators designed from the model inherit it and run on absolute signals.
 
     Raises
     ------
@@ -170,6 +175,7 @@ class FaultModel:
     outputs: tuple[str, ...]
     inputs: dict[str, tuple[str, ...]]
     dt: float | None = None
+    operating_point: OperatingPoint | None = None
 
     def __init__(
         self,
@@ -191,6 +197,7 @@ class FaultModel:
         faults: Sequence[str] | None = None,
         noise: Sequence[str] | None = None,
         dt: float | None = None,
+        operating_point: OperatingPoint | None = None,
     ) -> None:
         A = _matrix("A", A, None, None)
         n = A.shape[0]
@@ -231,6 +238,10 @@ class FaultModel:
         object.__setattr__(self, "outputs", _names("output", outputs, p, "y"))
         object.__setattr__(self, "inputs", groups)
         object.__setattr__(self, "dt", dt)
+        if operating_point is not None and not isinstance(operating_point, OperatingPoint):
+            raise ModelError(f"operating_point must be a fdikit.operating_point.OperatingPoint, got "
+                             f"{type(operating_point).__name__}; use model.with_operating_point(x0=, u0=, y0=)")
+        object.__setattr__(self, "operating_point", operating_point)
 
     # ------------------------------------------------------------------ sizes and blocks
     @property
@@ -294,8 +305,37 @@ class FaultModel:
     def _blocks(self) -> dict[str, np.ndarray]:
         return {f"{m}{g}": getattr(self, f"{m}{g}") for g in GROUPS for m in "BD"}
 
-    def _names_kw(self) -> dict[str, tuple[str, ...]]:
-        return {_GROUP_WORD[g]: self.inputs[g] for g in GROUPS} | {"states": self.states, "outputs": self.outputs}
+    def _names_kw(self) -> dict:
+        return {_GROUP_WORD[g]: self.inputs[g] for g in GROUPS} | {
+            "states": self.states, "outputs": self.outputs, "operating_point": self.operating_point}
+
+    def with_operating_point(self, x0=None, u0=None, y0=None) -> FaultModel:
+        """A copy that holds about the absolute operating point ``(x0, u0, y0)``.
+
+        Parameters
+        ----------
+        x0, u0, y0 : array_like or mapping, optional
+            One value per state / control / output in the model's order, or ``{name: value}`` for
+            some of them (the others 0); omitted means 0.
+
+        Returns
+        -------
+        FaultModel
+            The same matrices (deviation coordinates) with ``operating_point`` set.
+
+        Raises
+        ------
+        ParameterError
+            For a vector of the wrong length, an unknown name or a non-finite value.
+
+        Examples
+        --------
+        >>> m = FaultModel([[-1.0]], [[1.0]], Bu=[[1.0]], controls=["u"], outputs=["y"])
+        >>> m.with_operating_point(u0=[2.0], y0={"y": 2.0}).operating_point.y0
+        {'y': 2.0}
+        """
+        op = OperatingPoint.from_vectors(self.states, self.controls, self.outputs, x0, u0, y0)
+        return self.replace(operating_point=op)
 
     def replace(self, **changes) -> FaultModel:
         """A copy with some constructor arguments changed (e.g. ``Bf=..., faults=...``).
@@ -434,7 +474,8 @@ class FaultModel:
         if outputs is not None:
             rows = self.index("outputs", outputs)
             C, D, kw["outputs"] = C[rows], D[rows], tuple(self.outputs[i] for i in rows)
-        new = {"A": self.A, "C": C, "dt": self.dt, "states": self.states, "outputs": kw["outputs"]}
+        new = {"A": self.A, "C": C, "dt": self.dt, "states": self.states, "outputs": kw["outputs"],
+               "operating_point": self.operating_point}
         keep = None if inputs is None else set(inputs)
         if keep is not None:
             known = {nm for g in GROUPS for nm in self.inputs[g]}
@@ -547,28 +588,9 @@ class FaultModel:
         Raises :class:`ModelError` if ``sys`` is no :class:`control.StateSpace`, a named input does not
         exist, or the sample time is unspecified (``dt=True``).
         """
-        import control
+        from fdikit.model_interop import model_from_control
 
-        if not isinstance(sys, control.StateSpace):
-            raise ModelError(f"from_control needs a control.StateSpace, got {type(sys).__name__}; use control.ss(...)")
-        in_names = list(sys.input_labels)
-        others = list(disturbances) + list(faults) + list(noise)
-        if controls is None:
-            controls = [nm for nm in in_names if nm not in others]
-        groups = {"u": list(controls), "d": list(disturbances), "f": list(faults), "w": list(noise)}
-        kw: dict = {}
-        for g, names in groups.items():
-            missing = [nm for nm in names if nm not in in_names]
-            if missing:
-                raise ModelError(f"the system has no input named {missing}; its inputs are {in_names}")
-            cols = [in_names.index(nm) for nm in names]
-            kw[f"B{g}"] = np.asarray(sys.B)[:, cols]
-            kw[f"D{g}"] = np.asarray(sys.D)[:, cols]
-            kw[_GROUP_WORD[g]] = names
-        dt = None if not sys.dt else (None if sys.dt is True else float(sys.dt))
-        if sys.dt is True:
-            raise ModelError("the system is discrete with an unspecified sample time (dt=True); give it a number")
-        return cls(A=sys.A, C=sys.C, states=list(sys.state_labels), outputs=list(sys.output_labels), dt=dt, **kw)
+        return model_from_control(cls, sys, controls=controls, disturbances=disturbances, faults=faults, noise=noise)
 
     def __repr__(self) -> str:
         kind = "continuous" if self.dt is None else f"discrete dt={self.dt:g}"

@@ -20,21 +20,21 @@ The series they return, :class:`~fdikit.residuals.series.Residuals`, is :mod:`fd
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 
 from fdikit import validate
 from fdikit.errors import DataError, ModelError, ParameterError
 from fdikit.gaps import GapRule, Recovery, gap_options
 from fdikit.lti import dlsim_blocked
 from fdikit.model import GROUPS, FaultModel
+from fdikit.operating_point import OperatingPoint
 from fdikit.residuals.series import Residuals
 from fdikit.trace import Trace, check_signals
 
-__all__ = ["ResidualGenerator", "ResidualStepper", "stack_generators"]
+__all__ = ["ResidualGenerator", "ResidualStepper"]
 
 
 def _mat(name, value, shape):
@@ -63,12 +63,18 @@ class ResidualGenerator:
         with a zero-order hold at the trace's sample time).
     isolates : sequence of (str or None), optional
         The fault each residual is tied to; None for a residual that only detects.
+    operating_point : OperatingPoint, optional
+        The absolute operating point of the model the filter was designed from
+        (:class:`fdikit.operating_point.OperatingPoint`).  The filter reads deviations: ``run`` and
+        ``online().step`` take ABSOLUTE signals and subtract ``u0`` / ``y0`` of the signals read.
+        None (default) means the signals are deviations already.
 
     Raises
     ------
     ModelError
         If a matrix is not finite or its shape does not match the filter order, the signals and the
-        residuals, ``isolates`` has the wrong length, or ``dt`` is not positive.
+        residuals, ``isolates`` has the wrong length, ``dt`` is not positive or ``operating_point`` is
+        not an OperatingPoint.
 
     Examples
     --------
@@ -93,6 +99,7 @@ class ResidualGenerator:
     residuals: tuple[str, ...]
     dt: float | None = None
     isolates: tuple[str | None, ...] = ()
+    operating_point: OperatingPoint | None = None
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
@@ -111,6 +118,21 @@ class ResidualGenerator:
         set_(self, "isolates", iso)
         if self.dt is not None and not self.dt > 0:
             raise ModelError(f"dt must be positive or None, got {self.dt}")
+        op = self.operating_point
+        if op is not None:
+            if not isinstance(op, OperatingPoint):
+                raise ModelError(f"operating_point must be a fdikit.operating_point.OperatingPoint, got "
+                                 f"{type(op).__name__}")
+            set_(self, "operating_point", op.restricted(self.controls, self.outputs))
+        offset = np.zeros(nv) if op is None else np.concatenate(
+            [op.control_values(self.controls), op.output_values(self.outputs)])
+        offset.setflags(write=False)
+        set_(self, "offset", offset)
+
+    @property
+    def signals(self) -> tuple[str, ...]:
+        """The signals read, controls then outputs (the columns of ``B`` and ``D``)."""
+        return self.controls + self.outputs
 
     @property
     def n(self) -> int:
@@ -124,7 +146,8 @@ class ResidualGenerator:
         if self.dt is not None:
             raise ModelError(f"the generator is already discrete (dt={self.dt})")
         Ad, Bd, Cd, Dd, _ = scipy.signal.cont2discrete((self.A, self.B, self.C, self.D), dt, method="zoh")
-        return ResidualGenerator(Ad, Bd, Cd, Dd, self.controls, self.outputs, self.residuals, dt, self.isolates)
+        return ResidualGenerator(Ad, Bd, Cd, Dd, self.controls, self.outputs, self.residuals, dt, self.isolates,
+                                 self.operating_point)
 
     def _check_dt(self, dt: float) -> None:
         if self.dt is not None and not np.isclose(dt, self.dt, rtol=1e-6):
@@ -148,9 +171,19 @@ class ResidualGenerator:
         check_signals(trace, self.controls, self.outputs)
 
     def inputs_from(self, trace: Trace) -> np.ndarray:
-        """The (N, m + p) block ``[u, y]`` this generator reads, taken from a trace by name."""
+        """The (N, m + p) block ``[u − u0, y − y0]`` this generator reads, taken from a trace by name.
+
+        The deviations from the generator's operating point (none: the trace's values); the rows of the
+        samples the trace flags invalid (``trace.valid`` False: a gap, a bad status) are NaN.
+        """
+        return self.absolute_inputs(trace) - self.offset
+
+    def absolute_inputs(self, trace: Trace) -> np.ndarray:
+        """The (N, m + p) block ``[u, y]`` as the trace holds it, NaN on the samples it flags invalid."""
         self.check_trace(trace)
-        return np.hstack([trace.columns("u", self.controls), trace.columns("y", self.outputs)])
+        v = np.hstack([trace.columns("u", self.controls), trace.columns("y", self.outputs)])
+        v[~trace.valid] = np.nan
+        return v
 
     def run(
         self, trace: Trace, x0: np.ndarray | None = None, *, residual_cov=None, recovery_tol: float = 0.1
@@ -369,7 +402,8 @@ class ResidualStepper:
       to their ``step``).
 
     ``step`` accepts the values as sequences in the generator's ``controls``/``outputs`` order,
-    or as mappings ``{name: value}`` which are checked against those names.
+    or as mappings ``{name: value}`` which are checked against those names; they are absolute
+    signals when the generator carries an operating point (its ``u0``, ``y0`` are subtracted).
 
     Parameters
     ----------
@@ -465,6 +499,7 @@ class ResidualStepper:
                 f"step() got {v.size} values; need {len(g.controls)} controls {list(g.controls)} "
                 f"and {len(g.outputs)} outputs {list(g.outputs)}"
             )
+        v = v - g.offset
         ok_ch = np.isfinite(v)
         if not ok_ch.all():
             self.invalid += 1
@@ -489,7 +524,7 @@ class ResidualStepper:
             raise DataError(f"trace must be a fdikit.trace.Trace, got {type(trace).__name__}")
         if len(trace) > 1:
             g._check_dt(trace.dt)
-        v = g.inputs_from(trace)
+        v = g.absolute_inputs(trace)
         mu = len(g.controls)
         r = np.empty((len(trace), len(g.residuals)))
         valid = np.empty(len(trace), bool)
@@ -500,64 +535,3 @@ class ResidualStepper:
             recovering[k] = self.last_recovering
         return Residuals(trace.t, r, g.residuals, g.isolates, valid, meta={"trace": dict(trace.meta)},
                          recovering=recovering)
-
-
-def stack_generators(generators: Iterable[ResidualGenerator]) -> ResidualGenerator:
-    """One generator from several: block-diagonal filter states, concatenated residuals.
-
-    Every generator must read the same controls and outputs in the same order and share
-    ``dt``; residual names must be unique across them.
-
-    Parameters
-    ----------
-    generators : iterable of ResidualGenerator
-        The filters of the bank.
-
-    Returns
-    -------
-    ResidualGenerator
-        States, residuals and ``isolates`` of all generators in the given order.
-
-    Raises
-    ------
-    ModelError
-        On an empty list, different signals, different ``dt`` or a repeated residual name.
-
-    Examples
-    --------
-    >>> g = ResidualGenerator([[0.4]], [[1.0, 0.5]], [[-1.0]], [[0.0, 1.0]], ("u",), ("y",), ("r",), dt=1.0)
-    >>> bank = stack_generators([g, g.__class__(g.A, g.B, g.C, g.D, ("u",), ("y",), ("r2",), dt=1.0)])
-    >>> bank.n, bank.residuals
-    (2, ('r', 'r2'))
-    """
-    gens = list(generators)
-    if not gens:
-        raise ModelError("stack_generators needs at least one generator")
-    for i, g in enumerate(gens):
-        if not isinstance(g, ResidualGenerator):
-            raise ModelError(f"item {i} is a {type(g).__name__}, not a ResidualGenerator (use design.generator)")
-    g0 = gens[0]
-    for i, g in enumerate(gens[1:], start=1):
-        if g.controls != g0.controls or g.outputs != g0.outputs:
-            raise ModelError(
-                f"generator {i} reads controls {list(g.controls)} and outputs {list(g.outputs)}, generator 0 reads "
-                f"{list(g0.controls)} and {list(g0.outputs)}; stacked generators must read the same signals in "
-                "the same order"
-            )
-        if g.dt != g0.dt:
-            raise ModelError(f"generator {i} has dt={g.dt}, generator 0 dt={g0.dt}; discretize them alike first")
-    names = [nm for g in gens for nm in g.residuals]
-    dup = sorted({nm for nm in names if names.count(nm) > 1})
-    if dup:
-        raise ModelError(f"residual names {dup} occur in more than one generator; names must be unique")
-    return ResidualGenerator(
-        A=scipy.linalg.block_diag(*[g.A for g in gens]),
-        B=np.vstack([g.B for g in gens]),
-        C=scipy.linalg.block_diag(*[g.C for g in gens]),
-        D=np.vstack([g.D for g in gens]),
-        controls=g0.controls,
-        outputs=g0.outputs,
-        residuals=tuple(names),
-        dt=g0.dt,
-        isolates=tuple(iso for g in gens for iso in g.isolates),
-    )
