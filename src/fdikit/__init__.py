@@ -7,7 +7,8 @@ The layers, from data to decisions (``docs/ARCHITECTURE.md``):
 * signals — :mod:`fdikit.faults` (+ :mod:`fdikit.fault_spec`), :mod:`fdikit.simulate`, :mod:`fdikit.trace`
   (+ :mod:`fdikit.trace_io`), :mod:`fdikit.gaps`;
 * residual generation — :mod:`fdikit.design` (observers, game, parity families), :mod:`fdikit.residuals`;
-* decisions — :mod:`fdikit.decision` (evaluators), :mod:`fdikit.multimodel` (banks of estimators),
+* decisions — :mod:`fdikit.decision` (evaluators), :mod:`fdikit.detector` (a deployable detector, saved by
+  :mod:`fdikit.detector_file`), :mod:`fdikit.multimodel` (banks of estimators),
   :mod:`fdikit.estimate` (fault sizes), :mod:`fdikit.diagnosis`, :mod:`fdikit.metrics`, :mod:`fdikit.compare`;
 * analysis and plots — :mod:`fdikit.analysis`, :mod:`fdikit.linalg` (+ :mod:`fdikit.linalg.subspaces`,
   :mod:`fdikit.fault_maps`), :mod:`fdikit.plots`;
@@ -23,6 +24,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
     submodules=["analysis", "decision", "design", "estimate", "multimodel", "plants", "studies"],
     submod_attrs={
         "errors": ["DataError", "DesignError", "FdiError", "FdiWarning", "ModelError", "ParameterError"],
+        "detector": ["Detector", "DetectorStepper"],
         "model": ["FaultModel"],
     },
 )
