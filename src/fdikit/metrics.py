@@ -8,11 +8,21 @@ Definitions (one trace):
 * **detection** is the first sample at or after the onset where the fault is active
   and the alarm is on; the **delay** is its time minus the onset;
 * a **missed detection** is a faulty trace never detected while the fault is active;
-* the **isolated** fault is the label other than ``'unknown'`` named most often while the
-  fault is active and the alarm on (the earliest on a tie; ``'unknown'`` if there is none) —
-  a transient confusion, such as the air-mass fault rate leaking into the throttle
-  residual (Douglas et al. 1996, Fig. 5.5), does not decide the isolation;
-  isolation is correct when it equals the fault label.
+* the **isolated** fault is the label named most often while the fault is active and the alarm
+  on, ``'unknown'`` included (the earliest on a tie) — a transient confusion, such as the air-mass
+  fault rate leaking into the throttle residual (Douglas et al. 1996, Fig. 5.5), does not decide the
+  isolation, but an alarm that is ``'unknown'`` most of the time is not a correct isolation;
+  isolation is correct when it equals the fault label (``'unknown'`` never counts as correct);
+* the **correct fraction** is the fraction of those alarmed samples on which the right fault is named;
+* the **faulty interval** runs from the onset to the last sample of the first unbroken stretch of the
+  fault label; the **isolation delay** is the time from the onset to the first sample at which the
+  right fault is named *and held*: named on every valid sample (``Diagnosis.valid``) from then to the
+  end of the faulty interval — or, with ``hold=`` seconds, on every valid sample from then until
+  ``hold`` seconds later or the end of the faulty interval, whichever comes first.  None when the
+  right fault is never named and held.
+
+The false-alarm rate of a count observed over a given time has the exact Poisson (Garwood)
+interval of :func:`rate_interval`.
 """
 
 from __future__ import annotations
@@ -28,7 +38,7 @@ from fdikit.errors import DataError, ParameterError
 from fdikit.faults import NO_FAULT
 from fdikit.trace import Trace
 
-__all__ = ["Score", "Summary", "score", "summarize", "confusion_matrix", "vaf", "MISSED"]
+__all__ = ["Score", "Summary", "score", "summarize", "confusion_matrix", "rate_interval", "vaf", "MISSED"]
 
 #: Column of the confusion matrix for a faulty trace that was never detected.
 MISSED = "missed"
@@ -55,10 +65,16 @@ class Score:
     missed : bool
         A faulty trace never detected while the fault is active.
     isolated : str
-        The isolated fault: the most frequent named label while detected, ``'unknown'``, or ``'none'`` (missed);
-        for a healthy trace the isolation of its first false alarm (``'none'`` without one).
+        The isolated fault: the most frequent label (``'unknown'`` included) while detected, or ``'none'``
+        (missed); for a healthy trace the isolation of its first false alarm (``'none'`` without one).
     isolation_correct : bool or None
-        ``isolated == label`` for a faulty trace (False when missed); None for a healthy one.
+        ``isolated == label`` for a faulty trace (False when missed or ``'unknown'``); None for a healthy one.
+    isolation_delay : float or None
+        Time from the onset until the right fault is named and held [s] (module docstring); None when it
+        never is, or for a healthy trace.
+    correct_fraction : float or None
+        Fraction of the alarmed samples while the fault is active that name the right fault; None when not
+        detected, or for a healthy trace.
     false_alarm_rate : float
         False alarms per hour of fault-free time (NaN without fault-free time).
     outcome : str
@@ -72,8 +88,8 @@ class Score:
     >>> fired = np.array([[0, 0], [1, 0], [0, 0], [0, 0], [0, 0], [1, 0], [1, 0], [1, 0]], dtype=bool)
     >>> d = Diagnosis(np.arange(8) * 0.5, fired.any(axis=1), fired, ("ra", "rb"), isolate(fired, ("fa", "fb")))
     >>> s = score(np.array(["none"] * 4 + ["fa"] * 4), d)
-    >>> s.detected, s.detection_delay, s.false_alarms, s.isolated, s.outcome
-    (True, 0.5, 1, 'fa', 'fa')
+    >>> s.detected, s.detection_delay, s.false_alarms, s.isolated, s.outcome, s.isolation_delay
+    (True, 0.5, 1, 'fa', 'fa', 0.5)
     """
 
     label: str
@@ -85,6 +101,8 @@ class Score:
     missed: bool
     isolated: str
     isolation_correct: bool | None
+    isolation_delay: float | None = None
+    correct_fraction: float | None = None
 
     @property
     def false_alarm_rate(self) -> float:
@@ -99,7 +117,7 @@ class Score:
         return MISSED if self.missed else self.isolated
 
 
-def score(truth: Trace | np.ndarray, diagnosis: Diagnosis) -> Score:
+def score(truth: Trace | np.ndarray, diagnosis: Diagnosis, hold: float | None = None) -> Score:
     """Score one diagnosis against a trace (or its per-sample truth labels).
 
     Parameters
@@ -109,16 +127,19 @@ def score(truth: Trace | np.ndarray, diagnosis: Diagnosis) -> Score:
         (``'none'`` where healthy).
     diagnosis : Diagnosis
         An evaluator's decisions on that trace, sample for sample.
+    hold : float, optional
+        How long [s] the right fault must stay named for the isolation delay (module docstring); default
+        to the end of the faulty interval.
 
     Returns
     -------
     Score
-        Detection, delay, false alarms, missed detection and isolation of the trace.
+        Detection, delay, false alarms, missed detection, isolation and isolation delay of the trace.
 
     Raises
     ------
     ParameterError
-        When ``diagnosis`` is not a :class:`~fdikit.diagnosis.Diagnosis`.
+        When ``diagnosis`` is not a :class:`~fdikit.diagnosis.Diagnosis`, or ``hold`` is negative.
     DataError
         When the labels are not strings, not one-dimensional, or not as many as the diagnosis's samples.
 
@@ -134,6 +155,8 @@ def score(truth: Trace | np.ndarray, diagnosis: Diagnosis) -> Score:
     ('fa', 2.0, 0.5, 1800.0)
     """
     validate.instance("diagnosis", diagnosis, Diagnosis, "pass the Diagnosis an evaluator's run() returned")
+    if hold is not None:
+        hold = validate.non_negative("hold", hold)
     if isinstance(truth, Trace):
         labels = truth.fault
     else:
@@ -163,16 +186,42 @@ def score(truth: Trace | np.ndarray, diagnosis: Diagnosis) -> Score:
     hit = (~healthy) & diagnosis.alarm
     hit[:onset_idx] = False
     det = np.flatnonzero(hit)
+    end = onset_idx + int(np.argmax(np.append(labels[onset_idx:] != label, True)))  # one past the interval
+    iso_delay = _isolation_delay(t, np.asarray(diagnosis.isolated) == label, diagnosis.valid, onset_idx, end, hold)
     if det.size == 0:
-        return Score(label, onset, False, None, false_alarms, hours, True, NO_FAULT, False)
-    named = diagnosis.isolated[det][diagnosis.isolated[det] != UNKNOWN_FAULT]
-    if named.size:
-        labels, first, counts = np.unique(named, return_index=True, return_counts=True)
-        isolated = str(labels[np.lexsort((first, -counts))[0]])
-    else:
-        isolated = UNKNOWN_FAULT
+        return Score(label, onset, False, None, false_alarms, hours, True, NO_FAULT, False, iso_delay, None)
+    said = np.asarray(diagnosis.isolated)[det].astype(str)
+    names, first, counts = np.unique(said, return_index=True, return_counts=True)
+    isolated = str(names[np.lexsort((first, -counts))[0]])
+    correct = isolated == label and label != UNKNOWN_FAULT
     return Score(label, onset, True, float(t[det[0]] - onset), false_alarms, hours, False, isolated,
-                 isolated == label)
+                 correct, iso_delay, float(np.mean(said == label)))
+
+
+def _isolation_delay(t, right, valid, start: int, end: int, hold: float | None) -> float | None:
+    """Onset to the first valid sample in ``[start, end)`` naming the fault and holding it (module docstring)."""
+    idx = np.arange(start, end)
+    use = idx[valid[start:end]]
+    if use.size == 0:
+        return None
+    ok = right[use]
+    bad = use[~ok]
+    cand = use[ok]
+    if cand.size == 0:
+        return None
+    if hold is None:
+        if bad.size and bad[-1] > cand[-1]:
+            return None
+        k = cand[cand > bad[-1]][0] if bad.size else cand[0]
+    else:
+        nxt = np.searchsorted(bad, cand)  # the first wrong valid sample after each candidate
+        clear = np.ones(cand.size, bool)
+        has = nxt < bad.size
+        clear[has] = t[bad[nxt[has]]] > t[cand[has]] + hold
+        if not clear.any():
+            return None
+        k = cand[np.argmax(clear)]
+    return float(t[k] - t[start])
 
 
 @dataclass(frozen=True)
@@ -196,7 +245,13 @@ class Summary:
     false_alarm_rate : float
         False alarms per hour of fault-free time pooled over all traces [1/h].
     isolation_accuracy : float
-        Correctly isolated / detected faulty traces.
+        Correctly isolated / detected faulty traces (``'unknown'`` is never correct).
+    mean_isolation_delay, median_isolation_delay : float
+        Of the isolation delays of the faulty traces whose fault was named and held [s] (NaN when none).
+    isolation_held_rate : float
+        Faulty traces whose fault was named and held / faulty traces (NaN without faulty traces).
+    mean_correct_fraction : float
+        Mean over the detected faulty traces of the fraction of alarmed samples correctly named (NaN when none).
     confusion : pandas.DataFrame
         :func:`confusion_matrix` of the scores.
 
@@ -222,6 +277,10 @@ class Summary:
     false_alarm_rate: float
     isolation_accuracy: float
     confusion: object  # pandas.DataFrame
+    mean_isolation_delay: float = float("nan")
+    median_isolation_delay: float = float("nan")
+    isolation_held_rate: float = float("nan")
+    mean_correct_fraction: float = float("nan")
 
     def as_dict(self) -> dict:
         d = {k: getattr(self, k) for k in self.__dataclass_fields__ if k != "confusion"}
@@ -324,6 +383,8 @@ def summarize(scores: Iterable[Score]) -> Summary:
     hours = sum(s.fault_free_hours for s in scores)
     fa = sum(s.false_alarms for s in scores)
     detected = [s for s in faulty if s.detected]
+    iso = np.array([s.isolation_delay for s in faulty if s.isolation_delay is not None], dtype=float)
+    frac = np.array([s.correct_fraction for s in detected if s.correct_fraction is not None], dtype=float)
     nan = float("nan")
     return Summary(
         runs=len(scores),
@@ -336,7 +397,61 @@ def summarize(scores: Iterable[Score]) -> Summary:
         false_alarm_rate=fa / hours if hours > 0 else nan,
         isolation_accuracy=sum(bool(s.isolation_correct) for s in detected) / len(detected) if detected else nan,
         confusion=confusion_matrix(scores),
+        mean_isolation_delay=float(iso.mean()) if iso.size else nan,
+        median_isolation_delay=float(np.median(iso)) if iso.size else nan,
+        isolation_held_rate=iso.size / len(faulty) if faulty else nan,
+        mean_correct_fraction=float(np.mean(frac)) if frac.size else nan,
     )
+
+
+def rate_interval(count: int, hours: float, confidence: float = 0.95) -> tuple[float, float]:
+    """Exact Poisson (Garwood) confidence interval of an event rate from a count over a time.
+
+    For ``k`` events in ``T`` hours, with ``a = 1 − confidence``:
+
+        ``lower = χ²_{a/2}(2k) / (2T)`` (0 for ``k = 0``),  ``upper = χ²_{1−a/2}(2k + 2) / (2T)``,
+
+    ``χ²_p(ν)`` the ``p`` quantile of the chi-square distribution with ``ν`` degrees of freedom (the exact interval
+    of F. Garwood, "Fiducial limits for the Poisson distribution", Biometrika 28 (3/4): 437–442, in 1936).
+    The interval is conservative: it covers the true rate with probability at least ``confidence``.  With no
+    events, the upper end ``−ln(a/2) / T`` (``≈ 3.69 / T`` at 95 %) is the smallest rate the data can resolve.
+
+    Parameters
+    ----------
+    count : int
+        Number of events (false alarms), ``>= 0``.
+    hours : float
+        Observed time [h], positive.
+    confidence : float, default 0.95
+        Two-sided level, in (0, 1).
+
+    Returns
+    -------
+    (float, float)
+        Lower and upper end of the rate [1/h].
+
+    Raises
+    ------
+    ParameterError
+        When ``count`` is not a non-negative integer, ``hours`` is not positive, or ``confidence`` is not in (0, 1).
+
+    Examples
+    --------
+    >>> from fdikit.metrics import rate_interval
+    >>> [round(x, 4) for x in rate_interval(3, 2.0)]
+    [0.3093, 4.3836]
+    >>> round(rate_interval(0, 10.0)[1], 4)
+    0.3689
+    """
+    from scipy.stats import chi2
+
+    k = validate.integer("count", count, minimum=0)
+    T = validate.positive("hours", hours)
+    c = validate.in_range("confidence", confidence, 0.0, 1.0, closed="neither")
+    a = 1.0 - c
+    lower = float(chi2.ppf(a / 2, 2 * k)) / (2 * T) if k > 0 else 0.0
+    upper = float(chi2.ppf(1 - a / 2, 2 * k + 2)) / (2 * T)
+    return lower, upper
 
 
 def vaf(reference, estimate):

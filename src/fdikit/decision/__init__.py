@@ -31,6 +31,10 @@ given ``names=`` (or a mapping ``{name: value}``).  Bad arguments raise
   1996, §7.2).
 * :mod:`fdikit.decision.whiten` — Prewhitening of coloured residuals before a test that assumes white ones (CUSUM,
   GLR, SPRT).
+* :mod:`fdikit.decision.signature` — Isolation from a fault-signature (structure) table: the fault whose pattern
+  of residual groups fired.
+* :mod:`fdikit.decision.calibration` — Calibration on a list of fault-free runs, and the report of the false-alarm
+  rate the data support.
 * :mod:`fdikit.decision.common` — Pieces every evaluator shares: k-of-n persistence, holding decisions over bad
   samples, cached isolation, residual names checked against the fit.
 * :mod:`fdikit.decision.learned` — Learned residual classifiers (Douglas et al. 1996, Ch. 7): the Bayesian neural
@@ -67,9 +71,15 @@ __getattr__, __dir__, __all__ = lazy.attach(
         "whiten": [
             "Whitened", "yule_walker",
         ],
+        "signature": [
+            "MATCH_RULES", "SignatureTable", "as_signature_table", "signature_isolation",
+        ],
+        "calibration": [
+            "CalibrationReport", "CalibrationRuns", "calibration_report", "calibration_runs",
+        ],
         "common": [
             "check_fitted_names", "checked_names", "checked_residuals", "held", "is_count", "isolate_cached",
-            "k_of_n", "step_vector",
+            "isolate_fired", "k_of_n", "step_vector",
         ],
         "learned": [
             "BnnEvaluator", "BnnNetwork", "BnnNetwork", "GaussianMlEvaluator", "QuasiNewtonResult",

@@ -1,5 +1,5 @@
-"""Pieces every evaluator shares: k-of-n persistence, holding decisions over bad samples, cached isolation,
-residual names checked against the fit."""
+"""Pieces every evaluator shares: k-of-n persistence, holding decisions over bad samples, cached isolation
+(per-residual logic or a signature table), residual names checked against the fit."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from fdikit.diagnosis import isolate
 from fdikit.errors import DataError
 from fdikit.residuals import Residuals
 
-__all__ = ["is_count", "k_of_n", "held", "isolate_cached", "checked_names",
+__all__ = ["is_count", "k_of_n", "held", "isolate_cached", "isolate_fired", "checked_names",
            "check_fitted_names", "checked_residuals", "step_vector"]
 
 
@@ -121,8 +121,55 @@ def held(values: np.ndarray, valid: np.ndarray, initial) -> np.ndarray:
     return out
 
 
-def isolate_cached(cache: dict, fired: np.ndarray, isolates, groups=None) -> str:
+def isolate_fired(fired: np.ndarray, isolates, groups=None, signatures=None, names=None) -> np.ndarray:
+    """Per-sample isolation of per-residual decisions: the single-fault logic, or a signature table.
+
+    Parameters
+    ----------
+    fired : (N, q) bool array
+        Per-sample, per-residual (or per-block) decisions.
+    isolates : sequence of str or None
+        Fault name tied to each residual.
+    groups : sequence, optional
+        The filter each residual belongs to (:func:`fdikit.diagnosis.isolate`); ignored with ``signatures``.
+    signatures : SignatureTable, optional
+        Isolate by matching the fired residual groups against the table
+        (:func:`fdikit.decision.signature.signature_isolation`) instead.
+    names : sequence of str, optional
+        Residual names (``r0 …`` when not given), for ``signatures``.
+
+    Returns
+    -------
+    (N,) str ndarray
+        ``'none'``, a fault name or ``'unknown'`` per sample.
+
+    References
+    ----------
+    Douglas et al. 1996, §1 (the fault announced from the pattern of fired residuals).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.decision.common import isolate_fired
+    >>> from fdikit.decision.signature import SignatureTable
+    >>> fired = np.array([[True, True]])
+    >>> isolate_fired(fired, ("fa", "fb")).tolist(), isolate_fired(fired, ("fa", "fb"),
+    ...     signatures=SignatureTable({"fa": ["fa", "fb"], "fb": ["fb"]})).tolist()
+    (['unknown'], ['fa'])
+    """
+    if signatures is None:
+        return isolate(fired, isolates, groups)
+    from fdikit.decision.signature import signature_isolation
+
+    fired = np.asarray(fired, bool)
+    names = tuple(names) if names is not None else tuple(f"r{i}" for i in range(fired.shape[1]))
+    return signature_isolation(fired, signatures, names, isolates)
+
+
+def isolate_cached(cache: dict, fired: np.ndarray, isolates, groups=None, signatures=None, names=None) -> str:
     """Isolation of one sample's fired pattern, memoised in ``cache`` (a run has few distinct patterns).
+
+    The label is :func:`isolate_fired` of the pattern, so ``step`` names exactly what ``run`` names.
 
     Parameters
     ----------
@@ -134,11 +181,15 @@ def isolate_cached(cache: dict, fired: np.ndarray, isolates, groups=None) -> str
         Fault name tied to each residual.
     groups : sequence, optional
         The filter each residual belongs to (:func:`fdikit.diagnosis.isolate`).
+    signatures : SignatureTable, optional
+        Isolate from the table instead (:func:`isolate_fired`).
+    names : sequence of str, optional
+        Residual names, for ``signatures``.
 
     Returns
     -------
     str
-        The isolated fault name, ``"none"`` or ``"unknown"`` (:func:`fdikit.diagnosis.isolate`).
+        The isolated fault name, ``"none"`` or ``"unknown"``.
 
     References
     ----------
@@ -156,7 +207,7 @@ def isolate_cached(cache: dict, fired: np.ndarray, isolates, groups=None) -> str
     key = fired.tobytes()
     label = cache.get(key)
     if label is None:
-        label = cache[key] = str(isolate(fired[None, :], isolates, groups)[0])
+        label = cache[key] = str(isolate_fired(fired[None, :], isolates, groups, signatures, names)[0])
     return label
 
 
@@ -354,3 +405,4 @@ def step_vector(r, fitted=None, names=None, evaluator: str = "the evaluator") ->
             raise DataError(f"step() got {arr.size} residual values but {len(names)} names {list(names)}")
         check_fitted_names(names, fitted, evaluator)
     return arr
+

@@ -23,7 +23,10 @@ Restart policy (``restart=``):
   follows the ARL theory.
 
 The residuals' alarm is any fired residual; the fault is isolated from the fired
-residuals and each residual's tied fault by :func:`fdikit.diagnosis.isolate`.
+residuals and each residual's tied fault by :func:`fdikit.diagnosis.isolate`, or, with
+``signatures=``, by the fault-signature table (:mod:`fdikit.decision.signature`).  ``fit`` takes
+one fault-free run or a list of runs (:mod:`fdikit.decision.calibration`: pooled moments, each run
+evaluated on its own for the ``calibration`` report).
 
 Average run length (Siegmund 1985, Basseville & Nikiforov eq. 5.2.44): for a one-sided
 CUSUM whose increments ``s − ν`` are Gaussian with mean ``Δ`` and unit variance,
@@ -50,15 +53,18 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import brentq
 
+from fdikit.decision.calibration import calibration_report, calibration_runs
 from fdikit.decision.common import (
     checked_residuals,
     held,
     is_count,
     isolate_cached,
+    isolate_fired,
     k_of_n,
     step_vector,
 )
-from fdikit.diagnosis import Diagnosis, StepDecision, isolate
+from fdikit.decision.signature import as_signature_table
+from fdikit.diagnosis import Diagnosis, StepDecision
 from fdikit.errors import DataError, ParameterError
 from fdikit.residuals import Residuals
 
@@ -330,6 +336,14 @@ class CusumEvaluator:
     isolates, groups : sequence, optional
         Fault tied to each residual, and the filter of each residual in a bank, as in
         :class:`~fdikit.decision.threshold.ThresholdEvaluator`.
+    signatures : SignatureTable, mapping or DataFrame, optional
+        Isolate by the fault-signature table (:mod:`fdikit.decision.signature`) instead.
+
+    Attributes
+    ----------
+    calibration : CalibrationReport or None
+        After :meth:`fit` with a target: the alarms raised on the calibration runs over their hours, with the
+        Garwood interval (:class:`~fdikit.decision.calibration.CalibrationReport`).
 
     References
     ----------
@@ -349,7 +363,7 @@ class CusumEvaluator:
 
     def __init__(
         self, drift=None, threshold=None, mean=None, sigma=None, *, two_sided: bool = True,
-        restart: str = "reset", hold: int = 0, isolates=None, groups=None,
+        restart: str = "reset", hold: int = 0, isolates=None, groups=None, signatures=None,
     ) -> None:
         self.drift = _param("drift", drift)
         self.threshold = _param("threshold", threshold)
@@ -364,24 +378,27 @@ class CusumEvaluator:
         self.hold = int(hold)
         self.isolates = None if isolates is None else tuple(isolates)
         self.groups = None if groups is None else tuple(groups)
+        self.signatures = as_signature_table(signatures)
         self.names: tuple[str, ...] | None = None
         self.arl0: float | None = None
+        self.calibration = None
         self.reset()
 
     # ------------------------------------------------------------------ calibration
     def fit(
-        self, residuals: Residuals, arl0: float | None = None, mean_time_between_false_alarms: float | None = None,
-        shift=None,
+        self, residuals: Residuals | list[Residuals], arl0: float | None = None,
+        mean_time_between_false_alarms: float | None = None, shift=None,
     ) -> CusumEvaluator:
         """Estimate ``μ0`` and ``σ`` per residual on fault-free data; optionally design ``ν`` and ``h``.
 
         Parameters
         ----------
-        residuals : Residuals
-            Fault-free residuals (invalid and non-finite rows are skipped).
+        residuals : Residuals or list of Residuals
+            Fault-free residuals, one run or several (invalid and non-finite rows are skipped; the rows of
+            all runs are pooled, :func:`~fdikit.decision.calibration.calibration_runs`).
         arl0, mean_time_between_false_alarms : float, optional
             Target fault-free run length of the whole evaluator, in samples or in seconds
-            (converted with the median sample time).  Split evenly over the ``q``
+            (converted with the median sample time within the runs).  Split evenly over the ``q``
             residuals: each is designed for ``q · arl0`` (``1/ARL`` adds over
             independent residuals; positively correlated residuals lengthen the joint run length).
         shift : float or array_like, optional
@@ -392,21 +409,20 @@ class CusumEvaluator:
         Returns
         -------
         self
+            With ``mean``, ``sigma``, ``names`` (and ``drift``, ``threshold``, ``arl0`` with a target), and
+            ``calibration`` (the report on the calibration runs) when the evaluator is complete.
         """
-        residuals = checked_residuals(residuals, None)
-        r = residuals.r[residuals.valid]
-        r = r[np.all(np.isfinite(r), axis=1)]
+        runs = calibration_runs(residuals)
+        r = runs.rows
         q = r.shape[1]
-        if r.shape[0] < 10:
-            raise DataError(f"need at least 10 valid fault-free samples to fit a CUSUM, got {r.shape[0]}")
         mean, sigma = r.mean(axis=0), r.std(axis=0, ddof=1)
         if not np.all(sigma > 0):
-            bad = [residuals.names[i] for i in np.flatnonzero(~(sigma > 0))]
+            bad = [runs.names[i] for i in np.flatnonzero(~(sigma > 0))]
             raise DataError(f"residual(s) {bad} are constant on the fault-free data; cannot standardise them")
         if arl0 is not None and mean_time_between_false_alarms is not None:
             raise ParameterError("give at most one of arl0 and mean_time_between_false_alarms")
         if mean_time_between_false_alarms is not None:
-            dt = float(np.median(np.diff(residuals.t)))
+            dt = runs.dt
             if not mean_time_between_false_alarms > 0 or not dt > 0:
                 raise ParameterError(
                     f"need a positive mean time between false alarms and sample time, "
@@ -430,10 +446,14 @@ class CusumEvaluator:
             h = np.array([_threshold_for(float(arl0) * q, float(v), self.two_sided) for v in nu])
             self.drift, self.threshold, self.arl0 = nu, h, float(arl0)
         self.mean, self.sigma = mean, sigma
-        self.names = residuals.names
+        self.names = runs.names
         if self.isolates is None:
-            self.isolates = residuals.isolates
+            self.isolates = runs.isolates
         self.reset()
+        self.calibration = None
+        if self.drift is not None and self.threshold is not None:
+            target = 3600.0 / (self.arl0 * runs.dt) if self.arl0 is not None else None
+            self.calibration = calibration_report(self, runs, target_rate=target)
         return self
 
     def _ready(self, q: int, residuals: Residuals | None = None):
@@ -480,7 +500,7 @@ class CusumEvaluator:
                 xp[:, i], xm[:, i] if self.two_sided else None, float(h[i]), self.restart == "reset"
             )
         fired = held(k_of_n(ex, 1, self.hold + 1), valid, False)
-        isolated = isolate(fired, iso, self.groups)
+        isolated = isolate_fired(fired, iso, self.groups, self.signatures, residuals.names)
         meta = self._meta(nu, h, mu, sd)
         meta["g_plus"], meta["g_minus"] = held(gp, valid, 0.0), held(gm, valid, 0.0)
         return Diagnosis(residuals.t, fired.any(axis=1), fired, residuals.names, isolated, valid=valid, meta=meta)
@@ -548,7 +568,8 @@ class CusumEvaluator:
 
     def _isolate(self, fired: np.ndarray) -> str:
         """Isolation of one sample's pattern (memoised: the patterns of a run are few)."""
-        return isolate_cached(self._state["cache"], fired, self._state["iso"], self.groups)
+        return isolate_cached(self._state["cache"], fired, self._state["iso"], self.groups, self.signatures,
+                              self.names)
 
     def __repr__(self) -> str:
         return (f"CusumEvaluator(drift={self.drift}, threshold={self.threshold}, restart={self.restart!r}, "

@@ -47,9 +47,11 @@ from fdikit.decision.common import (
     held,
     is_count,
     isolate_cached,
+    isolate_fired,
     step_vector,
 )
-from fdikit.diagnosis import Diagnosis, StepDecision, isolate
+from fdikit.decision.signature import as_signature_table
+from fdikit.diagnosis import Diagnosis, StepDecision
 from fdikit.errors import DataError, ParameterError
 from fdikit.residuals import Residuals
 
@@ -320,13 +322,14 @@ def _check_cov(cov) -> np.ndarray | None:
     return c
 
 
-def fit_moments(residuals: Residuals, minimum: int = 10) -> tuple[np.ndarray, np.ndarray]:
-    """Mean and covariance of the valid, finite rows of fault-free residuals.
+def fit_moments(residuals: Residuals | Sequence[Residuals], minimum: int = 10) -> tuple[np.ndarray, np.ndarray]:
+    """Mean and covariance of the valid, finite rows of fault-free residuals (one run, or a list pooled).
 
     Parameters
     ----------
-    residuals : Residuals
-        Fault-free residuals; invalid and non-finite rows are skipped.
+    residuals : Residuals or sequence of Residuals
+        Fault-free residuals, one run or several with the same residuals
+        (:func:`~fdikit.decision.calibration.calibration_runs`); invalid and non-finite rows are skipped.
     minimum : int, default 10
         Fewest usable rows accepted.
 
@@ -338,7 +341,8 @@ def fit_moments(residuals: Residuals, minimum: int = 10) -> tuple[np.ndarray, np
     Raises
     ------
     DataError
-        When ``residuals`` is not a ``Residuals``, or has fewer than ``minimum`` usable rows.
+        When ``residuals`` is not a ``Residuals`` (or a list of them with the same names), or has fewer than
+        ``minimum`` usable rows.
 
     References
     ----------
@@ -352,11 +356,9 @@ def fit_moments(residuals: Residuals, minimum: int = 10) -> tuple[np.ndarray, np
     >>> mean.shape, cov.shape
     ((2,), (2, 2))
     """
-    residuals = checked_residuals(residuals, None)
-    r = residuals.r[residuals.valid]
-    r = r[np.all(np.isfinite(r), axis=1)]
-    if r.shape[0] < minimum:
-        raise DataError(f"need at least {minimum} valid fault-free samples to fit, got {r.shape[0]}")
+    from fdikit.decision.calibration import calibration_runs
+
+    r = calibration_runs(residuals, minimum).rows
     return r.mean(axis=0), np.atleast_2d(np.cov(r, rowvar=False, ddof=1))
 
 
@@ -381,6 +383,15 @@ class GlrEvaluator:
     isolates, groups : sequence, optional
         Fault tied to each residual and filter of each residual (bank); a block's fault is
         its residuals' common fault (None when they differ).
+    signatures : SignatureTable, mapping or DataFrame, optional
+        Isolate by the fault-signature table (:mod:`fdikit.decision.signature`): its groups are matched
+        against the fired *blocks* (by block name or the block's fault).
+
+    Attributes
+    ----------
+    calibration : CalibrationReport or None
+        After :meth:`fit` with a threshold: the alarms raised on the calibration runs over their hours, with the
+        Garwood interval (:class:`~fdikit.decision.calibration.CalibrationReport`).
 
     Notes
     -----
@@ -407,7 +418,7 @@ class GlrEvaluator:
 
     def __init__(
         self, window: int = 50, threshold=None, mean=None, cov=None, *, blocks="isolates", isolates=None,
-        groups=None,
+        groups=None, signatures=None,
     ) -> None:
         if not is_count(window, 1):
             raise ParameterError(f"window must be a positive number of samples, got {window}")
@@ -424,14 +435,20 @@ class GlrEvaluator:
         self.blocks = blocks if isinstance(blocks, str) else tuple(blocks)
         self.isolates = None if isolates is None else tuple(isolates)
         self.groups = None if groups is None else tuple(groups)
+        self.signatures = as_signature_table(signatures)
+        self.calibration = None
         self.names: tuple[str, ...] | None = None
         self.alpha: float | None = None
         self.reset()
 
     def fit(
-        self, residuals: Residuals, false_alarm_prob: float | None = None, false_alarms_per_hour: float | None = None
+        self, residuals: Residuals | Sequence[Residuals], false_alarm_prob: float | None = None,
+        false_alarms_per_hour: float | None = None,
     ) -> GlrEvaluator:
-        """Estimate ``μ0`` and ``Σ`` on fault-free residuals; optionally set ``h`` per block.
+        """Estimate ``μ0`` and ``Σ`` on fault-free residuals (one run or a list); optionally set ``h`` per block.
+
+        A list of runs is pooled for the moments (:func:`fit_moments`); each run is evaluated on its own for the
+        ``calibration`` report (no GLR window crosses a run boundary).
 
         ``false_alarm_prob`` (or a rate per hour, ``α = rate·dt/3600``) is the
         per-sample probability of any block alarming, split evenly over the ``G`` blocks,
@@ -440,16 +457,19 @@ class GlrEvaluator:
         """
         if false_alarm_prob is not None and false_alarms_per_hour is not None:
             raise ParameterError("give at most one of false_alarm_prob and false_alarms_per_hour")
+        from fdikit.decision.calibration import calibration_report, calibration_runs
+
+        runs = calibration_runs(residuals)
         mean, cov = fit_moments(residuals)
         if false_alarms_per_hour is not None:
-            dt = float(np.median(np.diff(residuals.t)))
+            dt = runs.dt
             if not false_alarms_per_hour > 0 or not dt > 0:
                 raise ParameterError(
                     f"need a positive rate and sample time, got {false_alarms_per_hour}/h and dt={dt}"
                 )
             false_alarm_prob = min(0.5, false_alarms_per_hour * dt / 3600.0)
-        iso = self.isolates if self.isolates is not None else residuals.isolates
-        layout = BlockLayout(self.blocks, residuals.names, iso, self.groups, cov)
+        iso = self.isolates if self.isolates is not None else runs.isolates
+        layout = BlockLayout(self.blocks, runs.names, iso, self.groups, cov)
         if false_alarm_prob is not None:
             if not 0 < false_alarm_prob < 1:
                 raise ParameterError(f"false-alarm probability must be in (0, 1), got {false_alarm_prob}")
@@ -457,9 +477,13 @@ class GlrEvaluator:
             self.threshold = np.array([glr_threshold(false_alarm_prob / G, self.window, int(p)) for p in layout.dims])
             self.alpha = float(false_alarm_prob)
         self.mean, self.cov = mean, cov
-        self.names = residuals.names
+        self.names = runs.names
         self.isolates = tuple(iso)
         self.reset()
+        self.calibration = None
+        if self.threshold is not None:
+            target = self.alpha * 3600.0 / runs.dt if false_alarm_prob is not None else None
+            self.calibration = calibration_report(self, runs, target_rate=target)
         return self
 
     def _ready(self, q: int, residuals: Residuals | None = None):
@@ -512,7 +536,7 @@ class GlrEvaluator:
         size = _lin(layout.chol, best_S) / best_n[..., None]
         change = vidx[np.arange(n)[:, None] - best_n + 1] if n else np.zeros((0, G), int)
         fired = held(best > h, valid, False)
-        isolated = isolate(fired, layout.isolates, layout.groups)
+        isolated = isolate_fired(fired, layout.isolates, layout.groups, self.signatures, layout.names)
         meta = self._meta(layout, h, residuals.names)
         meta["statistic"] = held(best, valid, 0.0)
         meta["change_index"] = held(change, valid, -1)
@@ -589,7 +613,8 @@ class GlrEvaluator:
 
     def _isolate(self, fired: np.ndarray) -> str:
         layout = self._state["layout"]
-        return isolate_cached(self._state["cache"], fired, layout.isolates, layout.groups)
+        return isolate_cached(self._state["cache"], fired, layout.isolates, layout.groups, self.signatures,
+                              layout.names)
 
     def __repr__(self) -> str:
         return f"GlrEvaluator(window={self.window}, threshold={self.threshold}, blocks={self.blocks!r})"

@@ -48,11 +48,13 @@ from fdikit.decision.common import (
     held,
     is_count,
     isolate_cached,
+    isolate_fired,
     k_of_n,
     step_vector,
 )
 from fdikit.decision.glr import BlockLayout, as_covariance, fit_moments
-from fdikit.diagnosis import Diagnosis, StepDecision, isolate
+from fdikit.decision.signature import as_signature_table
+from fdikit.diagnosis import Diagnosis, StepDecision
 from fdikit.errors import DataError, ParameterError
 from fdikit.residuals import Residuals
 
@@ -211,6 +213,15 @@ class SprtEvaluator:
         Keep ``fired`` on for this many valid samples after an alarm (``restart=True``).
     isolates, groups : sequence, optional
         Fault tied to each residual, filter of each residual (bank).
+    signatures : SignatureTable, mapping or DataFrame, optional
+        Isolate by the fault-signature table (:mod:`fdikit.decision.signature`): its groups are matched
+        against the fired *blocks* (by block name or the block's fault).
+
+    Attributes
+    ----------
+    calibration : CalibrationReport or None
+        After :meth:`fit`: the alarms raised on the calibration runs over their hours, with the Garwood interval
+        (:class:`~fdikit.decision.calibration.CalibrationReport`).
 
     References
     ----------
@@ -230,7 +241,7 @@ class SprtEvaluator:
 
     def __init__(
         self, shift, alpha: float = 0.01, beta: float = 0.01, mean=None, cov=None, *, blocks="isolates",
-        restart: bool = True, hold: int = 0, isolates=None, groups=None,
+        restart: bool = True, hold: int = 0, isolates=None, groups=None, signatures=None,
     ) -> None:
         self.shift = np.atleast_1d(np.asarray(shift, dtype=float))
         if self.shift.ndim != 1 or not np.all(np.isfinite(self.shift)):
@@ -253,21 +264,24 @@ class SprtEvaluator:
         self.hold = int(hold)
         self.isolates = None if isolates is None else tuple(isolates)
         self.groups = None if groups is None else tuple(groups)
+        self.signatures = as_signature_table(signatures)
         self.names: tuple[str, ...] | None = None
+        self.calibration = None
         self.reset()
 
-    def fit(self, residuals: Residuals) -> SprtEvaluator:
-        """Estimate ``μ0`` and ``Σ`` on fault-free residuals; returns ``self``.
+    def fit(self, residuals: Residuals | Sequence[Residuals]) -> SprtEvaluator:
+        """Estimate ``μ0`` and ``Σ`` on fault-free residuals (one run or a list); returns ``self``.
 
         Parameters
         ----------
-        residuals : Residuals
-            Fault-free residuals (invalid and non-finite rows skipped; at least 10 must remain).
+        residuals : Residuals or sequence of Residuals
+            Fault-free residuals, one run or several (invalid and non-finite rows skipped; at least 10 must
+            remain): pooled for the moments, each run evaluated on its own for the ``calibration`` report.
 
         Returns
         -------
         SprtEvaluator
-            ``self``, with ``mean``, ``cov`` and ``names`` set (and ``isolates`` when unset).
+            ``self``, with ``mean``, ``cov``, ``names`` and ``calibration`` set (and ``isolates`` when unset).
 
         Raises
         ------
@@ -277,12 +291,16 @@ class SprtEvaluator:
         ParameterError
             When a block's shift is zero.
         """
+        from fdikit.decision.calibration import calibration_report, calibration_runs
+
+        runs = calibration_runs(residuals)
         self.mean, self.cov = fit_moments(residuals)
-        self.names = residuals.names
+        self.names = runs.names
         if self.isolates is None:
-            self.isolates = residuals.isolates
-        self._ready(len(residuals.names), residuals)  # fail now on a singular block covariance
+            self.isolates = runs.isolates
+        self._ready(len(runs.names), runs.runs[0])  # fail now on a singular block covariance
         self.reset()
+        self.calibration = calibration_report(self, runs)
         return self
 
     def _ready(self, q: int, residuals: Residuals | None = None):
@@ -347,7 +365,7 @@ class SprtEvaluator:
             dec = np.cumsum(dec, axis=0, dtype=np.int8)  # one ±1 per block at most: latched from then on
             fired_v = dec > 0
         fired = held(fired_v, valid, False)
-        isolated = isolate(fired, layout.isolates, layout.groups)
+        isolated = isolate_fired(fired, layout.isolates, layout.groups, self.signatures, layout.names)
         meta = self._meta(layout, c, residuals.names)
         meta["llr"] = held(llr, valid, 0.0)
         meta["decision"] = held(dec, valid, 0)
@@ -403,7 +421,8 @@ class SprtEvaluator:
 
     def _isolate(self, fired: np.ndarray) -> str:
         layout = self._state["layout"]
-        return isolate_cached(self._state["cache"], fired, layout.isolates, layout.groups)
+        return isolate_cached(self._state["cache"], fired, layout.isolates, layout.groups, self.signatures,
+                              layout.names)
 
     def __repr__(self) -> str:
         return (f"SprtEvaluator(shift={self.shift}, alpha={self.alpha}, beta={self.beta}, "

@@ -4,7 +4,8 @@ The simplest residual processor of Douglas et al. 1996, §1 ("a simple threshold
 residual, traded between false and missed alarms").  Residual ``i`` fires when
 ``|r_i − c_i| > τ_i`` in at least ``k`` of the last ``n`` valid samples; the alarm
 is on when any residual fires, and the fault is isolated when every fired residual
-is tied to the same fault (:func:`fdikit.diagnosis.isolate`).
+is tied to the same fault (:func:`fdikit.diagnosis.isolate`) or, with ``signatures=``, when the
+fired residual groups match the fault's signature (:mod:`fdikit.decision.signature`).
 
 Calibration for a target false-alarm probability ``α`` per sample (family-wise,
 split evenly over the ``q`` residuals, Bonferroni):
@@ -16,7 +17,9 @@ split evenly over the ``q`` residuals, Bonferroni):
 
 A rate of false alarms per hour converts to ``α = rate · dt / 3600`` (each exceedance
 counted as an alarm; persistence and correlated residuals only lower the rate, so the
-conversion is conservative).
+conversion is conservative).  ``fit`` takes one fault-free run or a list of runs
+(:mod:`fdikit.decision.calibration`) and reports the false-alarm rate achieved on them with its
+exact Poisson interval (``calibration``).
 """
 
 from __future__ import annotations
@@ -26,8 +29,10 @@ from collections import deque
 import numpy as np
 from scipy.stats import norm
 
-from fdikit.decision.common import checked_residuals, held, isolate_cached, k_of_n, step_vector
-from fdikit.diagnosis import Diagnosis, StepDecision, isolate
+from fdikit.decision.calibration import calibration_report, calibration_runs
+from fdikit.decision.common import checked_residuals, held, isolate_cached, isolate_fired, k_of_n, step_vector
+from fdikit.decision.signature import as_signature_table
+from fdikit.diagnosis import Diagnosis, StepDecision
 from fdikit.errors import DataError, ParameterError
 from fdikit.residuals import Residuals
 
@@ -90,6 +95,17 @@ class ThresholdEvaluator:
     groups : sequence, optional
         The filter each residual belongs to, for a bank: filters whose residuals point to
         two or more faults are discarded (:func:`fdikit.diagnosis.isolate`).
+    signatures : SignatureTable, mapping or DataFrame, optional
+        Isolate by the fault-signature table instead (:mod:`fdikit.decision.signature`): the fired
+        residual groups are matched against each fault's pattern, so a fault that fires several groups is
+        named; ``run`` and ``step`` name the same fault.  ``groups`` is then ignored.
+
+    Attributes
+    ----------
+    calibration : CalibrationReport or None
+        After :meth:`fit`: hours of data, the alarms the calibrated evaluator raises on the calibration runs,
+        the Garwood interval of that rate and the smallest rate the data resolve
+        (:class:`~fdikit.decision.calibration.CalibrationReport`).
 
     References
     ----------
@@ -106,10 +122,13 @@ class ThresholdEvaluator:
     >>> ev = ThresholdEvaluator().fit(healthy, false_alarm_prob=1e-3)
     >>> round(float(ev.thresholds[0]), 1)
     3.3
+    >>> round(ev.calibration.hours * 3600), ev.calibration.runs
+    (100, 1)
     """
 
     def __init__(
-        self, thresholds=None, center=None, persistence: tuple[int, int] = (1, 1), isolates=None, groups=None
+        self, thresholds=None, center=None, persistence: tuple[int, int] = (1, 1), isolates=None, groups=None,
+        signatures=None,
     ) -> None:
         k, n = persistence
         if not (1 <= k <= n):
@@ -121,14 +140,16 @@ class ThresholdEvaluator:
         self.center = None if center is None else np.atleast_1d(np.asarray(center, dtype=float))
         self.isolates = None if isolates is None else tuple(isolates)
         self.groups = None if groups is None else tuple(groups)
+        self.signatures = as_signature_table(signatures)
         self.names: tuple[str, ...] | None = None
         self.alpha: float | None = None
+        self.calibration = None
         self.reset()
 
     # ------------------------------------------------------------------ calibration
     def fit(
         self,
-        residuals: Residuals,
+        residuals: Residuals | list[Residuals],
         false_alarm_prob: float | None = None,
         false_alarms_per_hour: float | None = None,
         method: str = "gaussian",
@@ -137,13 +158,15 @@ class ThresholdEvaluator:
 
         Parameters
         ----------
-        residuals : Residuals
-            Fault-free residuals (invalid and non-finite rows are skipped; at least 10 must remain).
+        residuals : Residuals or list of Residuals
+            Fault-free residuals, one run or several (:func:`~fdikit.decision.calibration.calibration_runs`:
+            their valid, finite rows are pooled — at least 10 must remain — while the calibration report
+            evaluates each run on its own, so no persistence window crosses a run boundary).
         false_alarm_prob : float, optional
             ``α`` in (0, 1), the family-wise false-alarm probability per sample.
         false_alarms_per_hour : float, optional
-            A rate instead, converted by :func:`alpha_from_rate` with the median sample time; give exactly
-            one of the two.
+            A rate instead, converted by :func:`alpha_from_rate` with the median sample time within the runs;
+            give exactly one of the two.
         method : {'gaussian', 'empirical'}, default 'gaussian'
             ``τ_i = σ_i Φ⁻¹(1 − α/(2q))``, or the ``1 − α/q`` quantile of ``|r_i − c_i|`` (needs
             ``10 q/α`` samples).
@@ -151,7 +174,8 @@ class ThresholdEvaluator:
         Returns
         -------
         ThresholdEvaluator
-            ``self``, with ``center``, ``thresholds``, ``alpha``, ``names`` (and ``isolates`` when unset).
+            ``self``, with ``center``, ``thresholds``, ``alpha``, ``names``, ``calibration`` (and ``isolates``
+            when unset).
 
         Raises
         ------
@@ -162,15 +186,11 @@ class ThresholdEvaluator:
         """
         if (false_alarm_prob is None) == (false_alarms_per_hour is None):
             raise ParameterError("give exactly one of false_alarm_prob and false_alarms_per_hour")
-        residuals = checked_residuals(residuals, None)
-        r = residuals.r[residuals.valid]
-        r = r[np.all(np.isfinite(r), axis=1)]
+        runs = calibration_runs(residuals)
+        r = runs.rows
         q = r.shape[1]
-        if r.shape[0] < 10:
-            raise DataError(f"need at least 10 valid fault-free samples to calibrate, got {r.shape[0]}")
         if false_alarms_per_hour is not None:
-            dt = float(np.median(np.diff(residuals.t)))
-            alpha = alpha_from_rate(false_alarms_per_hour, dt)
+            alpha = alpha_from_rate(false_alarms_per_hour, runs.dt)
         else:
             alpha = float(false_alarm_prob)
         if not 0 < alpha < 1:
@@ -190,13 +210,15 @@ class ThresholdEvaluator:
         else:
             raise ParameterError(f"unknown calibration method {method!r}; use 'gaussian' or 'empirical'")
         if not np.all(tau > 0):
-            bad = [residuals.names[i] for i in np.flatnonzero(~(tau > 0))]
+            bad = [runs.names[i] for i in np.flatnonzero(~(tau > 0))]
             raise DataError(f"residual(s) {bad} are constant on the fault-free data; cannot set a threshold")
         self.center, self.thresholds, self.alpha = center, tau, alpha
-        self.names = residuals.names
+        self.names = runs.names
         if self.isolates is None:
-            self.isolates = residuals.isolates
+            self.isolates = runs.isolates
         self.reset()
+        target = false_alarms_per_hour if false_alarms_per_hour is not None else alpha * 3600.0 / runs.dt
+        self.calibration = calibration_report(self, runs, target_rate=target)
         return self
 
     def _ready(self, q: int, residuals: Residuals | None = None) -> tuple[np.ndarray, np.ndarray, tuple]:
@@ -221,7 +243,7 @@ class ThresholdEvaluator:
         valid = residuals.valid & np.all(np.isfinite(r), axis=1)
         k, n = self.persistence
         fired = held(k_of_n(np.abs(r[valid] - c) > tau, k, n), valid, False)
-        isolated = isolate(fired, iso, self.groups)
+        isolated = isolate_fired(fired, iso, self.groups, self.signatures, residuals.names)
         return Diagnosis(
             residuals.t, fired.any(axis=1), fired, residuals.names, isolated, valid=valid,
             meta={"evaluator": "threshold", "thresholds": tau.tolist(), "persistence": list(self.persistence)},
@@ -251,7 +273,7 @@ class ThresholdEvaluator:
             fired = np.sum(self._window, axis=0) >= self.persistence[0]
             self._last = fired
             valid = True
-        fault = isolate_cached(self._labels, fired, iso, self.groups)
+        fault = isolate_cached(self._labels, fired, iso, self.groups, self.signatures, self.names)
         return StepDecision(bool(fired.any()), fault, fired.copy(), valid)
 
     def __repr__(self) -> str:
