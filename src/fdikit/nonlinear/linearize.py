@@ -16,12 +16,14 @@ from __future__ import annotations
 import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from fdikit import validate
 from fdikit.errors import FdiWarning, ModelError, ParameterError
 from fdikit.model import FaultModel
+from fdikit.operating_point import OperatingPoint
 from fdikit.simulate import NonlinearPlant
 
 __all__ = ["JacobianEstimate", "Linearization", "call_plant", "jacobian", "linearization", "linearize"]
@@ -68,7 +70,8 @@ class Linearization:
     ----------
     model : FaultModel
         Continuous model ``x' = A x + Bu u``, ``y = C x + Du u`` in deviations from the operating point,
-        named as the plant.
+        named as the plant; its ``operating_point`` is ``(x, u, y0)``, so generators designed from it run on
+        the plant's absolute signals.
     x, u : ndarray
         The operating point (state, control).
     t : float
@@ -79,6 +82,8 @@ class Linearization:
         Per block ``"A"``, ``"Bu"``, ``"C"``, ``"Du"``: the step each entry was taken at (0 if analytic).
     error : dict of str to ndarray
         Per block: the error estimate of each entry (0 if analytic).
+    trim : TrimResult or None
+        The trim the point came from (:func:`fdikit.nonlinear.trim.trim_and_linearize`), else None.
 
     Examples
     --------
@@ -102,6 +107,7 @@ class Linearization:
     y0: np.ndarray
     steps: dict
     error: dict
+    trim: Any = None
 
 
 def call_plant(plant: NonlinearPlant, which: str, t: float, x: np.ndarray, u: np.ndarray) -> np.ndarray:
@@ -344,8 +350,9 @@ def linearization(plant: NonlinearPlant, x, u, t: float = 0.0, *, step=None, rto
             fixed = None if step is None else (step if np.ndim(step) == 0 else step[cols])
             est = _jacobian(g, z[cols], step=fixed, rtol=rtol, name=f"{which}[{block}]")
             blocks[block], steps[block], error[block] = est.J, est.steps, est.error
+    op = OperatingPoint.from_vectors(plant.states, plant.controls, plant.outputs, x, u, y0)
     model = FaultModel(A=blocks["A"], C=blocks["C"], Bu=blocks["Bu"], Du=blocks["Du"], states=plant.states,
-                       outputs=plant.outputs, controls=plant.controls)
+                       outputs=plant.outputs, controls=plant.controls, operating_point=op)
     return Linearization(model, x, u, t, f0, y0, steps, error)
 
 

@@ -13,17 +13,17 @@ are solved by :func:`scipy.optimize.least_squares`.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.optimize import least_squares
 
 from fdikit import validate
 from fdikit.errors import DesignError, ParameterError
-from fdikit.nonlinear.linearize import call_plant
+from fdikit.nonlinear.linearize import Linearization, call_plant, linearization
 from fdikit.simulate import NonlinearPlant
 
-__all__ = ["TrimResult", "trim"]
+__all__ = ["TrimResult", "trim", "trim_and_linearize"]
 
 
 @dataclass(frozen=True)
@@ -262,4 +262,55 @@ def _indices(what: str, items, names: Sequence[str], word: str) -> list[int]:
     if len(set(out)) != len(out):
         raise ParameterError(f"{what} lists a {word} twice: {items}")
     return out
+
+
+def trim_and_linearize(plant: NonlinearPlant, x0=None, u0=None, y0=None, *, step=None, rtol: float = 1e-6,
+                       jacobian=None, **trim_options) -> Linearization:
+    """Trim the plant and linearise it there, in one call: the model and its operating point together.
+
+    :func:`trim` with ``x0``, ``u0``, ``y0`` and ``trim_options``, then
+    :func:`~fdikit.nonlinear.linearize.linearization` at the point found (``step``, ``rtol``, ``jacobian``).
+
+    Parameters
+    ----------
+    plant : NonlinearPlant
+        The plant.
+    x0, u0, y0 : optional
+        Initial guesses and output targets, as for :func:`trim`.
+    step, rtol, jacobian : optional
+        As for :func:`~fdikit.nonlinear.linearize.linearization`.
+    **trim_options
+        ``t``, ``ix``, ``iu``, ``iy``, ``dx0``, ``idx``, ``tol``, ``max_iterations`` of :func:`trim`.
+
+    Returns
+    -------
+    Linearization
+        ``model`` in deviation coordinates with ``model.operating_point`` = the trimmed ``(x, u, y)``, the
+        steps and error estimates, and ``trim`` (the :class:`TrimResult`).
+
+    Raises
+    ------
+    DesignError
+        When the trim fails (see :func:`trim`).
+    ParameterError
+        For a bad argument of either step.
+
+    Examples
+    --------
+    A tank ``h' = (q − √h) / 2`` with outflow ``√h`` measured: the level 4 needs the inflow 2.
+
+    >>> tank = NonlinearPlant(f=lambda t, x, u: np.array([(u[0] - np.sqrt(x[0])) / 2]),
+    ...                       h=lambda t, x, u: np.array([np.sqrt(x[0])]), states=("level",), outputs=("outflow",),
+    ...                       controls=("inflow",), x0=np.array([4.0]))
+    >>> lin = trim_and_linearize(tank, x0=[4.0], u0=[1.0], ix=["level"], iu=[])
+    >>> lin.model.operating_point.u0, round(float(lin.model.A[0, 0]), 6)   # ∂f/∂h = −1/(4 √h) = −1/8
+    ({'inflow': 2.0}, -0.125)
+
+    References
+    ----------
+    Douglas et al. 1996, Ch. 8 §8.3 (the nominal operating point, then the linearisation about it).
+    """
+    point = trim(plant, x0, u0, y0, **trim_options)
+    lin = linearization(plant, point.x, point.u, trim_options.get("t", 0.0), step=step, rtol=rtol, jacobian=jacobian)
+    return replace(lin, trim=point)
 
