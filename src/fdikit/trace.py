@@ -1,7 +1,8 @@
 """One logged run: time, controls, measurements, states and the true fault per sample.
 
 A :class:`Trace` is what :func:`fdikit.simulate.simulate` returns and what residual
-generators and evaluators consume.  It exports to pandas and saves to Parquet.
+generators and evaluators consume.  It exports to pandas and saves to Parquet; a recorded log
+comes in through :meth:`Trace.from_pandas` and :meth:`Trace.from_csv` (:mod:`fdikit.trace_import`).
 
 File format and integrity
 -------------------------
@@ -378,6 +379,74 @@ class Trace:
         data["fault"] = self.fault
         data["valid"] = self.valid
         return pd.DataFrame(data, index=pd.Index(self.t, name="t"))
+
+    @classmethod
+    def from_pandas(cls, df, **options) -> Trace:
+        """Import a recorded log: columns to signals in SI, clock times to seconds, gaps to invalid samples.
+
+        Parameters
+        ----------
+        df : pandas.DataFrame
+            One row per sample.
+        **options
+            ``time``, ``controls``, ``outputs``, ``units``, ``fault``, ``valid``, ``dt``, ``jitter``,
+            ``time_unit``, ``meta``: see :func:`fdikit.trace_import.from_pandas`.
+
+        Returns
+        -------
+        Trace
+            On the grid ``k dt`` from the first sample; ``meta["import"]`` records how it was read.
+
+        Raises
+        ------
+        ParameterError, DataError
+            As :func:`fdikit.trace_import.from_pandas` (a sample off the grid, a repeated time ...).
+
+        Examples
+        --------
+        >>> import pandas as pd
+        >>> clock = pd.date_range("2024-01-01", periods=4, freq="100ms", tz="UTC").delete(2)  # a gap
+        >>> df = pd.DataFrame({"r": [0.0, 180.0, 90.0]}, index=clock)
+        >>> tr = Trace.from_pandas(df, outputs=["r"], units={"r": "deg"}, dt=0.1)
+        >>> tr.valid.tolist(), tr.meta["import"]["time"]["start"]
+        ([True, True, False, True], '2024-01-01T00:00:00+00:00')
+        """
+        from fdikit.trace_import import from_pandas
+
+        return from_pandas(df, cls=cls, **options)
+
+    @classmethod
+    def from_csv(cls, path: str | Path, **options) -> Trace:
+        """Import a CSV log as :meth:`from_pandas` does (``read_csv=`` passes arguments to pandas).
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The CSV file, with a header row.
+        **options
+            As :meth:`from_pandas`, and ``read_csv``: see :func:`fdikit.trace_import.from_csv`.
+
+        Returns
+        -------
+        Trace
+            As :meth:`from_pandas`.
+
+        Raises
+        ------
+        ParameterError, DataError
+            As :func:`fdikit.trace_import.from_csv`.
+
+        Examples
+        --------
+        >>> import pathlib, tempfile
+        >>> path = pathlib.Path(tempfile.mkdtemp()) / "log.csv"
+        >>> _ = path.write_text("time,h_ft\\n2024-01-01T00:00:00Z,0\\n2024-01-01T00:00:01Z,1000\\n")
+        >>> Trace.from_csv(path, time="time", outputs={"h": "h_ft"}, units={"h": "ft"}).y[:, 0].round(6).tolist()
+        [0.0, 304.8]
+        """
+        from fdikit.trace_import import from_csv
+
+        return from_csv(path, cls=cls, **options)
 
     def plot(self, ax=None, **kwargs):
         """Draw the signals over time with the faulty samples shaded (:func:`fdikit.plots.plot_trace`).
