@@ -30,7 +30,7 @@ Their ``gain`` is fdikit's observer (predictor) gain ``ΦL``: the generator's st
 from __future__ import annotations
 
 import warnings
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -123,8 +123,14 @@ class DiscreteGtfdfDesign(FieldReport):
     REPORT = ("target", "gain", "filter_gain", "poles", "levels", "settled", "settling_step")
 
 
-def dgtfdf(setup: DiscreteGameSetup, targets: str | Sequence[str] | None = None,
-           settle_rtol: float = 1e-8) -> DiscreteGtfdfDesign:
+def dgtfdf(
+    setup: DiscreteGameSetup,
+    targets: str | Sequence[str] | None = None,
+    settle_rtol: float = 1e-8,
+    *,
+    names: Sequence[str] | None = None,
+    isolates: Sequence[str | None] | Mapping[str, str | None] | None = None,
+) -> DiscreteGtfdfDesign:
     """Discrete single-fault game-theoretic detection filter (Murray 2012, (5.42)–(5.43)), time-varying gain.
 
     From ``Θ(k0) = Π_0``: ``Σ = Θ − Cᵀ(ĤQĤ − V⁻¹)C``, ``Θ̃ = [ΦΣ⁻¹Φᵀ + F̂MF̂ᵀ/γ]⁻¹``, ``L(k) = Σ⁻¹CᵀV⁻¹``,
@@ -143,6 +149,9 @@ def dgtfdf(setup: DiscreteGameSetup, targets: str | Sequence[str] | None = None,
         setup's only target.
     settle_rtol : float, optional
         Relative change of the gain from one step to the next below which it counts as settled (default 1e-8).
+    names, isolates : optional
+        Residual names and the fault each residual isolates (default ``<target>[j]`` tied to the target), as
+        :func:`~fdikit.design.residual_labels.residual_labels`.
 
     Returns
     -------
@@ -203,7 +212,8 @@ def dgtfdf(setup: DiscreteGameSetup, targets: str | Sequence[str] | None = None,
     settled = bool(change.size and change[-1] < settle_rtol)
     L = gains[-1]
     return DiscreteGtfdfDesign(
-        discrete_game_generator(setup, L, [target]), target, Phi @ L, L, gains, P, levels,
+        discrete_game_generator(setup, L, [target], names=names, isolates=isolates), target, Phi @ L, L, gains, P,
+        levels,
         scipy.linalg.eigvals(Phi @ (np.eye(m.n) - L @ C)), settled,
         (int(above[-1]) + 2 if above.size else 1) if settled else None, model=setup.model,
     )
@@ -293,6 +303,8 @@ def dgtmfdf(
     min_sigma: float = 1e-3,
     max_radius: float = 0.99,
     xtol: float = 1e-8,
+    names: Sequence[str] | None = None,
+    isolates: Sequence[str | None] | Mapping[str, str | None] | None = None,
 ) -> DiscreteGtmfdfDesign:
     """Discrete game-theoretic multiple-fault detection filter, constant gain (Murray 2012, §5.2.2, (5.31)–(5.41)).
 
@@ -322,6 +334,9 @@ def dgtmfdf(
         ``exp(−σΔt)`` for a decay rate σ [1/s].  The optimum usually sits on this bound.
     xtol : float, optional
         (5.41) has converged when its step is below ``xtol`` times ``‖L‖`` (default 1e-8).
+    names, isolates : optional
+        Residual names and the fault each residual isolates (default ``<target>[j]`` tied to each target), as
+        :func:`~fdikit.design.residual_labels.residual_labels`.
 
     Returns
     -------
@@ -419,7 +434,8 @@ def dgtmfdf(
         it_gd = int(opt.nit)
         notes.append(f"gradient: {opt.message} ({opt.nit} iterations)")
     return DiscreteGtmfdfDesign(
-        discrete_game_generator(setup, L), m.A @ L, L, scipy.linalg.eigvals(m.A @ (np.eye(m.n) - L @ m.C)),
+        discrete_game_generator(setup, L, names=names, isolates=isolates), m.A @ L, L,
+        scipy.linalg.eigvals(m.A @ (np.eye(m.n) - L @ m.C)),
         float(np.linalg.svd(np.eye(m.n) - L @ m.C, compute_uv=False)[-1]), J, J_init, g, "+".join(stages),
         (it_fp, it_gd), discrete_game_riccati(setup, L), tuple(notes), model=setup.model,
     )

@@ -44,6 +44,7 @@ import numpy as np
 from fdikit import linalg, validate
 from fdikit.design.game.setup import GameProblem, game_problem, per_target, weight
 from fdikit.design.observers.full_order import observer_generator
+from fdikit.design.residual_labels import label_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.residuals import ResidualGenerator
@@ -513,7 +514,10 @@ def gain_update(setup: DiscreteGameSetup, L) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------- the residual generator
-def discrete_game_generator(setup: DiscreteGameSetup, L, targets: Sequence[str] | None = None) -> ResidualGenerator:
+def discrete_game_generator(
+    setup: DiscreteGameSetup, L, targets: Sequence[str] | None = None, *, names: Sequence[str] | None = None,
+    isolates: Sequence[str | None] | Mapping[str, str | None] | None = None,
+) -> ResidualGenerator:
     """Residual generator of the observer (5.3) with projected residuals ``Q_iᵀ r`` (Murray 2012, (5.3), (5.6)).
 
     ``x̄(k+1) = Φ(I − LC) x̄ + (Bu − ΦL Du) u + ΦL y``, ``r = y − C x̄ − Du u``; ``Q_i`` is an orthonormal
@@ -527,6 +531,9 @@ def discrete_game_generator(setup: DiscreteGameSetup, L, targets: Sequence[str] 
         The constant gain in Murray's filtered form; the generator's observer gain is ``Φ L``.
     targets : sequence of str, optional
         The targets whose projected residuals are produced, in this order (default every target of the setup).
+    names, isolates : optional
+        Residual names and the fault each residual isolates (default ``<target>[j]`` tied to its target), as
+        :func:`~fdikit.design.residual_labels.residual_labels`.
 
     Returns
     -------
@@ -548,10 +555,11 @@ def discrete_game_generator(setup: DiscreteGameSetup, L, targets: Sequence[str] 
     Murray 2012, §5.1.1, (5.3), (5.6); §2.2.2 (the discrete detection filter).
     """
     m = setup.model
-    names, blocks, isolates = [], [], []
+    res_names, blocks, iso = [], [], []
     for t in targets if targets is not None else setup.names:
         Qi = linalg.orth(setup.problem.projectors[t])
         blocks.append(Qi)
-        names += [f"{t}[{j}]" for j in range(Qi.shape[1])]
-        isolates += [t] * Qi.shape[1]
-    return observer_generator(m, m.A @ np.asarray(L, dtype=float), names, np.hstack(blocks), isolates)
+        res_names += [f"{t}[{j}]" for j in range(Qi.shape[1])]
+        iso += [t] * Qi.shape[1]
+    gen = observer_generator(m, m.A @ np.asarray(L, dtype=float), res_names, np.hstack(blocks))
+    return label_generator(gen, m, names, isolates, default_isolates=iso)

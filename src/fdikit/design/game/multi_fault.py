@@ -53,6 +53,7 @@ from fdikit.design.game.single_fault import (
     single_fault_game_filter,
 )
 from fdikit.design.observers.full_order import observer_generator
+from fdikit.design.residual_labels import label_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import ProblemDesign
@@ -177,6 +178,8 @@ def game_filter(
     options: Mapping | None = None,
     P0=None,
     steps: int | None = None,
+    names: Sequence[str] | None = None,
+    isolates: Sequence[str | None] | Mapping[str, str | None] | None = None,
 ) -> GameDesign | DiscreteGtmfdfDesign:
     """Game-theoretic multiple-fault detection filter, steady state (Murray 2012, (3.27)–(3.28)).
 
@@ -233,6 +236,9 @@ def game_filter(
     method, options : passed to :func:`scipy.optimize.minimize` (default ``'L-BFGS-B'`` and options
         ``{'maxiter': 500}``); for a discrete model see above.
     P0, steps : discrete models only: initial-error weight (``P(k0) = P0/γ``) and horizon in samples.
+    names, isolates : optional
+        Residual names and the fault each residual isolates (default ``<target>[k]`` tied to each target), as
+        :func:`~fdikit.design.residual_labels.residual_labels`.
 
     Returns
     -------
@@ -277,7 +283,7 @@ def game_filter(
                                  "min_sigma, max_radius, xtol")
         setup = discrete_setup(model, targets, nuisance, gamma=gamma, V=V, Q=Q, M=M, K=K, N=N, P0=P0,
                                 steps=steps)
-        return dgtmfdf(setup, L0, method=dmethod, **dict(options or {}))
+        return dgtmfdf(setup, L0, method=dmethod, names=names, isolates=isolates, **dict(options or {}))
     continuous_only(model, P0=P0, steps=steps)
     eps_stab = 1e-3 if eps_stab is None else eps_stab
     eps_ham = 1e-3 if eps_ham is None else eps_ham
@@ -342,9 +348,10 @@ def game_filter(
     L = x.reshape(n, p)
     J, _, pis, margins = stacked_cost(prob, L, tg, Vw)
     bases = {t: residual_basis(prob.projectors[t]) for t in prob.names}
-    names = [nm for t in prob.names for nm in residual_names(t, bases[t].shape[1])]
-    isolates = [t for t in prob.names for _ in range(bases[t].shape[1])]
-    gen = observer_generator(model, L, names, np.hstack(list(bases.values())), isolates)
+    res_names = [nm for t in prob.names for nm in residual_names(t, bases[t].shape[1])]
+    iso = [t for t in prob.names for _ in range(bases[t].shape[1])]
+    gen = label_generator(observer_generator(model, L, res_names, np.hstack(list(bases.values()))), model, names,
+                          isolates, default_isolates=iso)
     return GameDesign(
         generator=gen, gain=L, poles=scipy.linalg.eigvals(model.A - L @ model.C), riccati=pis,
         hamiltonian_margins=margins, projectors=dict(prob.projectors), cost=J, initial_gain=L0, initial_cost=J0,

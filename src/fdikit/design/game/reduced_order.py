@@ -44,6 +44,7 @@ import scipy.linalg
 from fdikit import linalg
 from fdikit.design.game.goh import GohRiccatiSolution, goh_riccati
 from fdikit.design.game.setup import GameProblem, game_problem, per_target
+from fdikit.design.residual_labels import label_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import ProblemDesign
@@ -132,6 +133,8 @@ def goh_filter(
     V=1.0,
     Q=1e-4,
     rtol: float | None = None,
+    names: Sequence[str] | None = None,
+    isolates: Sequence[str | None] | Mapping[str, str | None] | None = None,
 ) -> GohFilterDesign:
     """Reduced-order asymptotic game filter for one or several targets (Murray 2012, (4.60)–(4.75)).
 
@@ -150,6 +153,9 @@ def goh_filter(
     Q : weight on ``Ĥᵢ C e`` (scalar, p x p, or a mapping target → weight).  ``Q < 1/V`` keeps the
         Goh Riccati equation of standard (LQ) type.
     rtol : rank tolerance of the subspace computations.
+    names, isolates : optional
+        Residual names and the fault each residual isolates (default ``<target>[k]`` tied to each target), as
+        :func:`~fdikit.design.residual_labels.residual_labels`.
 
     Returns
     -------
@@ -185,15 +191,15 @@ def goh_filter(
             "model and discretise the generator"
         )
     prob = game_problem(model, targets, nuisance, rtol)
-    names = prob.names
+    tnames = prob.names
     given = [targets] if isinstance(targets, str) else list(targets)
-    Qs = per_target("Q", Q, names, [str(g) for g in given])
+    Qs = per_target("Q", Q, tnames, [str(g) for g in given])
     A, C, n, p = model.A, model.C, model.n, model.p
     sols = {t: goh_riccati(A, C, prob.complementary[t], V=V, Q=Qs[t], projector=prob.projectors[t], rtol=rtol)
-            for t in names}
+            for t in tnames}
     kernel = reduce(lambda U, W: linalg.intersect(U, W, rtol), [s.kernel for s in sols.values()])
-    if len(names) == 1:
-        Gam, n1 = sols[names[0]].transformation, sols[names[0]].order
+    if len(tnames) == 1:
+        Gam, n1 = sols[tnames[0]].transformation, sols[tnames[0]].order
     else:
         comp = linalg.null(kernel.T, rtol) if kernel.shape[1] else np.eye(n)
         Gam, n1 = np.vstack([comp.T, kernel.T]), comp.shape[1]
@@ -202,10 +208,10 @@ def goh_filter(
     G1 = Gam[:n1]
     At, Ct = Gam @ A @ Gam.T, C @ Gam.T
     A11, A12, C1, C2 = At[:n1, :n1], At[:n1, n1:], Ct[:, :n1], Ct[:, n1:]
-    Vw = sols[names[0]].V
+    Vw = sols[tnames[0]].V
     Vi = np.linalg.inv(Vw)
     Sbar, lhs, rhs = {}, np.zeros((n1, n1)), np.zeros((n1, p))
-    for t in names:
+    for t in tnames:
         s = sols[t]
         Sb = G1 @ s.S @ G1.T
         Sbar[t] = (Sb + Sb.T) / 2
@@ -227,10 +233,10 @@ def goh_filter(
     if np.any(poles.real >= 0):
         raise DesignError(f"the reduced-order Goh filter is not stable: poles {np.round(poles, 6).tolist()}")
     sep = 0.0
-    if len(names) > 1:
+    if len(tnames) > 1:
         inv = np.linalg.inv(lhs)
-        for j in names:
-            for k in names:
+        for j in tnames:
+            for k in tnames:
                 target = Sbar[j] if j == k else 0 * Sbar[j]
                 sep = max(sep, np.linalg.norm(Sbar[j] @ inv @ Sbar[k] - target) / np.linalg.norm(Sbar[j]))
     struct = float(np.linalg.norm(A12 - L1 @ C2) / max(np.linalg.norm(A), 1e-300)) if n1 < n else 0.0
@@ -239,7 +245,7 @@ def goh_filter(
         K = np.linalg.solve(C2.T @ Vi @ C2, C2.T @ Vi)
     B1, Du = G1 @ model.Bu, model.Du
     rows_C, rows_D, res_names, iso = [], [], [], []
-    for t in names:
+    for t in tnames:
         U = linalg.orth(prob.projectors[t])
         rows_C.append(-U.T @ C1)
         rows_D.append(np.hstack([-U.T @ Du, U.T]))
@@ -249,6 +255,7 @@ def goh_filter(
         A=Acl, B=np.hstack([B1 - L1 @ Du, L1]), C=np.vstack(rows_C), D=np.vstack(rows_D),
         controls=model.controls, outputs=model.outputs, residuals=tuple(res_names), dt=None, isolates=tuple(iso),
     )
+    gen = label_generator(gen, model, names, isolates)
     return GohFilterDesign(gen, L1, poles, Gam, n1, sols, Sbar, dict(prob.projectors), K, float(sep), struct, prob)
 
 
@@ -260,6 +267,8 @@ def goh_detector(
     V=1.0,
     Q=1e-4,
     rtol: float | None = None,
+    names: Sequence[str] | None = None,
+    isolates: Sequence[str | None] | Mapping[str, str | None] | None = None,
 ) -> GohFilterDesign:
     """PATH's reduced-order detector for one target fault (Douglas et al. 1996, §9.5, (9.61)–(9.68), (9.77)).
 
@@ -275,6 +284,9 @@ def goh_detector(
     V : PATH's ``V̄`` (``ν/γ``; 0.8 in §9.6), p x p or scalar.
     Q : PATH's ``Q₁`` (1 in §9.6).
     rtol : rank tolerance.
+    names, isolates : optional
+        Residual names and the fault each residual isolates (as :func:`goh_filter`), as
+        :func:`~fdikit.design.residual_labels.residual_labels`.
 
     Returns
     -------
@@ -305,4 +317,4 @@ def goh_detector(
     prob_targets = targets if not isinstance(targets, str) else [targets]
     if len(prob_targets) != 1:
         raise ParameterError(f"goh_detector detects one target fault, got {list(prob_targets)}; use goh_filter")
-    return goh_filter(model, prob_targets, nuisance, V=V, Q=Q, rtol=rtol)
+    return goh_filter(model, prob_targets, nuisance, V=V, Q=Q, rtol=rtol, names=names, isolates=isolates)

@@ -30,6 +30,7 @@ from fdikit.design.game.discrete_setup import DiscreteGameSetup, discrete_game_s
 from fdikit.design.game.riccati import checked_gamma, require_continuous, solve_game_are
 from fdikit.design.game.setup import GameProblem, game_problem, per_target, weight
 from fdikit.design.observers.full_order import observer_generator
+from fdikit.design.residual_labels import label_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.fault_maps import resolve_nuisance
 from fdikit.model import FaultModel
@@ -145,6 +146,8 @@ def single_fault_game_filter(
     R=0.0,
     P0=None,
     steps: int | None = None,
+    names: Sequence[str] | None = None,
+    isolates: Sequence[str | None] | Mapping[str, str | None] | None = None,
 ) -> SingleFaultGameDesign | DiscreteGtfdfDesign:
     """Single-fault game-theoretic detection filter, steady state (Murray 2012, (3.29)–(3.30)).
 
@@ -189,6 +192,9 @@ def single_fault_game_filter(
     M : complementary-fault weight (dim F̂ square, or scalar).
     R : PATH's weight ``R_1`` on ``(I − Ĥ) C e`` (p x p or scalar; default 0 = Murray's form).
     P0, steps : discrete models only: initial-error weight (``P(k0) = P0/γ``) and horizon in samples.
+    names, isolates : optional
+        Residual names and the fault each residual isolates (default ``<target>[k]`` tied to the target), as
+        :func:`~fdikit.design.residual_labels.residual_labels`.
 
     Returns
     -------
@@ -227,7 +233,7 @@ def single_fault_game_filter(
         setup = discrete_setup(model, targets, nuisance, gamma=gamma, V=V, Q=Q, M=M, P0=P0, steps=steps)
         if len(setup.names) != 1:
             raise DesignError(f"single_fault_game_filter takes one target, got {list(setup.names)}; use game_filter")
-        return dgtfdf(setup)
+        return dgtfdf(setup, names=names, isolates=isolates)
     continuous_only(model, P0=P0, steps=steps)
     require_continuous(model)
     g = checked_gamma(gamma)
@@ -270,7 +276,8 @@ def single_fault_game_filter(
     if np.any(poles.real >= 0):
         raise DesignError(f"the single-fault game filter for {name!r} is not stable: poles {np.round(poles, 6)}")
     basis = residual_basis(H)
-    gen = observer_generator(model, L, residual_names(name, basis.shape[1]), basis, [name] * basis.shape[1])
+    gen = label_generator(observer_generator(model, L, residual_names(name, basis.shape[1]), basis), model, names,
+                          isolates, default_isolates=[name] * basis.shape[1])
     return SingleFaultGameDesign(gen, L, poles, P, H, name, prob, solver)
 
 
@@ -332,6 +339,8 @@ def game_filter_bank(
     V=1.0,
     Q=1e-4,
     M=0.01,
+    names: Sequence[str] | None = None,
+    isolates: Sequence[str | None] | Mapping[str, str | None] | None = None,
 ) -> GameBankDesign:
     """One single-fault game filter per fault, each blocking all the others (Murray 2012, §6.1.1).
 
@@ -356,6 +365,9 @@ def game_filter_bank(
     Q, M : float, array or mapping fault → value
         Output weight (p x p) and complementary-fault weight (sized to each ``F̂_i``) of each filter (defaults 1e-4
         and 0.01; scalars mean multiples of I).
+    names, isolates : optional
+        Names and isolated faults of the stacked residuals of the bank (default ``<target>[k]`` of each filter,
+        tied to its target), as :func:`~fdikit.design.residual_labels.residual_labels`.
 
     Returns
     -------
@@ -384,4 +396,5 @@ def game_filter_bank(
         designs[name] = single_fault_game_filter(
             model, {name: prob.targets[name]}, others, gamma=gamma, V=V, Q=Qs[name], M=Ms[name]
         )
-    return GameBankDesign(stack_generators([d.generator for d in designs.values()]), designs)
+    return GameBankDesign(label_generator(stack_generators([d.generator for d in designs.values()]), model, names,
+                                          isolates), designs)

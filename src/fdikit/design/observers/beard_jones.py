@@ -51,6 +51,7 @@ import scipy.linalg
 
 from fdikit import linalg, lti, validate
 from fdikit.design.observers.full_order import observer_generator
+from fdikit.design.residual_labels import label_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.fault_maps import resolve_faults
 from fdikit.model import FaultModel
@@ -284,8 +285,8 @@ def _residual_generator(model, L, names, spaces, rtol):
         isolates += [name] * Q.shape[1]
     Q = np.hstack(blocks)
     # L is the observer gain (the report's matrix negated): r = y − C x̂ − Du u, x̂' = (A − LC) x̂ + (Bu − L Du) u + L y
-    gen = observer_generator(model, L, res_names, Q, isolates)
-    return gen, projectors
+    gen = observer_generator(model, L, res_names, Q)
+    return gen, isolates, projectors
 
 
 def beard_jones(
@@ -297,6 +298,8 @@ def beard_jones(
     sweeps: int = 100,
     seed: int = 0,
     rtol: float | None = None,
+    names: Sequence[str] | None = None,
+    isolates: Sequence[str | None] | Mapping[str, str | None] | None = None,
 ) -> BeardJonesDesign:
     """Beard–Jones detection filter by left-eigenvector assignment (Douglas et al. 1996, App. B, Alg. B.1).
 
@@ -311,6 +314,9 @@ def beard_jones(
     complement_poles : the ``ν_0 = n − Σ ν_i`` remaining eigenvalues (Ξ_0).
     sweeps, seed : eigenvector selection (sweep limit, default 100; seed of the random start, default 0).
     rtol : relative rank tolerance of the subspace computations (default ``None``: fdikit.linalg's default).
+    names, isolates : optional
+        Residual names and the fault each residual isolates (default ``<fault>[k]`` tied to each target), as
+        :func:`~fdikit.design.residual_labels.residual_labels`.
 
     Returns
     -------
@@ -384,7 +390,8 @@ def beard_jones(
     L_report, Vm, order, sigma, bound = _assign(model, spaces, sets, sweeps, seed, rtol)
     L = -L_report  # the observer gain: A + L_report C = A − L C
     achieved = scipy.linalg.eigvals(A - L @ C)
-    gen, projectors = _residual_generator(model, L, list(spaces), spaces, rtol)
+    gen, default_iso, projectors = _residual_generator(model, L, list(spaces), spaces, rtol)
+    gen = label_generator(gen, model, names, isolates, default_isolates=default_iso)
     return BeardJonesDesign(gen, L, sets, achieved, spaces, projectors, Vm, order, sigma, bound, model=model)
 
 
@@ -441,6 +448,8 @@ def restricted_diagonal(
     sweeps: int = 100,
     seed: int = 0,
     rtol: float | None = None,
+    names: Sequence[str] | None = None,
+    isolates: Sequence[str | None] | Mapping[str, str | None] | None = None,
 ) -> RestrictedDiagonalDesign:
     """Restricted-diagonal detection filters (RDDFP, Douglas et al. 1996, App. A.4).
 
@@ -459,6 +468,9 @@ def restricted_diagonal(
     poles : n stable, distinct, self-conjugate eigenvalues of ``A − L C`` used by every filter;
         the first ``dim T̂_i`` go to the nuisance space (keep conjugate pairs adjacent).
     sweeps, seed, rtol : as in :func:`beard_jones`.
+    names, isolates : optional
+        Residual names and the fault each residual isolates (default ``<target>[k]`` tied to its target), as
+        :func:`~fdikit.design.residual_labels.residual_labels`.
 
     Returns
     -------
@@ -519,10 +531,12 @@ def restricted_diagonal(
         # residual: every output direction outside C T̂ (a.11), tied to the target
         H = np.eye(model.p) - image_hat @ image_hat.T
         Q = linalg.orth(H, rtol)
-        names = [f"{target}[{k}]" for k in range(Q.shape[1])]
-        gen = observer_generator(model, L, names, Q, [target] * len(names))
+        res_names = [f"{target}[{k}]" for k in range(Q.shape[1])]
+        gen = label_generator(observer_generator(model, L, res_names, Q), model,
+                              default_isolates=[target] * len(res_names))
         filters[target] = BeardJonesDesign(gen, L, sub, scipy.linalg.eigvals(A - L @ C), {nuis_name: T_hat},
                                            {target: H}, Vm, order, sigma, bound, model=model)
         spaces[target] = T_hat
         gens.append(gen)
-    return RestrictedDiagonalDesign(stack_generators(gens), filters, spaces, model=model)
+    return RestrictedDiagonalDesign(label_generator(stack_generators(gens), model, names, isolates), filters, spaces,
+                                    model=model)

@@ -16,13 +16,14 @@ Kalman residual the white innovation sequence with covariance ``C P Cᵀ + R``.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
 
 from fdikit import lti, validate
+from fdikit.design.residual_labels import label_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import FieldReport
@@ -119,7 +120,9 @@ def observer_generator(
     L: np.ndarray,
     outputs: Sequence[str] | None = None,
     projection: np.ndarray | None = None,
-    isolates: Sequence[str | None] | None = None,
+    isolates: Sequence[str | None] | Mapping[str, str | None] | None = None,
+    *,
+    names: Sequence[str] | None = None,
 ) -> ResidualGenerator:
     """The residual generator of the observer ``x̂' = A x̂ + Bu u + L (y − C x̂ − Du u)``.
 
@@ -133,16 +136,28 @@ def observer_generator(
     L : (n, p) array_like
         Observer gain (the filter's state matrix is ``A − L C``).
     outputs : sequence of str, optional
-        Names of the residuals (default: the model's output names, or ``r0, r1 …`` with a projection).
+        Names of the residuals (default: the model's output names, or ``r0, r1 …`` with a projection); the
+        same as ``names``.
     projection : (p, k) array_like, optional
         Output projection ``Q``; the residuals are ``Qᵀ r`` (default: identity, all ``p`` residuals).
-    isolates : sequence of str or None, optional
-        The fault each residual is tied to (one entry per residual; default none).
+    isolates : sequence of (str or None) or mapping, optional
+        The fault each residual isolates, by fault name: one entry per residual (None: detection only), or a
+        mapping residual name -> fault (:func:`~fdikit.design.residual_labels.residual_labels`); default none.
+    names : sequence of str, optional
+        Residual names (the keyword all designs take; give ``names`` or ``outputs``, not both).
 
     Returns
     -------
     ResidualGenerator
-        ``z' = (A − L C) z + [Bu − L Du, L] [u; y]``, ``r = Qᵀ (y − C z − Du u)``.
+        ``z' = (A − L C) z + [Bu − L Du, L] [u; y]``, ``r = Qᵀ (y − C z − Du u)``; it carries the model's
+        operating point, when the model has one.
+
+    Raises
+    ------
+    ParameterError
+        A bad gain or projection shape, both ``outputs`` and ``names``, or bad ``names`` / ``isolates``.
+    ModelError
+        An ``isolates`` entry that is no fault of the model.
 
     Examples
     --------
@@ -160,9 +175,15 @@ def observer_generator(
     A, C, Bu, Du = model.A, model.C, model.Bu, model.Du
     L = validate.as_matrix("L (the observer gain)", L, (model.n, model.p))
     Q = np.eye(model.p) if projection is None else validate.as_matrix("projection", projection, (model.p, None))
+    if outputs is not None and names is not None:
+        raise ParameterError("give the residual names once: names= (outputs= is its older spelling)")
+    outputs = names if outputs is None else outputs
     if outputs is None:
         outputs = model.outputs if projection is None else tuple(f"r{k}" for k in range(Q.shape[1]))
-    return ResidualGenerator(
+    outputs = (outputs,) if isinstance(outputs, str) else tuple(outputs)
+    if len(outputs) != Q.shape[1]:
+        raise ParameterError(f"{len(outputs)} residual names for {Q.shape[1]} residuals")
+    gen = ResidualGenerator(
         A=A - L @ C,
         B=np.hstack([Bu - L @ Du, L]),
         C=-Q.T @ C,
@@ -171,8 +192,8 @@ def observer_generator(
         outputs=model.outputs,
         residuals=tuple(outputs),
         dt=model.dt,
-        isolates=tuple(isolates) if isolates is not None else (),
     )
+    return label_generator(gen, model, None, isolates)
 
 
 def _check_stable(model: FaultModel, poles: np.ndarray, what: str) -> None:
@@ -186,7 +207,8 @@ def _check_stable(model: FaultModel, poles: np.ndarray, what: str) -> None:
         )
 
 
-def observer(model: FaultModel, poles: Sequence[complex], method: str = "place") -> ObserverDesign:
+def observer(model: FaultModel, poles: Sequence[complex], method: str = "place", *, names: Sequence[str] | None = None,
+             isolates: Sequence[str | None] | Mapping[str, str | None] | None = None) -> ObserverDesign:
     """Full-order observer residual generator by pole placement.
 
     Parameters
@@ -195,6 +217,9 @@ def observer(model: FaultModel, poles: Sequence[complex], method: str = "place")
     poles : n desired eigenvalues of ``A − L C`` (complex values in conjugate pairs).
     method : ``'place'`` (:func:`control.place`, Tits–Yang; repeated poles up to the
         number of outputs) or ``'varga'`` (:func:`control.place_varga`, Schur method).
+    names, isolates : optional
+        Residual names (default the output names) and the fault each residual isolates (default none), as
+        :func:`~fdikit.design.residual_labels.residual_labels`.
 
     Returns
     -------
@@ -242,7 +267,7 @@ def observer(model: FaultModel, poles: Sequence[complex], method: str = "place")
         raise DesignError(f"pole placement failed for poles {poles.tolist()}: {exc}") from exc
     achieved = scipy.linalg.eigvals(model.A - L @ model.C)
     _check_stable(model, achieved, "the placed observer")
-    return ObserverDesign(observer_generator(model, L), L, achieved, model=model)
+    return ObserverDesign(observer_generator(model, L, isolates=isolates, names=names), L, achieved, model=model)
 
 
 def _poles(poles, n: int) -> np.ndarray:
@@ -253,7 +278,8 @@ def _poles(poles, n: int) -> np.ndarray:
     return out
 
 
-def kalman(model: FaultModel, Q, R) -> ObserverDesign:
+def kalman(model: FaultModel, Q, R, *, names: Sequence[str] | None = None,
+           isolates: Sequence[str | None] | Mapping[str, str | None] | None = None) -> ObserverDesign:
     """Steady-state Kalman filter residual generator (the innovation).
 
     The Riccati equation is solved by :func:`scipy.linalg.solve_discrete_are` or
@@ -272,6 +298,10 @@ def kalman(model: FaultModel, Q, R) -> ObserverDesign:
         time, intensity (PSD) in continuous time; a scalar means ``Q I``.
     R : float or (p, p) array_like
         Covariance (intensity) of measurement noise added to every output; a scalar means ``R I``.
+    names, isolates : optional
+        Residual names (default the output names) and the fault each residual isolates (default none: the
+        innovation detects; ``isolates=["yaw_rate_sensor", …]`` ties each output's residual to a fault), as
+        :func:`~fdikit.design.residual_labels.residual_labels`.
 
     Returns
     -------
@@ -326,4 +356,5 @@ def kalman(model: FaultModel, Q, R) -> ObserverDesign:
         ) from exc
     poles = scipy.linalg.eigvals(A - L @ C)
     _check_stable(model, poles, "the Kalman filter")
-    return ObserverDesign(observer_generator(model, L), L, poles, (P + P.T) / 2, (innov + innov.T) / 2, model=model)
+    return ObserverDesign(observer_generator(model, L, isolates=isolates, names=names), L, poles, (P + P.T) / 2,
+                          (innov + innov.T) / 2, model=model)

@@ -54,6 +54,7 @@ import scipy.linalg
 from fdikit import linalg, validate
 from fdikit.design.observers.detection_gain import DetectionGainFamily, detection_gain_family
 from fdikit.design.observers.full_order import observer_generator
+from fdikit.design.residual_labels import label_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import FieldReport
@@ -304,6 +305,8 @@ def hinf_detection_filter(
     steady_tol: float = 1e-9,
     polish: bool = True,
     rtol: float | None = None,
+    names: Sequence[str] | None = None,
+    isolates: Sequence[str | None] | Mapping[str, str | None] | None = None,
 ) -> HinfDesign:
     """H∞-bounded detection filter (Douglas et al. 1996, App. C, Prop. C.7, (c.17)–(c.18)).
 
@@ -321,6 +324,9 @@ def hinf_detection_filter(
     horizon, steady_tol : integration limit (s) and relative steady-state tolerance of the
         differential Riccati equation; ``polish`` refines the steady state by Newton's method.
     rtol : relative rank tolerance of the subspace computations.
+    names, isolates : optional
+        Residual names and the fault each residual isolates (default ``<fault>[k]`` tied to each target), as
+        :func:`~fdikit.design.residual_labels.residual_labels`.
 
     Returns
     -------
@@ -364,11 +370,12 @@ def hinf_detection_filter(
     import control
 
     fam = detection_gain_family(model, targets, rtol)
-    names, B, D = _omega(model, disturbances)
+    omega_names, B, D = _omega(model, disturbances)
     p = model.p
     if linalg.rank(D @ D.T) < p:
         raise DesignError(
-            f"D Dᵀ of the disturbance/noise inputs {list(names)} is singular (rank {linalg.rank(D @ D.T)} < p = {p}); "
+            f"D Dᵀ of the disturbance/noise inputs {list(omega_names)} is singular (rank {linalg.rank(D @ D.T)} "
+            f"< p = {p}); "
             "Prop. C.7 needs V = D₂₁D₂₁ᵀ invertible: give every output its own noise input"
         )
     T = fam.coordinates
@@ -401,14 +408,15 @@ def hinf_detection_filter(
     sys = control.ss(model.A - L @ model.C, B - L @ D, H @ model.C, H @ D)
     norm, peak = control.linfnorm(sys)
     bound = float(np.sqrt(gamma**2 + np.linalg.norm(H @ D, 2) ** 2))
-    res_names, isolates = [], []
+    res_names, iso = [], []
     for k, Hk in fam.residual_maps.items():
         res_names += [f"{k}[{j}]" for j in range(Hk.shape[0])]
-        isolates += [k] * Hk.shape[0]
-    gen = observer_generator(model, L, res_names, H.T, isolates)
+        iso += [k] * Hk.shape[0]
+    gen = label_generator(observer_generator(model, L, res_names, H.T), model, names, isolates,
+                          default_isolates=iso)
     rel = float(np.linalg.norm(ric.residual(Y)) / ric.scale(Y))
     return HinfDesign(gen, L, float(gamma), form, Y, Y0, rel, t_end, alphas, alpha0, poles, float(norm),
-                      float(peak), bound, fam, names, B, D, model=model)
+                      float(peak), bound, fam, omega_names, B, D, model=model)
 
 
 # ---------------------------------------------------------------------- (c.19)–(c.26) fault enhancement
@@ -448,7 +456,8 @@ class Enhancement(FieldReport):
         return {"fault": self.fault, "direction": self.direction, "ratio": self.ratio}
 
 
-def enhancement_direction(design: HinfDesign, fault: str) -> Enhancement:
+def enhancement_direction(design: HinfDesign, fault: str, *, names: Sequence[str] | None = None,
+        isolates: Sequence[str | None] | Mapping[str, str | None] | None = None) -> Enhancement:
     """Fault-enhancing direction of a multi-dimensional residual (Douglas et al. 1996, (c.19)–(c.26), T = ∞).
 
     On the reduced realisation of ``z_i`` (the factor space ``X / Σ_{j≠i} W_j``, coordinates
@@ -468,6 +477,9 @@ def enhancement_direction(design: HinfDesign, fault: str) -> Enhancement:
         The result of :func:`hinf_detection_filter`.
     fault : str
         One of the design's faults (its residual ``z_i`` is combined).
+    names, isolates : optional
+        Residual names and the fault each residual isolates (default ``<fault>[q]`` tied to ``fault``), as
+        :func:`~fdikit.design.residual_labels.residual_labels`.
 
     Returns
     -------
@@ -525,7 +537,10 @@ def enhancement_direction(design: HinfDesign, fault: str) -> Enhancement:
     q = V[:, -1] / np.linalg.norm(V[:, -1])
     q = q if q[np.argmax(np.abs(q))] > 0 else -q
     g = design.generator
-    rows = [i for i, k in enumerate(g.isolates) if k == fault]
+    sizes = {k: Hk.shape[0] for k, Hk in design.family.residual_maps.items()}  # the rows of z_i, whatever the names
+    start = sum(sizes[k] for k in list(sizes)[: list(sizes).index(fault)])
+    rows = list(range(start, start + sizes[fault]))
     gen = ResidualGenerator(g.A, g.B, (q @ g.C[rows]).reshape(1, -1), (q @ g.D[rows]).reshape(1, -1),
                             g.controls, g.outputs, (f"{fault}[q]",), g.dt, (fault,))
+    gen = label_generator(gen, design.model, names, isolates)
     return Enhancement(fault, q, float(lam[-1]), gen, model=design.model)

@@ -51,13 +51,15 @@ must be stable); the design's ``fixed_modes`` and ``notes`` report them.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import dataclasses
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
 
 from fdikit import fault_maps, linalg, lti, validate
+from fdikit.design.residual_labels import label_generator, residual_labels
 from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import FieldReport
@@ -297,7 +299,8 @@ def _freqresp(A, B, C, D, omega, dt) -> np.ndarray:
 # ---------------------------------------------------------------------- design
 def uio(
     model: FaultModel, targets: str | Sequence[str], nuisance: Sequence[str] | str = (),
-    poles: Sequence[complex] | None = None
+    poles: Sequence[complex] | None = None, *, names: Sequence[str] | None = None,
+    isolates: Sequence[str | None] | Mapping[str, str | None] | None = None,
 ) -> UIODesign:
     """Unknown-input observer residual generator for one target fault (Chen & Patton 1999, §3.2).
 
@@ -315,6 +318,9 @@ def uio(
         (``None``): ``K1`` is the gain of the unit-weight steady-state Kalman filter of that part
         (``Q = I``, ``R = I``): stable by construction and with moderate gains; its poles are
         reported in ``poles``.
+    names, isolates : optional
+        Residual names and the fault each residual isolates (default ``<target>[k]``, all tied to the target),
+        as :func:`~fdikit.design.residual_labels.residual_labels`.
 
     Returns
     -------
@@ -452,6 +458,7 @@ def uio(
         dt=model.dt,
         isolates=(target,) * q,
     )
+    gen = label_generator(gen, model, names, isolates)
 
     # --- attained decoupling and target detectability, from the internal form
     omega = _grid(model, N)
@@ -491,6 +498,8 @@ def uio_bank(
     nuisance: Sequence[str] | str = (),
     *,
     poles: Sequence[complex] | None = None,
+    names: Sequence[str] | None = None,
+    isolates: Sequence[str | None] | Mapping[str, str | None] | None = None,
 ) -> list[UIODesign]:
     """A bank of UIOs (generalised observer scheme): one per fault, each decoupled from the others.
 
@@ -507,6 +516,10 @@ def uio_bank(
         fault input of the model that is not a target, or a sequence of names.  Faults of the model
         that are neither targets nor nuisance are neither targeted nor decoupled.
     poles : passed to every :func:`uio` (``None``: each design's default).
+    names, isolates : optional
+        Names and isolated faults of the residuals of the whole bank, member after member (default
+        ``<target>[k]`` of each member, tied to its target), as :func:`~fdikit.design.residual_labels.residual_labels`;
+        each member's generator gets its share.
 
     Returns
     -------
@@ -549,4 +562,16 @@ def uio_bank(
             bank.append(uio(model, f, nuisance=[g for g in faults if g != f] + list(extra), poles=poles))
         except DesignError as exc:
             raise DesignError(f"bank member for target {f!r}: {exc}") from exc
-    return bank
+    if names is None and isolates is None:
+        return bank
+    gens = [d.generator for d in bank]
+    res, iso = residual_labels(model, sum(len(g.residuals) for g in gens), names, isolates,
+                               default_names=[r for g in gens for r in g.residuals],
+                               default_isolates=[k for g in gens for k in g.isolates])
+    out, start = [], 0
+    for d, g in zip(bank, gens):
+        stop = start + len(g.residuals)
+        out.append(dataclasses.replace(d, generator=dataclasses.replace(g, residuals=res[start:stop],
+                                                                         isolates=iso[start:stop])))
+        start = stop
+    return out
