@@ -217,7 +217,8 @@ def _grid(rel: np.ndarray, rel_ns, dt, jitter, labels: list[str]) -> tuple[np.nd
     k = np.rint(rel / dt)
     dev = np.abs(rel - k * dt)
     if not given and n > 2 and np.any(dev > tol + slack):  # the median of a rounded clock is off: fit the slope
-        fit = float(np.dot(k, rel) / np.dot(k, k))
+        steps = np.concatenate(([0.0], np.cumsum(np.maximum(np.rint(np.diff(rel) / dt), 1.0))))  # no drift
+        fit = float(np.dot(steps, rel) / np.dot(steps, steps))
         tol_fit = _JITTER * fit if jitter is None else tol
         k_fit = np.rint(rel / fit)
         dev_fit = np.abs(rel - k_fit * fit)
@@ -274,6 +275,8 @@ def _valid_rows(valid, df) -> tuple[np.ndarray, object]:
 
 
 def _labels(fault, df) -> np.ndarray:
+    import pandas as pd
+
     n = len(df)
     if fault is None:
         return np.full(n, NO_FAULT, dtype=object)
@@ -283,7 +286,7 @@ def _labels(fault, df) -> np.ndarray:
         raise DataError(f"fault: the log has no column {fault!r}; its columns are {list(df.columns)}")
     out = df[fault].to_numpy(dtype=object)
     for k, v in enumerate(out):
-        if v is None or v == "" or (isinstance(v, float) and np.isnan(v)) or repr(v) == "<NA>":
+        if v is None or v is pd.NA or (isinstance(v, float) and np.isnan(v)) or (isinstance(v, str) and not v):
             out[k] = NO_FAULT
         elif not isinstance(v, str):
             raise DataError(f"fault label column {fault!r} holds {v!r} ({type(v).__name__}) at row {k}; labels must "
