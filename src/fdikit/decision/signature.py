@@ -247,10 +247,11 @@ class SignatureTable:
     def resolve(self, names: Sequence[str], isolates: Sequence[str | None] | None = None) -> np.ndarray:
         """Membership of residuals in the table's groups: a (q, n_groups) bool matrix.
 
-        With ``members`` a group holds exactly the residuals listed there.  Otherwise residual ``i``
-        belongs to group ``g`` when ``g`` is its name, its tied fault ``isolates[i]``, or, for a stacked
-        bank residual named ``'<filter>:<...>'``, ``'<filter>:<isolates[i]>'`` (the groups of
-        :func:`fdikit.analysis.structure_matrix`).
+        Residual ``i`` belongs to group ``g`` when ``g`` is its name, its tied fault ``isolates[i]``, or,
+        for a stacked bank residual named ``'<filter>:<...>'``, ``'<filter>:<isolates[i]>'`` (the groups of
+        :func:`fdikit.analysis.structure_matrix`) — except that a residual listed in ``members`` belongs
+        exactly to the groups that list it.  (The GLR and SPRT fire per *block*: a block named after its
+        fault, as with ``blocks='isolates'``, finds its group by that rule.)
 
         Parameters
         ----------
@@ -276,10 +277,11 @@ class SignatureTable:
         M = np.zeros((len(names), len(self.groups)), bool)
         for j, g in enumerate(self.groups):
             for i, (n, f) in enumerate(zip(names, iso)):
-                if self.members is not None:
-                    M[i, j] = n in self.members.get(g, ())
-                else:
-                    M[i, j] = g == n or (f is not None and (g == f or (":" in n and g == f"{n.split(':', 1)[0]}:{f}")))
+                M[i, j] = g == n or (f is not None and (g == f or (":" in n and g == f"{n.split(':', 1)[0]}:{f}")))
+        if self.members is not None:
+            listed = np.array([[n in self.members.get(g, ()) for g in self.groups] for n in names], bool)
+            listed = listed.reshape(M.shape)
+            M = np.where(listed.any(axis=1, keepdims=True), listed, M)
         lonely = [n for n, row in zip(names, M) if not row.any()]
         if lonely:
             raise DataError(
