@@ -150,7 +150,7 @@ def _parse_text_times(what: str, values: np.ndarray):
 
 
 def _times(what: str, values, time_unit: str):
-    """(integer ns offsets or None, float seconds offsets, kind, timezone, start, row labels)."""
+    """(integer ns offsets or None, float seconds offsets, kind, timezone, start, row -> time text)."""
     import pandas as pd
 
     from fdikit.units import to_si
@@ -173,7 +173,7 @@ def _times(what: str, values, time_unit: str):
             raise DataError(f"{what} is missing or not finite at row {k}; every sample needs a time (drop rows "
                             "without one first)")
         start = float(seconds[0]) if seconds.size else 0.0
-        return None, seconds - start, "seconds", None, start, [f"{v:g} s" for v in seconds]
+        return None, seconds - start, "seconds", None, start, lambda i: f"{seconds[i]:g} s"
     else:
         idx = _parse_text_times(what, values.to_numpy(dtype=object))
     if idx.hasnans:
@@ -183,13 +183,13 @@ def _times(what: str, values, time_unit: str):
     offsets = ns - ns[0] if ns.size else ns
     if isinstance(idx, pd.TimedeltaIndex):
         start = float(ns[0]) / 1e9 if ns.size else 0.0
-        return offsets, offsets / 1e9, "timedelta", None, start, [str(v) for v in idx]
+        return offsets, offsets / 1e9, "timedelta", None, start, lambda i: str(idx[i])
     tz = None if idx.tz is None else str(idx.tz)
     start = idx[0].isoformat() if ns.size else None
-    return offsets, offsets / 1e9, "datetime", tz, start, [v.isoformat() for v in idx]
+    return offsets, offsets / 1e9, "datetime", tz, start, lambda i: idx[i].isoformat()
 
 
-def _grid(rel: np.ndarray, rel_ns, dt, jitter, labels: list[str]) -> tuple[np.ndarray, float, float, float]:
+def _grid(rel: np.ndarray, rel_ns, dt, jitter, label) -> tuple[np.ndarray, float, float, float]:
     """Grid index k of each sample, the sample time, the tolerance used and the largest deviation."""
     n = rel.size
     diffs = np.diff(rel_ns) if rel_ns is not None else np.diff(rel)
@@ -198,8 +198,8 @@ def _grid(rel: np.ndarray, rel_ns, dt, jitter, labels: list[str]) -> tuple[np.nd
         i = int(back[0]) + 1
         what = "repeats the time of" if diffs[i - 1] == 0 else "goes back in time from"
         raise DataError(
-            f"the log's time is not strictly increasing: row {i} (t = {labels[i]}) {what} row {i - 1} "
-            f"(t = {labels[i - 1]}). Sort the rows by time and remove the duplicates (deciding which one is right) "
+            f"the log's time is not strictly increasing: row {i} (t = {label(i)}) {what} row {i - 1} "
+            f"(t = {label(i - 1)}). Sort the rows by time and remove the duplicates (deciding which one is right) "
             "before importing; the import never reorders or merges samples"
         )
     given = dt is not None
@@ -228,7 +228,7 @@ def _grid(rel: np.ndarray, rel_ns, dt, jitter, labels: list[str]) -> tuple[np.nd
     if off.size:
         i = int(off[0])
         raise DataError(
-            f"row {i} (t = {labels[i]}) is off the sampling grid t0 + k dt by {dev[i]:.3g} s = {dev[i] / dt:.3g} dt "
+            f"row {i} (t = {label(i)}) is off the sampling grid t0 + k dt by {dev[i]:.3g} s = {dev[i] / dt:.3g} dt "
             f"(dt = {dt:.6g} s {'as given' if given else 'estimated as the median spacing'}, tolerance jitter = "
             f"{tol:.3g} s; {off.size} rows off the grid, the largest deviation {dev.max():.3g} s). Pass the true "
             "dt= (the median spacing is too long when most steps are gaps), a larger jitter= if the clock jitters, "
@@ -238,13 +238,13 @@ def _grid(rel: np.ndarray, rel_ns, dt, jitter, labels: list[str]) -> tuple[np.nd
     same = np.flatnonzero(np.diff(k) == 0)
     if same.size:
         i = int(same[0]) + 1
-        raise DataError(f"rows {i - 1} and {i} (t = {labels[i - 1]}, {labels[i]}) fall on the same grid point at "
+        raise DataError(f"rows {i - 1} and {i} (t = {label(i - 1)}, {label(i)}) fall on the same grid point at "
                         f"dt = {dt:.6g} s; pass the true dt= or remove one of them")
     if n and k[-1] + 1 > _MAX_GROWTH * n + 100:
         i = int(np.argmax(np.diff(k))) + 1
         raise DataError(
             f"the log's {n} rows span {k[-1] + 1} samples of dt = {dt:.6g} s: the longest gap, before row {i} "
-            f"(t = {labels[i]}), lasts {(k[i] - k[i - 1]) * dt:g} s. Check dt=, or split the log at its long gaps "
+            f"(t = {label(i)}), lasts {(k[i] - k[i - 1]) * dt:g} s. Check dt=, or split the log at its long gaps "
             "and import each part"
         )
     return k, dt, tol, float(dev.max()) if n else 0.0
@@ -386,9 +386,9 @@ def from_pandas(df, *, time=None, controls=None, outputs=None, units=None, fault
         if time not in df.columns:
             raise DataError(f"time: the log has no column {time!r}; its columns are {list(df.columns)}")
         what, values = f"the time column {time!r}", df[time]
-    rel_ns, rel, kind, tz, start, labels = _times(what, values, time_unit)
+    rel_ns, rel, kind, tz, start, label = _times(what, values, time_unit)
     dt_given = dt is not None
-    k, dt, tol, max_dev = _grid(rel, rel_ns, dt, jitter, labels)
+    k, dt, tol, max_dev = _grid(rel, rel_ns, dt, jitter, label)
 
     n = len(df)
     size = int(k[-1]) + 1 if n else 0
