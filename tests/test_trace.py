@@ -233,6 +233,7 @@ def test_valid_defaults_to_all_true_and_is_checked():
     flags[0] = False  # the trace holds its own copy
     assert tr.valid[0]
     assert tr.gaps == [(tr.t[3], tr.t[5]), (tr.t[20], tr.t[20]), (tr.t[N - 1], tr.t[N - 1])]
+    assert repr(tr).endswith(", invalid=5)") and "invalid" not in repr(_trace())
     assert _trace(valid=[True] * N).valid.all()
     with pytest.raises(DataError, match=rf"valid flags have shape \(3,\), need \({N},\)"):
         _trace(valid=[True, False, True])

@@ -541,7 +541,8 @@ class Trace:
         span = f"{self.t[0]:g}..{self.t[-1]:g} s" if len(self) else "empty"
         return (
             f"Trace({len(self)} samples, {span}, u={len(self.controls)}, y={len(self.outputs)}, "
-            f"x={len(self.states)}, faults={sorted(set(self.fault.tolist()) - {NO_FAULT})})"
+            f"x={len(self.states)}, faults={sorted(set(self.fault.tolist()) - {NO_FAULT})}"
+            + (f", invalid={int((~self.valid).sum())})" if not self.valid.all() else ")")
         )
 
 
