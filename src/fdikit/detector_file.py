@@ -142,7 +142,7 @@ def _fields(obj, where: str) -> dict:
         twin.reset()
         after = vars(twin)
         per_run = {k for k, v in after.items() if k not in before or before[k] is not v}
-        attrs = {k: v for k, v in after.items() if k not in per_run}
+        attrs = {k: v for k, v in attrs.items() if k not in per_run and k in after}  # the originals, not copies
     return attrs
 
 
