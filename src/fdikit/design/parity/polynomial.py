@@ -37,14 +37,15 @@ The bar matrices, the left null space, the minimal degree and the rank tests (2.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from fdikit import linalg
 from fdikit.dae import DAEModel, dae_form
-from fdikit.design.parity.polynomial_rank import bar_matrices, minimal_degree, target_fault
+from fdikit.design.parity.polynomial_rank import bar, bar_matrices, detectability, minimal_degree, target_fault
+from fdikit.design.residual_labels import fault_label, label_generator, warn_unlisted_faults
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import FieldReport, joined_form, no_internal_form
@@ -52,6 +53,7 @@ from fdikit.residuals import ResidualGenerator
 
 __all__ = [
     "PolynomialParityDesign",
+    "RESPONSE_RTOL",
     "parity_filter",
 ]
 
@@ -107,8 +109,12 @@ class PolynomialParityDesign(FieldReport):
     NL : coefficients of ``N(q) L(q)``, row ``i`` = ``qⁱ``, columns ``z = [outputs; controls]``.
     NF : coefficients of ``N(q) F(q)`` (``qⁱ``).
     denominator : ``d̄ = [d_0 … d_n]`` (monic); poles : its roots.
-    decoupling : ``‖N̄ H̄‖ / (‖N̄‖ ‖H̄‖)`` (0 for exact decoupling, round-off in practice).
+    decoupling : ``‖N̄ H̄‖ / (‖N̄‖ ‖H̄‖)`` (0 for exact decoupling, round-off in practice; ``H̄`` includes the
+        nuisance faults' columns).
     model : the discrete FaultModel it was made from, or None (keyword-only; set by :func:`parity_filter`).
+    nuisance : the faults the filter is decoupled from (keyword-only).
+    responses : relative response ``‖N̄ F̄_j‖ / (‖N̄‖ ‖F̄_j‖)`` of the residual to every fault column ``j`` of the
+        DAE (keyword-only; round-off for a nuisance fault).
 
     Examples
     --------
@@ -134,6 +140,8 @@ class PolynomialParityDesign(FieldReport):
     denominator: np.ndarray
     poles: np.ndarray
     decoupling: float
+    nuisance: tuple[str, ...] = field(default=(), kw_only=True)
+    responses: dict = field(default_factory=dict, kw_only=True)
 
     @property
     def N_bar(self) -> np.ndarray:
@@ -182,10 +190,47 @@ class PolynomialParityDesign(FieldReport):
     def report(self) -> dict:
         """``fault``, ``degree`` (``d_N``), ``null_dimension``, ``N`` (coefficients ``N_i``), ``denominator`` and
         ``poles`` (of ``d(q)``), ``decoupling`` (``‖N̄ H̄‖ / (‖N̄‖ ‖H̄‖)``), ``dc_gain`` (``G(1)``, 1 by design)
-        and ``fault_zeros``."""
+        , ``fault_zeros``, ``nuisance`` and ``responses`` (relative response to each fault column)."""
         return {"fault": self.fault, "degree": self.degree, "null_dimension": self.null_dimension, "N": self.N,
                 "denominator": self.denominator, "poles": self.poles, "decoupling": self.decoupling,
-                "dc_gain": self.dc_gain, "fault_zeros": self.fault_zeros}
+                "dc_gain": self.dc_gain, "fault_zeros": self.fault_zeros, "nuisance": self.nuisance,
+                "responses": dict(self.responses)}
+
+
+#: Relative response ``‖N̄ F̄_j‖ / (‖N̄‖ ‖F̄_j‖)`` at or below which the filter counts as blind to fault ``j``: far
+#: above the round-off of a null-space row (~1e-14), far below the response of a fault that is not decoupled.
+RESPONSE_RTOL = 1e-8
+
+
+def _nuisance_faults(dae: DAEModel, nuisance, target: str) -> tuple[str, ...]:
+    if nuisance is None:
+        raise ParameterError("nuisance=None is not a fault set; use () for none or 'others' for every other fault")
+    if isinstance(nuisance, str) and nuisance == "others":
+        return tuple(f for f in dae.faults if f != target)
+    out = []
+    for nm in [nuisance] if isinstance(nuisance, str) else list(nuisance):
+        nm = fault_label(dae, nm)
+        if nm not in dae.faults:
+            raise DesignError(f"nuisance {nm!r} is not a fault column of the DAE; its faults are {list(dae.faults)} "
+                              "(add it to the model with with_sensor_faults / with_actuator_faults)")
+        if nm == target:
+            raise ParameterError(f"{nm!r} is the target and cannot be nuisance too")
+        out.append(nm)
+    return tuple(dict.fromkeys(out))
+
+
+def _decoupled(dae: DAEModel, nuisance: Sequence[str]) -> DAEModel:
+    """The DAE with the nuisance fault columns moved from ``F(q)`` into the unknowns (``H̃ = [H F_nuisance]``, §2-3)."""
+    if not nuisance:
+        return dae
+    idx = [dae.faults.index(f) for f in nuisance]
+    keep = [j for j in range(len(dae.faults)) if j not in idx]
+    d = max(len(dae.H), len(dae.F))
+    H = list(dae.H) + [np.zeros_like(dae.H[0])] * (d - len(dae.H))
+    F = list(dae.F) + [np.zeros_like(dae.F[0])] * (d - len(dae.F))
+    return DAEModel(H=tuple(np.hstack([h, f[:, idx]]) for h, f in zip(H, F)), L=dae.L,
+                    F=tuple(f[:, keep] for f in dae.F), unknowns=dae.unknowns + tuple(nuisance), outputs=dae.outputs,
+                    controls=dae.controls, faults=tuple(dae.faults[j] for j in keep), dt=dae.dt)
 
 
 def parity_filter(
@@ -195,6 +240,9 @@ def parity_filter(
     degree: int | None = None,
     poles: float | Sequence[float] = 0.9048,
     name: str | None = None,
+    nuisance: Sequence[str] | str = (),
+    names: Sequence[str] | None = None,
+    isolates: Sequence[str | None] | Mapping[str, str | None] | None = None,
 ) -> PolynomialParityDesign:
     """LTI parity-space fault detection filter (van der Ploeg 2018, Lemma 2-1.2, (2.6)–(2.9); Sec. 4-3-1).
 
@@ -205,7 +253,7 @@ def parity_filter(
     targets : str, optional
         The fault to detect, by fault name (a column of ``F``: ``'<control>_actuator'``,
         ``'<output>_sensor'``, …) or a one-element sequence; may be omitted when there is one.
-        The other faults are not decoupled.
+        The other faults are decoupled only when named in ``nuisance``.
     degree : int, optional
         Parity degree ``d_N``; default the minimal one (:func:`minimal_degree`).
     poles : float or sequence of float
@@ -213,20 +261,31 @@ def parity_filter(
         the thesis' triple pole); a sequence needs at least ``deg N L`` entries (the filter
         is strictly proper with more).
     name : str, optional
-        Residual name (default ``r_<fault>``).
+        Residual name (default ``r_<fault>``; the same as ``names=[name]``).
+    nuisance : str or sequence of str, optional
+        Faults (columns of ``F``) the residual is decoupled from: ``()`` (default) none, ``'others'`` every
+        other fault, or fault names.  They join the unknowns, ``N [H F_nuisance] = 0`` (Sec. 2-3): an LTI
+        filter exists iff the target is isolable from them (:func:`~fdikit.design.parity.polynomial_rank.isolability`).
+    names, isolates : optional
+        Residual name (default ``r_<fault>``) and the fault it isolates (default the target), as
+        :func:`~fdikit.design.residual_labels.residual_labels`.
 
     Returns
     -------
     PolynomialParityDesign
-        With ``G(1) = 1`` (2.8b) and ``N̄ H̄ = 0`` (2.8a).
+        With ``G(1) = 1`` (2.8b) and ``N̄ H̄ = 0`` (2.8a); ``responses`` gives its relative response to every
+        fault.  When the residual also responds (relative response above :data:`RESPONSE_RTOL`) to a fault
+        that is neither the target nor nuisance, a :class:`~fdikit.errors.FdiWarning` lists those faults: an
+        alarm could be one of them, and isolation would name the target wrongly.
 
     Raises
     ------
     ParameterError
         ``model`` neither a DAEModel nor a FaultModel; several targets or a bare signal name.
     DesignError
-        Undetectable or unknown fault, unstable or complex poles, too few poles, or a fault whose
-        residual response vanishes at DC (the normalisation (2.8b) is then impossible).
+        Undetectable or unknown fault, unstable or complex poles, too few poles, a fault whose
+        residual response vanishes at DC (the normalisation (2.8b) is then impossible), or a target that
+        is not isolable from the nuisance faults (the message gives the normal ranks of Sec. 2-3).
 
     Examples
     --------
@@ -245,7 +304,17 @@ def parity_filter(
     if not isinstance(dae, DAEModel):
         raise ParameterError(f"parity_filter needs a DAEModel or a discrete FaultModel, got {type(model).__name__}")
     fault = target_fault(dae, targets)
-    dN = minimal_degree(dae, fault) if degree is None else int(degree)
+    nuis = _nuisance_faults(dae, nuisance, fault)
+    full, dae = dae, _decoupled(dae, nuis)
+    try:
+        dN = minimal_degree(dae, fault) if degree is None else int(degree)
+    except DesignError as exc:
+        if not nuis:
+            raise
+        test = detectability(dae, fault)
+        raise DesignError(f"fault {fault!r} is not isolable from nuisance {list(nuis)} (Sec. 2-3): normal ranks "
+                          f"[H F_nuisance F] {test.rank_with}, [H F_nuisance] {test.rank_without}; no LTI parity "
+                          f"filter sees it while ignoring them ({exc})") from exc
     Hb, Lb, Fb = bar_matrices(dae, dN, fault)
     V = linalg.null(Hb.T).T
     g = Fb.sum(axis=1)  # N̄ F̄ 1 = N(1) F(1)
@@ -271,11 +340,21 @@ def parity_filter(
     n_y = len(dae.outputs)
     num = np.hstack([NL[:, n_y:], NL[:, :n_y]])[: p.size + 1]  # generator inputs are [controls; outputs]
     A, B, C, D = _newton_chain(num, p)
-    name = name or f"r_{fault}"
-    gen = ResidualGenerator(A, B, C, D, dae.controls, dae.outputs, (name,), dae.dt, (fault,))
+    if name is not None and names is not None:
+        raise ParameterError("give the residual name once: names= (name= is its older spelling)")
+    gen = ResidualGenerator(A, B, C, D, dae.controls, dae.outputs, (name or f"r_{fault}",), dae.dt, (fault,))
+    gen = label_generator(gen, model, names, isolates)
     decoupling = float(np.linalg.norm(Nb @ Hb) / (np.linalg.norm(Nb) * np.linalg.norm(Hb)))
+    responses = {}
+    for j, f in enumerate(full.faults):
+        Fj = bar([c[:, [j]] for c in full.F], dN)
+        scale = np.linalg.norm(Nb) * np.linalg.norm(Fj)
+        responses[f] = float(np.linalg.norm(Nb @ Fj) / scale) if scale > 0 else 0.0
+    claimed = {fault} | {f for f in gen.isolates if f is not None}
+    warn_unlisted_faults("parity_filter", {f: r for f, r in responses.items()
+                                           if f not in claimed and f not in nuis and r > RESPONSE_RTOL})
     return PolynomialParityDesign(
-        generator=gen, dae=dae, fault=fault, degree=dN, null_dimension=V.shape[0], N=Nb.reshape(dN + 1, -1),
+        generator=gen, dae=full, fault=fault, degree=dN, null_dimension=V.shape[0], N=Nb.reshape(dN + 1, -1),
         NL=NL, NF=NF, denominator=den, poles=p, decoupling=decoupling,
-        model=model if isinstance(model, FaultModel) else None,
+        model=model if isinstance(model, FaultModel) else None, nuisance=nuis, responses=responses,
     )

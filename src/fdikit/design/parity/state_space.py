@@ -18,13 +18,15 @@ at every sample of a trace (16).  The robust choice of ``W₂`` is in
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from fdikit import validate
+from fdikit import linalg, validate
+from fdikit.design.residual_labels import fault_label, label_generator, warn_unlisted_faults
 from fdikit.errors import DataError, DesignError, ModelError, ParameterError
+from fdikit.fault_maps import split_fault_name
 from fdikit.lpv import LPVModel, StackedMatrices, check_horizon, lpv_stacked_matrices, stacked_matrices
 from fdikit.model import FaultModel
 from fdikit.protocols import FieldReport
@@ -37,6 +39,8 @@ __all__ = [
     "parity_matrix",
     "ParityDesign",
     "parity_design",
+    "stacked_fault_map",
+    "RESPONSE_RTOL",
     "lpv_parity_residuals",
 ]
 
@@ -197,6 +201,9 @@ class ParityDesign(FieldReport):
     rows : the rows of ``H_os1``.
     s : horizon.
     model : the FaultModel of the design (keyword-only; set by :func:`parity_design`).
+    targets, nuisance : the faults the residual must see and those it is decoupled from (keyword-only).
+    responses : relative response ``‖Wᵀ H_f‖₂ / (‖W‖₂ ‖H_f‖₂)`` of the residual to each fault input of the
+        model and each named fault over the window (keyword-only; 0 up to round-off for a decoupled fault).
 
     Examples
     --------
@@ -217,6 +224,9 @@ class ParityDesign(FieldReport):
     stacked: StackedMatrices
     rows: tuple[int, ...]
     s: int
+    targets: tuple[str, ...] = field(default=(), kw_only=True)
+    nuisance: tuple[str, ...] = field(default=(), kw_only=True)
+    responses: dict = field(default_factory=dict, kw_only=True)
 
     @property
     def q(self) -> int:
@@ -225,8 +235,104 @@ class ParityDesign(FieldReport):
 
     def report(self) -> dict:
         """``s`` (horizon), ``q`` (parity-space dimension), ``rows`` (of ``H_os1``), ``P`` (parity basis),
-        ``W2`` (free parameter) and ``W`` (parity matrix ``Pᵀ W₂``)."""
-        return {"s": self.s, "q": self.q, "rows": self.rows, "P": self.P, "W2": self.W2, "W": self.W}
+        ``W2`` (free parameter), ``W`` (parity matrix ``Pᵀ W₂``), ``targets``, ``nuisance`` and ``responses``
+        (relative response to each fault)."""
+        return {"s": self.s, "q": self.q, "rows": self.rows, "P": self.P, "W2": self.W2, "W": self.W,
+                "targets": self.targets, "nuisance": self.nuisance, "responses": dict(self.responses)}
+
+
+#: Relative response ``‖Wᵀ H_f‖ / (‖W‖ ‖H_f‖)`` at or below which a parity residual counts as blind to a fault: far
+#: above the round-off of ``P`` and of a null-space basis (~1e-13 for condition numbers up to 1e3), far below the
+#: response of a fault that is seen.
+RESPONSE_RTOL = 1e-8
+
+
+def _fault_io(model: FaultModel, name: str, F=None) -> tuple[np.ndarray, np.ndarray]:
+    """``(B_f, D_f)`` of a named fault: a fault input's columns, a sensor's ``(0, e_i)``, an actuator's ``Bu``/``Du``
+    columns, or an explicit state-space map ``(F, 0)``."""
+    if F is not None:
+        F = np.atleast_2d(validate.as_array(f"fault map {name!r}", F, error=ModelError))
+        F = F.T if F.shape[0] != model.n and F.shape[1] == model.n else F
+        if F.shape[0] != model.n:
+            raise ModelError(f"fault map {name!r} has {F.shape[0]} rows; the model has {model.n} states")
+        return F, np.zeros((model.p, F.shape[1]))
+    kind, base, _ = split_fault_name(model, name)
+    if kind == "fault":
+        j = [model.index("f", base)[0]]
+        return model.Bf[:, j], model.Df[:, j]
+    if kind == "sensor":
+        return np.zeros((model.n, 1)), np.eye(model.p)[:, [model.outputs.index(base)]]
+    j = [model.controls.index(base)]
+    return model.Bu[:, j], model.Du[:, j]
+
+
+def _fault_specs(model: FaultModel, spec, what: str, exclude: Sequence[str] = ()) -> dict:
+    """Fault name -> ``(B_f, D_f)`` for ``targets=`` / ``nuisance=`` (``'others'``: every fault input not excluded)."""
+    if spec is None:
+        raise ParameterError(f"{what}=None is not a fault set; use () for none" +
+                             (" or 'others' for every other fault input" if what == "nuisance" else ""))
+    if isinstance(spec, str) and spec == "others" and what == "nuisance":
+        return {f: _fault_io(model, f) for f in model.faults if f not in exclude}
+    if isinstance(spec, Mapping):
+        return {str(k): _fault_io(model, str(k), F) for k, F in spec.items()}
+    names = [spec] if isinstance(spec, str) else list(spec)
+    return {fault_label(model, nm): _fault_io(model, nm) for nm in names}
+
+
+def stacked_fault_map(model: FaultModel, B: np.ndarray, D: np.ndarray, s: int) -> np.ndarray:
+    """Window map ``((s+1)p, (s+1)k)`` of a fault entering as ``x⁺ = … + B f``, ``y = … + D f``.
+
+    Block ``(i, j)`` is ``D`` for ``j = i`` and ``C A^{i−j−1} B`` for ``j < i``: the ``H_fs`` of
+    :class:`~fdikit.lpv.StackedMatrices` for one fault, with the window's samples stacked in the same order.
+
+    Parameters
+    ----------
+    model : FaultModel
+        Discrete model (its ``A``, ``C``).
+    B, D : (n, k), (p, k) array_like
+        How the fault enters the states and the outputs.
+    s : int
+        Horizon.
+
+    Returns
+    -------
+    numpy.ndarray
+        The ((s+1)p, (s+1)k) lower block-triangular Toeplitz map.
+
+    Raises
+    ------
+    ParameterError
+        A bad horizon.
+
+    Examples
+    --------
+    >>> from fdikit import FaultModel
+    >>> m = FaultModel([[0.5]], [[2.0]], dt=1.0)
+    >>> stacked_fault_map(m, [[1.0]], [[0.0]], 2).tolist()
+    [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [1.0, 2.0, 0.0]]
+
+    References
+    ----------
+    Varrier et al. 2014, §3.1, (7)–(8).
+    """
+    s = check_horizon(s)
+    B, D = np.atleast_2d(np.asarray(B, dtype=float)), np.atleast_2d(np.asarray(D, dtype=float))
+    p, k = model.p, B.shape[1]
+    markov = [D]
+    Ak = np.eye(model.n)
+    for _ in range(s):
+        markov.append(model.C @ Ak @ B)
+        Ak = model.A @ Ak
+    H = np.zeros(((s + 1) * p, (s + 1) * k))
+    for i in range(s + 1):
+        for j in range(i + 1):
+            H[i * p:(i + 1) * p, j * k:(j + 1) * k] = markov[i - j]
+    return H
+
+
+def _relative_response(W: np.ndarray, H: np.ndarray) -> float:
+    scale = np.linalg.norm(W, 2) * np.linalg.norm(H, 2)
+    return float(np.linalg.norm(W.T @ H, 2) / scale) if scale > 0 else 0.0
 
 
 def _as_w2(W2, q: int) -> np.ndarray:
@@ -241,7 +347,10 @@ def _as_w2(W2, q: int) -> np.ndarray:
 
 
 def parity_design(model: FaultModel, s: int | None = None, *, W2=None, rows: Sequence[int] | None = None,
-                  names: Sequence[str] | None = None, isolates: Sequence[str | None] | None = None) -> ParityDesign:
+                  targets: Sequence[str] | Mapping[str, np.ndarray] | str = (),
+                  nuisance: Sequence[str] | Mapping[str, np.ndarray] | str = (),
+                  names: Sequence[str] | None = None,
+                  isolates: Sequence[str | None] | Mapping[str, str | None] | None = None) -> ParityDesign:
     """Parity-space residual generator of a discrete LTI model (Varrier et al. 2014, (7)–(12); Chow & Willsky 1984).
 
     The residual is ``r(k) = W₂ᵀ P (Y_s(k) − H_us U_s(k))`` over the window ``[k−s, k]``,
@@ -255,14 +364,29 @@ def parity_design(model: FaultModel, s: int | None = None, *, W2=None, rows: Seq
     s : int, optional
         Horizon; default :func:`minimal_horizon` for one residual.
     W2 : array_like, optional
-        (q,) or (q, k); default ``I_q`` (the q primary parity residuals).
-    rows, names, isolates
-        Rows of ``H_os1``; residual names (default ``parity_0, …``); fault tied to each residual.
+        (q,) or (q, k); default ``I_q`` (the q primary parity residuals).  With ``nuisance``, ``W2`` weights
+        the ``q'`` directions of the parity space left after decoupling ((q',) or (q', k); default all of them):
+        the stored ``W2`` is that basis times the given one.
+    rows : sequence of int, optional
+        Rows of ``H_os1``.
+    targets : str, sequence of str or mapping, optional
+        Faults the residual must see (fault names, docs/ARCHITECTURE.md "faults in APIs", or a mapping
+        name -> state-space map ``F``); a target the decoupled residual is blind to raises :class:`DesignError`.
+    nuisance : str, sequence of str or mapping, optional
+        Faults the residual is decoupled from, over the whole window (``W₂ᵀ P H_f = 0``): ``()`` none,
+        ``'others'`` every fault input of the model that is not a target, fault names or explicit maps.
+    names, isolates : optional
+        Residual names (default ``parity_0, …``) and the fault each residual isolates (default the target when
+        there is one, else None), as :func:`~fdikit.design.residual_labels.residual_labels`.
 
     Returns
     -------
     ParityDesign
-        The FIR generator and ``P``, ``W₂``, ``W``, the stacked matrices and the rows of ``H_os1``.
+        The FIR generator and ``P``, ``W₂``, ``W``, the stacked matrices, the rows of ``H_os1`` and the
+        residual's relative response to each fault (``responses``).  When the residual is tied to faults
+        (``targets`` or ``isolates``) and also responds (relative response above :data:`RESPONSE_RTOL`) to a
+        fault input of the model that is neither a target nor nuisance, a :class:`~fdikit.errors.FdiWarning`
+        lists those faults: an alarm could be one of them.
 
     Raises
     ------
@@ -271,7 +395,9 @@ def parity_design(model: FaultModel, s: int | None = None, *, W2=None, rows: Seq
     ModelError
         A continuous model.
     DesignError
-        No parity space at horizon ``s``; ``H_os`` of rank < n or ``H_os1`` ill-conditioned; ``W2 = 0``.
+        No parity space at horizon ``s``; ``H_os`` of rank < n or ``H_os1`` ill-conditioned; ``W2 = 0``; a
+        nuisance set that fills the parity space (nothing is left after decoupling); a target the residual does
+        not see.
 
     Examples
     --------
@@ -281,6 +407,13 @@ def parity_design(model: FaultModel, s: int | None = None, *, W2=None, rows: Seq
     >>> d = parity_design(m, 0)
     >>> d.q, bool(np.allclose(d.P @ d.stacked.H_os, 0))
     (1, True)
+
+    Two sensors of one state: the residual that ignores the first sensor's fault isolates the second's.
+
+    >>> m2 = FaultModel([[0.9]], [[1.0], [1.0]], Bu=[[1.0]], dt=0.1).with_sensor_faults(["y0", "y1"])
+    >>> d2 = parity_design(m2, 1, targets="y1_sensor", nuisance="others")
+    >>> d2.generator.isolates, d2.responses["y0_sensor"] < 1e-12, d2.responses["y1_sensor"] > 0.1
+    (('y1_sensor',), True, True)
 
     References
     ----------
@@ -297,8 +430,34 @@ def parity_design(model: FaultModel, s: int | None = None, *, W2=None, rows: Seq
                           f"space; use s >= {minimal_horizon(model.n, model.p)}")
     rows = regular_rows(st.H_os) if rows is None else tuple(int(i) for i in rows)
     P = parity_matrix(st.H_os, rows)
-    W2 = _as_w2(W2, P.shape[0])
+    tg = _fault_specs(model, targets, "targets")
+    nu = _fault_specs(model, nuisance, "nuisance", exclude=tuple(tg))
+    if set(tg) & set(nu):
+        raise ParameterError(f"faults {sorted(set(tg) & set(nu))} are both targets and nuisance; name each once")
+    Hf = {k: stacked_fault_map(model, B, D, s) for k, (B, D) in (tg | nu).items()}
+    for f in model.faults:
+        if f not in Hf:
+            Hf[f] = stacked_fault_map(model, *_fault_io(model, f), s)
+    if nu:
+        M = P @ np.hstack([Hf[k] for k in nu])
+        basis = linalg.null(M.T)
+        if basis.shape[1] == 0:
+            kk = sum(B.shape[1] for B, _ in nu.values())
+            raise DesignError(
+                f"the q = {P.shape[0]} parity directions at horizon s={s} cannot be decoupled from nuisance "
+                f"{list(nu)}: P H_f has rank {linalg.rank(M)} = q (the nuisance faults over the window span the parity "
+                f"space; each step adds p = {model.p} directions and {kk} nuisance columns); decoupling needs "
+                "fewer nuisance faults than outputs, or a longer horizon")
+        W2 = basis @ _as_w2(W2, basis.shape[1])
+    else:
+        W2 = _as_w2(W2, P.shape[0])
     W = P.T @ W2
+    responses = {k: _relative_response(W, H) for k, H in Hf.items()}
+    blind = [k for k in tg if responses[k] <= RESPONSE_RTOL]
+    if blind:
+        raise DesignError(f"the parity residual does not see target(s) {blind} (relative response "
+                          f"{[f'{responses[k]:.3g}' for k in blind]} <= {RESPONSE_RTOL:g}) once decoupled from "
+                          f"{list(nu)}; drop them from nuisance, choose another W2 or a longer horizon")
     k, p, mu = W2.shape[1], model.p, len(model.controls)
     Wy = W.T  # (k, (s+1)p)
     Wu = -(W.T @ st.H_us)  # (k, (s+1)mu)
@@ -309,10 +468,15 @@ def parity_design(model: FaultModel, s: int | None = None, *, W2=None, rows: Seq
     if s:
         B[-nv:] = np.eye(nv)
     C = np.hstack(M[:s]) if s else np.zeros((k, 0))
-    names = tuple(f"parity_{i}" for i in range(k)) if names is None else tuple(names)
-    gen = ResidualGenerator(A, B, C, M[s], model.controls, model.outputs, names, model.dt,
-                            tuple(isolates) if isolates is not None else ())
-    return ParityDesign(gen, P, W2, W, st, tuple(rows), s, model=model)
+    gen = ResidualGenerator(A, B, C, M[s], model.controls, model.outputs, tuple(f"parity_{i}" for i in range(k)),
+                            model.dt)
+    gen = label_generator(gen, model, names, isolates, default_isolates=[next(iter(tg))] * k if len(tg) == 1 else None)
+    claimed = set(tg) | {f for f in gen.isolates if f is not None}
+    if claimed:
+        warn_unlisted_faults("parity_design", {f: responses[f] for f in model.faults
+                                               if f not in claimed and f not in nu and responses[f] > RESPONSE_RTOL})
+    return ParityDesign(gen, P, W2, W, st, tuple(rows), s, model=model, targets=tuple(tg), nuisance=tuple(nu),
+                        responses=responses)
 
 
 # ---------------------------------------------------------------------------------------------- LPV runner
