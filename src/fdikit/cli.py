@@ -442,6 +442,74 @@ def b747(
     console.print(f"wrote {out} in {time.perf_counter() - start:.0f} s ({len(table.rows)} runs)")
 
 
+@app.command("design")
+def design(
+    spec: str = typer.Argument(..., help="The design spec: a YAML file, a .py file or an importable module name "
+                               "(model, filters, log, calibration; see docs/tutorial.md)."),
+    healthy: list[Path] = typer.Option(..., "--healthy", help="A fault-free CSV log to calibrate the thresholds on "
+                                       "(repeat for several runs)."),
+    out: Path = typer.Option(Path("detector.json"), "--out", "-o", help="The detector file to write."),
+    key: str = typer.Option(None, "--key", envvar="FDIKIT_DETECTOR_KEY", help="Secret for an HMAC-signed file "
+                            "(default a plain SHA-256 digest)."),
+) -> None:
+    """Design a detector from a model spec, calibrate it on fault-free logs, write it to a detector file."""
+    from fdikit.detector_spec import build_detector, load_spec
+
+    try:
+        det = build_detector(load_spec(spec), healthy)
+        det.save(out, key=key)
+    except (FdiError, OSError) as exc:
+        _fail(exc)
+    ev = det.evaluator
+    table = Table(title=f"{det.name}: {len(det.generator.residuals)} residuals, thresholds on {len(healthy)} log(s)")
+    for col in ("residual", "threshold"):
+        table.add_column(col)
+    for nm, tau in zip(ev.names, ev.thresholds):
+        table.add_row(nm, f"{tau:.4g}")
+    console.print(table)
+    cal = ev.calibration
+    lo, hi = cal.interval
+    console.print(f"calibration: {cal.alarms} alarm(s) in {cal.hours:.3g} h of fault-free logs ({cal.runs} run(s)): "
+                  f"{cal.rate:.3g}/h, {cal.confidence:.0%} interval [{lo:.3g}, {hi:.3g}]/h (target "
+                  f"{cal.target_rate:g}/h); these logs cannot resolve a rate below {cal.min_resolvable_rate:.3g}/h")
+    sig = ev.signatures
+    if sig is not None and sig.indistinguishable:
+        console.print(f"faults the bank cannot tell apart: {[list(s) for s in sig.indistinguishable]}")
+    console.print(f"wrote {out}")
+
+
+@app.command("diagnose")
+def diagnose(
+    detector: Path = typer.Argument(..., help="A detector file (fdikit design)."),
+    logs: list[Path] = typer.Argument(..., help="CSV log(s) to diagnose."),
+    out: Path = typer.Option(Path("out/diagnosis"), "--out", "-o", help="Folder for diagnosis.csv, alarms.csv and "
+                             "report.html (one sub-folder per log when several)."),
+    key: str = typer.Option(None, "--key", envvar="FDIKIT_DETECTOR_KEY", help="The secret of an HMAC-signed file."),
+) -> None:
+    """Diagnose logs with a saved detector: a per-sample diagnosis table and an HTML report with the residuals."""
+    from fdikit.detector import Detector
+    from fdikit.diagnosis_report import write_diagnosis
+
+    try:
+        det = Detector.load(detector, key=key)
+        traces = [det.read_log(p) for p in logs]
+    except (FdiError, OSError) as exc:
+        _fail(exc)
+    table = Table(title=f"diagnosis by {det.name}")
+    for col in ("log", "alarms", "first alarm [s]", "fault named at it", "report"):
+        table.add_column(col)
+    for path, trace in zip(logs, traces):
+        folder = out if len(logs) == 1 else out / path.name.split(".")[0]
+        try:
+            diag, files = write_diagnosis(folder, det, trace, log_name=path.name)
+        except (FdiError, OSError) as exc:
+            _fail(exc)
+        first = diag.first_alarm()
+        table.add_row(path.name, str(len(diag.alarms)), "-" if first is None else f"{first.time:g}",
+                      "-" if first is None else first.fault, str(files["report"]))
+    console.print(table)
+
+
 def main() -> None:  # pragma: no cover
     app()
 
