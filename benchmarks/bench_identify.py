@@ -109,7 +109,8 @@ def main() -> None:
         errs = [eig_error(fn(tr)) for tr in noisy]
         rows.append((name, e_clean, float(np.sqrt(np.mean(np.square(errs)))), seconds))
     ref = next(r for r in rows if r[0] == "fdikit n4sid")
-    print("| method | max rel. eigenvalue error, noise-free | RMS over seeds, noisy | time [ms] | time / fdikit n4sid |")
+    print("| method | max rel. eigenvalue error, noise-free | RMS over seeds, noisy | time [ms] "
+          "| time / fdikit n4sid |")
     print("|---|---:|---:|---:|---:|")
     for name, e0, e1, sec in rows:
         print(f"| {name} | {e0:.1e} | {e1:.3f} | {1e3 * sec:.1f} | {sec / ref[3]:.2f} |")

@@ -113,7 +113,7 @@ def test_with_noise_the_estimates_are_unbiased_and_the_order_is_found():
     # 2 methods × 6 quantities at a total level 1e-3: |t| < t_{1 − 1e-3 / 24}(R − 1) (≈ 6.3 for R = 8).
     R, q_true = 8, np.r_[TRUE.real[[0, 1, 2]], 0.3, 0.09, 0.09]
     crit = stats.t.ppf(1 - 1e-3 / 24, R - 1)
-    traces = [run(3000, 100 + s, noise_std=0.3) for s in range(R)]
+    traces = [run(2000, 100 + s, noise_std=0.3) for s in range(R)]
     for method in ("n4sid", "moesp"):
         est = []
         for tr in traces:

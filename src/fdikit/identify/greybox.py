@@ -8,6 +8,10 @@ data's inputs (each gap-free segment from the plant's initial state) and
     V(θ) = Σ_k Σ_i ((ŷ_i(k; θ) − y_i(k)) / s_i)²
 
 with ``s_i`` the scale of output ``i`` (Ljung 1999, §7.3 and §4.3: the output-error model).
+Each trace is one experiment, simulated as a whole from ``x0`` (the state is not known after a gap, so the
+simulation runs through it): an output sample that is not finite or has ``valid == False`` is left out of
+the error; a non-finite control cannot be simulated through and is refused (split the trace into
+separate experiments, each starting at ``x0``).
 With ``s_i`` the noise standard deviation of output ``i`` (or any scale under which the scaled
 errors have one common variance), the covariance of the estimate is asymptotically
 ``σ̂² (JᵀJ)⁻¹``, ``J`` the Jacobian of the scaled errors at the optimum and
@@ -22,10 +26,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from fdikit import validate
-from fdikit.errors import ModelError, ParameterError
-from fdikit.identify.data import segments
+from fdikit.errors import DataError, ModelError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.simulate import NonlinearPlant, simulate
+from fdikit.trace import Trace
 
 __all__ = ["ParameterFit", "fit_parameters"]
 
@@ -102,8 +106,9 @@ def fit_parameters(
     p0 : (d,) array_like
         Initial parameters (finite; also their scale for the trust region, ``x_scale = |p0|``).
     data : Trace or sequence of Trace
-        Measured controls and outputs (absolute: a FaultModel's operating point is applied).
-        Gaps (NaN, ``valid == False``) split the data; each segment starts from ``x0``.
+        Measured controls and outputs (absolute: a FaultModel's operating point is applied), one
+        experiment per trace, each starting at ``x0``.  Output samples that are NaN or have
+        ``valid == False`` are left out of the error (module docstring).
     outputs : sequence of str, optional
         The outputs to fit (default all of the plant's).
     names : sequence of str, optional
@@ -132,7 +137,8 @@ def fit_parameters(
     ModelError
         When ``build`` does not return a plant.
     DataError
-        When the data lack the plant's signals or have no usable segment.
+        When the data lack the plant's signals, hold a non-finite control, have no usable output
+        sample, or the traces' sample times differ.
 
     Examples
     --------
@@ -165,10 +171,27 @@ def fit_parameters(
     if missing:
         raise ParameterError(f"outputs {missing} are not outputs of the plant; it has {list(plant.outputs)}")
     cols = [plant.outputs.index(o) for o in outputs]
-    ds = segments(data, plant.controls, outputs, min_length=2, detrend=False)
-    y_all = np.concatenate(ds.y)
+    traces = [data] if isinstance(data, Trace) else list(data) if isinstance(data, Sequence) else []
+    if not traces or not all(isinstance(tr, Trace) for tr in traces):
+        raise DataError(f"data must be a Trace or a non-empty list of Traces, got {type(data).__name__}")
+    us, ys, masks = [], [], []
+    for k, tr in enumerate(traces):
+        u, y = tr.columns("u", plant.controls), tr.columns("y", outputs)
+        if not np.all(np.isfinite(u)):
+            row = int(np.argwhere(~np.isfinite(u))[0, 0])
+            raise DataError(f"trace {k} has a non-finite control at sample {row} (t={tr.t[row]:g}); the plant cannot "
+                            "be simulated through it: split the trace there into separate experiments")
+        if abs(tr.dt - traces[0].dt) > 1e-9 * traces[0].dt:
+            raise DataError(f"trace {k} has sample time {tr.dt:g} s, trace 0 {traces[0].dt:g} s; use one sample time")
+        ok = np.isfinite(y) & np.asarray(getattr(tr, "valid", np.ones(len(tr), bool)), bool)[:, None]
+        us.append((tr.t - tr.t[0], u))
+        ys.append(np.where(ok, y, 0.0))
+        masks.append(ok)
+    if not any(m.any() for m in masks):
+        raise DataError("the data hold no finite, valid output sample to fit")
     if scale is None:
-        scale = y_all.std(axis=0)
+        scale = np.array([np.concatenate([y[m[:, i], i] for y, m in zip(ys, masks)]).std()
+                          for i in range(len(outputs))])
         scale = np.where(scale > 0, scale, 1.0)
     else:
         scale = validate.as_vector("scale", np.broadcast_to(np.asarray(scale, float), (len(outputs),)))
@@ -181,13 +204,13 @@ def fit_parameters(
         u0 = op.control_values(pl.controls) if op is not None else 0.0
         y0 = op.output_values(pl.outputs)[cols] if op is not None else 0.0
         out = []
-        for u in ds.u:
-            tr = simulate(pl, t=np.arange(len(u)) * ds.dt, u=u - u0, x0=x0, method=method, substeps=substeps)
+        for t, u in us:
+            tr = simulate(pl, t=t, u=u - u0, x0=x0, method=method, substeps=substeps)
             out.append(tr.y[:, cols] + y0)
         return out
 
     def residual(params) -> np.ndarray:
-        return np.concatenate([((ys - y) / scale).ravel() for ys, y in zip(simulated(params), ds.y)])
+        return np.concatenate([((ysim - y) / scale)[m] for ysim, y, m in zip(simulated(params), ys, masks)])
 
     options = {"x_scale": np.where(p0 != 0, np.abs(p0), 1.0), **least_squares_options}
     res = least_squares(residual, p0, bounds=bounds, **options)
@@ -197,6 +220,10 @@ def fit_parameters(
     sigma2 = float(2.0 * res.cost / (N - d))
     J = np.atleast_2d(res.jac)
     cov = sigma2 * np.linalg.pinv(J.T @ J)
-    err = np.concatenate([ys - y for ys, y in zip(simulated(res.x), ds.y)])
-    fit = 100.0 * (1.0 - np.linalg.norm(err, axis=0) / np.linalg.norm(y_all - y_all.mean(axis=0), axis=0))
+    sims = simulated(res.x)
+    fit = np.empty(len(outputs))
+    for i in range(len(outputs)):
+        y_i = np.concatenate([y[m[:, i], i] for y, m in zip(ys, masks)])
+        e_i = np.concatenate([(ysim - y)[m[:, i], i] for ysim, y, m in zip(sims, ys, masks)])
+        fit[i] = 100.0 * (1.0 - np.linalg.norm(e_i) / np.linalg.norm(y_i - y_i.mean()))
     return ParameterFit(res.x, names, np.sqrt(np.diag(cov)), cov, sigma2, fit, outputs, build(res.x), res)
