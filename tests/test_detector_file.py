@@ -302,3 +302,28 @@ def test_every_supported_value_round_trips_exactly(tmp_path):
     for name in ("A", "B", "C", "D"):
         assert getattr(back.generator, name).tobytes() == getattr(g, name).tobytes()
         assert not getattr(back.generator, name).flags.writeable
+
+
+@pytest.mark.parametrize("field", ["run", "reset", "__class__", "not an identifier"])
+def test_a_stored_attribute_cannot_shadow_a_method(small_file, field):
+    def add(doc):
+        doc["payload"]["evaluator"]["fields"][field] = "x"
+
+    rewrite(small_file, add)
+    with pytest.raises(DataError, match="would replace a method|not an attribute name"):
+        load_detector(small_file)
+
+
+def test_a_malformed_value_is_refused_as_data(small_file):
+    def break_array(doc):
+        doc["payload"]["generator"]["fields"]["A"]["shape"] = [3, 3]  # 4 values stored
+
+    original = small_file.read_bytes()
+    cases = [(break_array, "32 bytes for an array of shape"),
+             (lambda doc: doc["payload"]["evaluator"].pop("fields"), "without a 'fields' mapping"),
+             (lambda doc: doc["payload"].pop("log"), "lacks or misshapes")]
+    for mutate, message in cases:
+        small_file.write_bytes(original)
+        rewrite(small_file, mutate)
+        with pytest.raises(DataError, match=message):
+            load_detector(small_file)

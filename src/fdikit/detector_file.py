@@ -51,6 +51,7 @@ import copy
 import hashlib
 import hmac
 import importlib
+import inspect
 import json
 import math
 import os
@@ -203,6 +204,15 @@ def _array(node: dict, where: str) -> np.ndarray:
     return np.frombuffer(raw, dtype=dt).reshape(shape).astype(dt.newbyteorder("="), copy=True)
 
 
+def _check_field(cls, name, where: str) -> None:
+    """Refuse an attribute name that is not an identifier or would shadow a method or property of ``cls``."""
+    if not isinstance(name, str) or not name.isidentifier() or name.startswith("__"):
+        raise DataError(f"{where}: {name!r} is not an attribute name a detector file may set")
+    static = inspect.getattr_static(cls, name, None)
+    if callable(static) or isinstance(static, (property, classmethod, staticmethod)):
+        raise DataError(f"{where}: attribute {name!r} would replace a method or property of {cls.__name__}")
+
+
 def _decode(node, where: str, depth: int = 0):
     if depth > _MAX_DEPTH:
         raise DataError(f"{where}: nested more than {_MAX_DEPTH} levels deep")
@@ -259,6 +269,8 @@ def _decode(node, where: str, depth: int = 0):
         fields = node.get("fields")
         if type(fields) is not dict:
             raise DataError(f"{where}: an object without a 'fields' mapping")
+        for k in fields:
+            _check_field(cls, k, where)
         obj = cls.__new__(cls)
         obj.__dict__.update({k: _decode(v, f"{where}.{k}", depth + 1) for k, v in fields.items()})
         if callable(getattr(cls, "reset", None)):
@@ -475,7 +487,9 @@ def _detector(payload: dict, where: str):
             residual_cov=_decode(options["residual_cov"], f"{where}: residual_cov"),
             recovery_tol=_decode(options["recovery_tol"], f"{where}: recovery_tol"),
         )
-    except (KeyError, TypeError, AttributeError) as exc:
+    except (KeyError, TypeError, AttributeError, ValueError, IndexError) as exc:
+        if isinstance(exc, DataError):
+            raise
         raise DataError(f"{where}: the payload lacks or misshapes a field ({exc!r})") from None
     signals = {"controls": list(det.controls), "outputs": list(det.outputs), "residuals": list(det.generator.residuals)}
     op = det.operating_point
