@@ -209,8 +209,6 @@ def test_signals_units_columns_and_metadata(all_detectors):
 
 
 def test_read_log_rereads_a_csv_with_the_stored_columns_and_units(tmp_path):
-    if not hasattr(Trace, "from_csv"):
-        pytest.skip("Trace.from_csv (fdikit.trace_import) is not in this tree yet")
     g = bank()
     ev = ThresholdEvaluator().fit(g.run(plant_trace(2000, 1)), false_alarm_prob=1e-3)
     det = Detector(g, ev, units={"y1": "deg"}, columns={"y2": "Y2_LOG"}, time_column="time")
@@ -221,3 +219,6 @@ def test_read_log_rereads_a_csv_with_the_stored_columns_and_units(tmp_path):
     back = det.read_log(tmp_path / "log.csv")
     assert np.allclose(back.y, tr.y, rtol=1e-14, atol=1e-15)
     assert np.allclose(back.t, tr.t, rtol=0, atol=1e-12)
+    # the import record of that log gives the same reading instructions back
+    assert Detector(g, ev).with_log(back).log_spec() == det.log_spec()
+    assert np.array_equal(Detector(g, ev).with_log(back).read_log(tmp_path / "log.csv").y, back.y)

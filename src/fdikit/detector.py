@@ -359,6 +359,48 @@ class Detector:
             spec = {"time": self.time_column, **spec}
         return spec
 
+    def with_log(self, trace) -> Detector:
+        """A copy that reads logs the way ``trace`` was imported: its columns, units and time column.
+
+        Parameters
+        ----------
+        trace : Trace or mapping
+            A trace read by ``Trace.from_csv`` / ``Trace.from_pandas`` (or its ``meta``); only the signals the
+            detector reads are taken.
+
+        Returns
+        -------
+        Detector
+            The same generator, evaluator and metadata with ``units``, ``columns`` and ``time_column`` replaced.
+
+        Raises
+        ------
+        DataError
+            When ``trace`` holds no import record.
+
+        Examples
+        --------
+        >>> import pandas as pd
+        >>> from fdikit.decision import ThresholdEvaluator
+        >>> from fdikit.residuals import ResidualGenerator
+        >>> from fdikit.trace import Trace
+        >>> g = ResidualGenerator([[0.4]], [[1.0, 0.5]], [[-1.0]], [[0.0, 1.0]], ("u",), ("y",), ("r",), dt=1.0)
+        >>> df = pd.DataFrame({"time": [0.0, 1.0], "U": [1.0, 1.0], "Y": [0.0, 57.3]})
+        >>> log = Trace.from_pandas(df, time="time", controls={"u": "U"}, outputs={"y": "Y"}, units={"y": "deg"})
+        >>> Detector(g, ThresholdEvaluator(thresholds=[0.5])).with_log(log).log_spec()
+        {'time': 'time', 'controls': {'u': 'U'}, 'outputs': {'y': 'Y'}, 'units': {'y': 'deg'}}
+        """
+        import dataclasses
+
+        from fdikit.trace_import import import_arguments
+
+        args = import_arguments(getattr(trace, "meta", trace))
+        signals = self.controls + self.outputs
+        columns = {**args["controls"], **args["outputs"]}
+        return dataclasses.replace(
+            self, units={s: u for s, u in args["units"].items() if s in signals},
+            columns={s: c for s, c in columns.items() if s in signals and c != s}, time_column=args["time"])
+
     def save(self, path: str | os.PathLike, *, key: str | bytes | None = None) -> Path:
         """Write the detector file (:func:`fdikit.detector_file.save_detector`; atomic, digest-checked).
 
