@@ -9,14 +9,17 @@ The most used designs are importable from here; every name of a family is in its
   continuous, discrete and time-varying filters, and the γ → 0 limit (Goh transformation, reduced-order detector).
 * :mod:`fdikit.design.parity` — Parity-space residual generators: state-space parity relations, polynomial (DAE)
   parity filters, speed-scheduled parity filters and the robust LPV parity design.
+* :mod:`fdikit.design.labels` — the ``names=`` / ``isolates=`` every design takes (what its residuals are called
+  and which fault each one isolates), and the warning of a parity residual that responds to an unlisted fault.
 """
 
 import lazy_loader as lazy
 
 __getattr__, __dir__, __all__ = lazy.attach(
     __name__,
-    submodules=["observers", "game", "parity"],
+    submodules=["observers", "game", "parity", "labels"],
     submod_attrs={
+        "labels": ["fault_label", "label_generator", "residual_labels", "warn_unlisted_faults"],
         "observers": [
             "BeardJonesDesign", "DetectionGainFamily", "Enhancement", "HinfDesign", "ObserverDesign",
             "RestrictedDiagonalDesign", "UIODesign", "beard_jones", "detection_gain_family", "enhancement_direction",

@@ -48,7 +48,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
             "DiscreteGtfdfDesign", "DiscreteGtmfdfDesign", "dgtfdf", "dgtmfdf",
         ],
         "ltv_filter": [
-            "LTVDetectionFilter", "ltv_detection_filter",
+            "LTVDetectionFilter", "ltv_detection_filter", "ltv_labels",
         ],
         "time_varying": [
             "LTVFeasibility", "LTVGameDesign", "ltv_feasibility", "ltv_game_filter",

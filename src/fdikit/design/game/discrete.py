@@ -151,7 +151,7 @@ def dgtfdf(
         Relative change of the gain from one step to the next below which it counts as settled (default 1e-8).
     names, isolates : optional
         Residual names and the fault each residual isolates (default ``<target>[j]`` tied to the target), as
-        :func:`~fdikit.design.residual_labels.residual_labels`.
+        :func:`~fdikit.design.labels.residual_labels`.
 
     Returns
     -------
@@ -336,7 +336,7 @@ def dgtmfdf(
         (5.41) has converged when its step is below ``xtol`` times ``‖L‖`` (default 1e-8).
     names, isolates : optional
         Residual names and the fault each residual isolates (default ``<target>[j]`` tied to each target), as
-        :func:`~fdikit.design.residual_labels.residual_labels`.
+        :func:`~fdikit.design.labels.residual_labels`.
 
     Returns
     -------

@@ -44,7 +44,7 @@ import numpy as np
 from fdikit import linalg, validate
 from fdikit.design.game.setup import GameProblem, game_problem, per_target, weight
 from fdikit.design.observers.full_order import observer_generator
-from fdikit.design.residual_labels import label_generator
+from fdikit.design.labels import label_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.residuals import ResidualGenerator
@@ -533,7 +533,7 @@ def discrete_game_generator(
         The targets whose projected residuals are produced, in this order (default every target of the setup).
     names, isolates : optional
         Residual names and the fault each residual isolates (default ``<target>[j]`` tied to its target), as
-        :func:`~fdikit.design.residual_labels.residual_labels`.
+        :func:`~fdikit.design.labels.residual_labels`.
 
     Returns
     -------

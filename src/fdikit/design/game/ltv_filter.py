@@ -9,16 +9,17 @@ given gain schedule ``L(t)`` and, per target, the projected residual ``Ĥ_i(t) r
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from fdikit.design.labels import residual_labels
 from fdikit.errors import DataError, DesignError, ParameterError
 from fdikit.ltv import LTVModel, MatrixFunction, ltv_projector
 from fdikit.residuals import Residuals
 
-__all__ = ["LTVDetectionFilter", "ltv_detection_filter"]
+__all__ = ["LTVDetectionFilter", "ltv_detection_filter", "ltv_labels"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -41,6 +42,9 @@ class LTVDetectionFilter:
         Relative rank tolerance of the projectors (default 1e-6).
     gain_batch : callable, optional
         ``(N,) times -> (N, n, p)`` gains, used by :meth:`run` when given.
+    names, isolates : tuple, optional
+        Residual names and the fault each residual isolates, already checked (default
+        ``'<target>:<output>'``, tied to its target); set by the design functions' ``names=`` / ``isolates=``.
 
     Examples
     --------
@@ -62,6 +66,8 @@ class LTVDetectionFilter:
     complementary: dict[str, tuple[str, ...]]
     rtol: float = 1e-6
     gain_batch: Callable[[np.ndarray], np.ndarray] | None = None
+    names: tuple[str, ...] | None = None
+    isolates: tuple[str | None, ...] | None = None
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     def projector(self, target: str, t: float) -> np.ndarray:
@@ -133,8 +139,8 @@ class LTVDetectionFilter:
         r = y - np.einsum("kpn,kn->kp", Cs, x) - np.einsum("kpm,km->kp", Ds, u)
         out_names = self.model.outputs or tuple(f"y{i}" for i in range(p))
         cols = [np.einsum("kij,kj->ki", Hs[k], r) for k in self.complementary]
-        names = tuple(f"{k}:{o}" for k in self.complementary for o in out_names)
-        isolates = tuple(k for k in self.complementary for _ in out_names)
+        names = self.names or tuple(f"{k}:{o}" for k in self.complementary for o in out_names)
+        isolates = self.isolates or tuple(k for k in self.complementary for _ in out_names)
         return Residuals(t, np.hstack(cols), names, isolates, meta={"filter": "ltv", "hold": hold})
 
     def run_trace(self, trace, x0=None) -> Residuals:
@@ -146,8 +152,53 @@ class LTVDetectionFilter:
         return self.run(trace.t, y, u, x0)
 
 
+def ltv_labels(model: LTVModel, complementary: Mapping[str, Sequence[str]], names=None, isolates=None):
+    """Checked ``(names, isolates)`` of an LTV detection filter's residuals, or ``(None, None)`` for the defaults.
+
+    Parameters
+    ----------
+    model : LTVModel
+        The plant (its outputs name the default residuals ``'<target>:<output>'``).
+    complementary : mapping of str to sequence of str
+        The filter's targets (keys), in residual order.
+    names, isolates : optional
+        As :func:`~fdikit.design.labels.residual_labels`.
+
+    Returns
+    -------
+    tuple
+        ``(names, isolates)`` as tuples, or ``(None, None)`` when both are None.
+
+    Raises
+    ------
+    ParameterError, ModelError
+        As :func:`~fdikit.design.labels.residual_labels`.
+
+    Examples
+    --------
+    >>> from fdikit.ltv import LTVModel
+    >>> from fdikit.plants.white_speyer import white_speyer
+    >>> m = LTVModel.from_lti(white_speyer(), ["f1", "f2"])
+    >>> ltv_labels(m, {"f1": ("f2",)}, names=["a", "b"])
+    (('a', 'b'), ('f1', 'f1'))
+
+    References
+    ----------
+    Murray 2012, §3.1.1, (3.9) (one projected residual per target).
+    """
+    if names is None and isolates is None:
+        return None, None
+    p = model.matrix("C", 0.0).shape[0]
+    outs = model.outputs or tuple(f"y{i}" for i in range(p))
+    return residual_labels(model, len(complementary) * p, names, isolates,
+                           default_names=[f"{k}:{o}" for k in complementary for o in outs],
+                           default_isolates=[k for k in complementary for _ in outs])
+
+
 def ltv_detection_filter(model: LTVModel, targets: Sequence[str], nuisance: Sequence[str], gain: MatrixFunction,
-                         rtol: float = 1e-6) -> LTVDetectionFilter:
+                         rtol: float = 1e-6, *, names: Sequence[str] | None = None,
+                         isolates: Sequence[str | None] | Mapping[str, str | None] | None = None
+                         ) -> LTVDetectionFilter:
     """A detection filter with a given gain schedule ``L(t)``; target ``i``'s residual is ``Ĥ_i(t) r``.
 
     Parameters
@@ -163,6 +214,9 @@ def ltv_detection_filter(model: LTVModel, targets: Sequence[str], nuisance: Sequ
         :func:`~fdikit.design.game.time_varying.ltv_game_filter` design).
     rtol : float, optional
         Relative rank tolerance of the projectors ``Ĥ_i(t)`` (default 1e-6).
+    names, isolates : optional
+        Residual names and the fault each residual isolates (default ``'<target>:<output>'`` tied to its
+        target), as :func:`~fdikit.design.labels.residual_labels`.
 
     Returns
     -------
@@ -181,7 +235,9 @@ def ltv_detection_filter(model: LTVModel, targets: Sequence[str], nuisance: Sequ
     ----------
     Murray 2012, §3.1.1, (3.7), (3.9)–(3.10).
     """
-    return LTVDetectionFilter(model, gain, complements(model, targets, nuisance), rtol)
+    comp = complements(model, targets, nuisance)
+    res, iso = ltv_labels(model, comp, names, isolates)
+    return LTVDetectionFilter(model, gain, comp, rtol, names=res, isolates=iso)
 
 
 _PADE13 = (64764752532480000.0, 32382376266240000.0, 7771770303897600.0, 1187353796428800.0, 129060195264000.0,

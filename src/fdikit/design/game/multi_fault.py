@@ -53,7 +53,7 @@ from fdikit.design.game.single_fault import (
     single_fault_game_filter,
 )
 from fdikit.design.observers.full_order import observer_generator
-from fdikit.design.residual_labels import label_generator
+from fdikit.design.labels import label_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import ProblemDesign
@@ -238,7 +238,7 @@ def game_filter(
     P0, steps : discrete models only: initial-error weight (``P(k0) = P0/γ``) and horizon in samples.
     names, isolates : optional
         Residual names and the fault each residual isolates (default ``<target>[k]`` tied to each target), as
-        :func:`~fdikit.design.residual_labels.residual_labels`.
+        :func:`~fdikit.design.labels.residual_labels`.
 
     Returns
     -------

@@ -44,7 +44,7 @@ import scipy.linalg
 from fdikit import linalg
 from fdikit.design.game.goh import GohRiccatiSolution, goh_riccati
 from fdikit.design.game.setup import GameProblem, game_problem, per_target
-from fdikit.design.residual_labels import label_generator
+from fdikit.design.labels import label_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import ProblemDesign
@@ -155,7 +155,7 @@ def goh_filter(
     rtol : rank tolerance of the subspace computations.
     names, isolates : optional
         Residual names and the fault each residual isolates (default ``<target>[k]`` tied to each target), as
-        :func:`~fdikit.design.residual_labels.residual_labels`.
+        :func:`~fdikit.design.labels.residual_labels`.
 
     Returns
     -------
@@ -286,7 +286,7 @@ def goh_detector(
     rtol : rank tolerance.
     names, isolates : optional
         Residual names and the fault each residual isolates (as :func:`goh_filter`), as
-        :func:`~fdikit.design.residual_labels.residual_labels`.
+        :func:`~fdikit.design.labels.residual_labels`.
 
     Returns
     -------

@@ -30,7 +30,7 @@ from fdikit.design.game.discrete_setup import DiscreteGameSetup, discrete_game_s
 from fdikit.design.game.riccati import checked_gamma, require_continuous, solve_game_are
 from fdikit.design.game.setup import GameProblem, game_problem, per_target, weight
 from fdikit.design.observers.full_order import observer_generator
-from fdikit.design.residual_labels import label_generator
+from fdikit.design.labels import label_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.fault_maps import resolve_nuisance
 from fdikit.model import FaultModel
@@ -194,7 +194,7 @@ def single_fault_game_filter(
     P0, steps : discrete models only: initial-error weight (``P(k0) = P0/γ``) and horizon in samples.
     names, isolates : optional
         Residual names and the fault each residual isolates (default ``<target>[k]`` tied to the target), as
-        :func:`~fdikit.design.residual_labels.residual_labels`.
+        :func:`~fdikit.design.labels.residual_labels`.
 
     Returns
     -------
@@ -367,7 +367,7 @@ def game_filter_bank(
         and 0.01; scalars mean multiples of I).
     names, isolates : optional
         Names and isolated faults of the stacked residuals of the bank (default ``<target>[k]`` of each filter,
-        tied to its target), as :func:`~fdikit.design.residual_labels.residual_labels`.
+        tied to its target), as :func:`~fdikit.design.labels.residual_labels`.
 
     Returns
     -------

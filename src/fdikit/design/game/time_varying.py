@@ -36,7 +36,7 @@ import scipy.linalg
 from scipy.integrate import solve_ivp
 
 from fdikit import validate
-from fdikit.design.game.ltv_filter import LTVDetectionFilter, complements
+from fdikit.design.game.ltv_filter import LTVDetectionFilter, complements, ltv_labels
 from fdikit.design.game.setup import weight
 from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.ltv import LTVModel, MatrixFunction, invariant_generators, ltv_projector
@@ -231,7 +231,10 @@ class LTVGameDesign:
 
 def ltv_game_filter(model: LTVModel, targets: str | Sequence[str], nuisance: Sequence[str] | str, t, *,
                     gamma: float, M=1.0, Q=1e-3, V=1.0, P0=1.0, rtol: float = 1e-8, atol: float | None = None,
-                    method: str = "BDF", escape: float = 1e4, geometry_rtol: float = 1e-6) -> LTVGameDesign:
+                    method: str = "BDF", escape: float = 1e4, geometry_rtol: float = 1e-6,
+    names: Sequence[str] | None = None,
+    isolates: Sequence[str | None] | Mapping[str, str | None] | None = None,
+) -> LTVGameDesign:
     """Finite-horizon time-varying single-fault game-theoretic detection filter (GTFDF).
 
     Integrates ``Ṗ = A P + P Aᵀ + F̂MF̂ᵀ/γ − P Cᵀ(V⁻¹ − ĤQĤ)C P`` forward from
@@ -262,6 +265,9 @@ def ltv_game_filter(model: LTVModel, targets: str | Sequence[str], nuisance: Seq
         ``max(1, ‖P0‖/γ, ‖F̂MF̂ᵀ‖(t1 − t0)/γ)``; the time is extrapolated (``P ~ 1/(t_e − t)``).
     geometry_rtol : float, optional
         Relative rank tolerance of the projector and separability checks (default 1e-6).
+    names, isolates : optional
+        Residual names and the fault each residual isolates (default ``<target>:<output>`` tied to the target), as
+        :func:`~fdikit.design.labels.residual_labels`.
 
     Returns
     -------
@@ -301,6 +307,7 @@ def ltv_game_filter(model: LTVModel, targets: str | Sequence[str], nuisance: Seq
                              "ltv_feasibility")
     target = str(given[0])
     comp = complements(model, [target], nuisance)[target]
+    res, iso = ltv_labels(model, {target: comp}, names, isolates)
     t = _grid(t)
     for s in (t[0], t[len(t) // 2], t[-1]):
         _check_visible(model, target, ltv_projector(model, comp, s, geometry_rtol), s, geometry_rtol)
@@ -323,7 +330,7 @@ def ltv_game_filter(model: LTVModel, targets: str | Sequence[str], nuisance: Seq
         P = np.moveaxis(dense(ts).reshape(n, n, -1), -1, 0)
         return np.array([_sym(Pk) @ model.matrix("C", s).T @ Vinv for Pk, s in zip(P, ts)])
 
-    filt = LTVDetectionFilter(model, gain, {target: comp}, geometry_rtol, gain_batch)
+    filt = LTVDetectionFilter(model, gain, {target: comp}, geometry_rtol, gain_batch, names=res, isolates=iso)
     Hs = np.array([ltv_projector(model, comp, s, geometry_rtol) for s in t])
     return LTVGameDesign(filt, target, t, Ps, gains, Hs, float(gamma))
 

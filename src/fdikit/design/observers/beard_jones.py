@@ -51,7 +51,7 @@ import scipy.linalg
 
 from fdikit import linalg, lti, validate
 from fdikit.design.observers.full_order import observer_generator
-from fdikit.design.residual_labels import label_generator
+from fdikit.design.labels import label_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.fault_maps import resolve_faults
 from fdikit.model import FaultModel
@@ -316,7 +316,7 @@ def beard_jones(
     rtol : relative rank tolerance of the subspace computations (default ``None``: fdikit.linalg's default).
     names, isolates : optional
         Residual names and the fault each residual isolates (default ``<fault>[k]`` tied to each target), as
-        :func:`~fdikit.design.residual_labels.residual_labels`.
+        :func:`~fdikit.design.labels.residual_labels`.
 
     Returns
     -------
@@ -470,7 +470,7 @@ def restricted_diagonal(
     sweeps, seed, rtol : as in :func:`beard_jones`.
     names, isolates : optional
         Residual names and the fault each residual isolates (default ``<target>[k]`` tied to its target), as
-        :func:`~fdikit.design.residual_labels.residual_labels`.
+        :func:`~fdikit.design.labels.residual_labels`.
 
     Returns
     -------

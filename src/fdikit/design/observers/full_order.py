@@ -23,7 +23,7 @@ import numpy as np
 import scipy.linalg
 
 from fdikit import lti, validate
-from fdikit.design.residual_labels import label_generator
+from fdikit.design.labels import label_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import FieldReport
@@ -142,7 +142,7 @@ def observer_generator(
         Output projection ``Q``; the residuals are ``Qᵀ r`` (default: identity, all ``p`` residuals).
     isolates : sequence of (str or None) or mapping, optional
         The fault each residual isolates, by fault name: one entry per residual (None: detection only), or a
-        mapping residual name -> fault (:func:`~fdikit.design.residual_labels.residual_labels`); default none.
+        mapping residual name -> fault (:func:`~fdikit.design.labels.residual_labels`); default none.
     names : sequence of str, optional
         Residual names (the keyword all designs take; give ``names`` or ``outputs``, not both).
 
@@ -219,7 +219,7 @@ def observer(model: FaultModel, poles: Sequence[complex], method: str = "place",
         number of outputs) or ``'varga'`` (:func:`control.place_varga`, Schur method).
     names, isolates : optional
         Residual names (default the output names) and the fault each residual isolates (default none), as
-        :func:`~fdikit.design.residual_labels.residual_labels`.
+        :func:`~fdikit.design.labels.residual_labels`.
 
     Returns
     -------
@@ -301,7 +301,7 @@ def kalman(model: FaultModel, Q, R, *, names: Sequence[str] | None = None,
     names, isolates : optional
         Residual names (default the output names) and the fault each residual isolates (default none: the
         innovation detects; ``isolates=["yaw_rate_sensor", …]`` ties each output's residual to a fault), as
-        :func:`~fdikit.design.residual_labels.residual_labels`.
+        :func:`~fdikit.design.labels.residual_labels`.
 
     Returns
     -------

@@ -54,7 +54,7 @@ import scipy.linalg
 from fdikit import linalg, validate
 from fdikit.design.observers.detection_gain import DetectionGainFamily, detection_gain_family
 from fdikit.design.observers.full_order import observer_generator
-from fdikit.design.residual_labels import label_generator
+from fdikit.design.labels import label_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import FieldReport
@@ -326,7 +326,7 @@ def hinf_detection_filter(
     rtol : relative rank tolerance of the subspace computations.
     names, isolates : optional
         Residual names and the fault each residual isolates (default ``<fault>[k]`` tied to each target), as
-        :func:`~fdikit.design.residual_labels.residual_labels`.
+        :func:`~fdikit.design.labels.residual_labels`.
 
     Returns
     -------
@@ -479,7 +479,7 @@ def enhancement_direction(design: HinfDesign, fault: str, *, names: Sequence[str
         One of the design's faults (its residual ``z_i`` is combined).
     names, isolates : optional
         Residual names and the fault each residual isolates (default ``<fault>[q]`` tied to ``fault``), as
-        :func:`~fdikit.design.residual_labels.residual_labels`.
+        :func:`~fdikit.design.labels.residual_labels`.
 
     Returns
     -------

@@ -59,7 +59,7 @@ import numpy as np
 import scipy.linalg
 
 from fdikit import fault_maps, linalg, lti, validate
-from fdikit.design.residual_labels import label_generator, residual_labels
+from fdikit.design.labels import label_generator, residual_labels
 from fdikit.errors import DesignError, ModelError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import FieldReport
@@ -320,7 +320,7 @@ def uio(
         reported in ``poles``.
     names, isolates : optional
         Residual names and the fault each residual isolates (default ``<target>[k]``, all tied to the target),
-        as :func:`~fdikit.design.residual_labels.residual_labels`.
+        as :func:`~fdikit.design.labels.residual_labels`.
 
     Returns
     -------
@@ -518,7 +518,7 @@ def uio_bank(
     poles : passed to every :func:`uio` (``None``: each design's default).
     names, isolates : optional
         Names and isolated faults of the residuals of the whole bank, member after member (default
-        ``<target>[k]`` of each member, tied to its target), as :func:`~fdikit.design.residual_labels.residual_labels`;
+        ``<target>[k]`` of each member, tied to its target), as :func:`~fdikit.design.labels.residual_labels`;
         each member's generator gets its share.
 
     Returns

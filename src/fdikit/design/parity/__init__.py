@@ -29,7 +29,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
     submod_attrs={
         "state_space": [
             "ParityDesign", "lpv_parity_residuals", "minimal_horizon", "parity_design", "parity_matrix",
-            "regular_rows",
+            "regular_rows", "stacked_fault_map",
         ],
         "polynomial": ["PolynomialParityDesign", "parity_filter"],
         "polynomial_rank": [

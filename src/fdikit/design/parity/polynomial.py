@@ -45,7 +45,7 @@ import numpy as np
 from fdikit import linalg
 from fdikit.dae import DAEModel, dae_form
 from fdikit.design.parity.polynomial_rank import bar, bar_matrices, detectability, minimal_degree, target_fault
-from fdikit.design.residual_labels import fault_label, label_generator, warn_unlisted_faults
+from fdikit.design.labels import fault_label, label_generator, warn_unlisted_faults
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import FieldReport, joined_form, no_internal_form
@@ -268,7 +268,7 @@ def parity_filter(
         filter exists iff the target is isolable from them (:func:`~fdikit.design.parity.polynomial_rank.isolability`).
     names, isolates : optional
         Residual name (default ``r_<fault>``) and the fault it isolates (default the target), as
-        :func:`~fdikit.design.residual_labels.residual_labels`.
+        :func:`~fdikit.design.labels.residual_labels`.
 
     Returns
     -------

@@ -21,7 +21,7 @@ the LTI LMI (27)–(31) and its normalisations in :mod:`fdikit.design.parity.lmi
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -35,6 +35,7 @@ from fdikit.design.parity.polytope import (
     scheduling_weights,
 )
 from fdikit.design.parity.state_space import lpv_parity_residuals, regular_rows
+from fdikit.design.labels import residual_labels
 from fdikit.errors import DesignError, ParameterError
 from fdikit.lpv import LPVModel, Uncertainty, lpv_stacked_matrices
 from fdikit.protocols import no_internal_form
@@ -58,6 +59,8 @@ class RobustParityDesign:
     Γ₁, Γ₂, det Γ_κ and adj Γ_κ (the paper's "products", §5.3); box_vertices : 2^(adj degree);
     truncation_error : sup over the grid of ‖adj − truncated adj‖ / ‖adj‖.
     lpv, uncertainties, s, rows, rho_min, rho_max, order, method, criteria_kw : the design's arguments.
+    names, isolates : the residual's name (default ``('robust_parity',)``) and the fault it isolates (default
+    ``(None,)``), used by :meth:`residuals` (keyword-only).
 
     Examples
     --------
@@ -92,6 +95,8 @@ class RobustParityDesign:
     box_vertices: int
     truncation_error: float
     criteria_kw: dict = field(default_factory=dict)
+    names: tuple[str, ...] = field(default=("robust_parity",), kw_only=True)
+    isolates: tuple[str | None, ...] = field(default=(None,), kw_only=True)
 
     def weights(self, rho) -> np.ndarray:
         """``α̃_j(ρ)`` (..., N+1)."""
@@ -109,10 +114,11 @@ class RobustParityDesign:
         J = np.einsum("ki,kij,kj->k", w, cr.gamma1, w) / np.einsum("ki,kij,kj->k", w, cr.gamma2, w)
         return J, theorem1_batch(cr.gamma1, cr.gamma2)[0]
 
-    def residuals(self, trace: Trace, rho, *, mode: str = "frozen", name: str = "robust_parity") -> Residuals:
-        """The U-LPV residual (16) of a trace (see :func:`lpv_parity_residuals`)."""
+    def residuals(self, trace: Trace, rho, *, mode: str = "frozen", name: str | None = None) -> Residuals:
+        """The U-LPV residual (16) of a trace (see :func:`lpv_parity_residuals`), named ``name`` (default
+        ``names[0]``) and tied to ``isolates[0]``."""
         return lpv_parity_residuals(self.lpv, trace, rho, self.s, W2=self.w2, mode=mode, rows=self.rows,
-                                    names=[name])
+                                    names=[name or self.names[0]], isolates=self.isolates)
 
     @property
     def generator(self) -> RobustParityDesign:
@@ -153,6 +159,8 @@ def robust_lpv_parity(
     grid: int = 41,
     points: int = 64,
     solver: str = "CLARABEL",
+    names: Sequence[str] | None = None,
+    isolates: Sequence[str | None] | Mapping[str, str | None] | None = None,
     **criteria_kw,
 ) -> RobustParityDesign:
     """Polytopic robust parity design for an uncertain LPV model (Varrier et al. 2014, §4.5–4.6, (32)–(46)).
@@ -175,6 +183,8 @@ def robust_lpv_parity(
     c : (q,) array_like or None, the normalisation vector; rows : rows of ``H_os1``.
     grid, points : ρ grid size for the checks (41) and FFT points of the polynomial fit (64).
     solver : str, cvxpy solver (default ``"CLARABEL"``); **criteria_kw : keywords of :func:`robust_criteria`.
+    names, isolates : the residual's name (default ``robust_parity``) and the fault it isolates (default None),
+        as :func:`~fdikit.design.labels.residual_labels`; :meth:`RobustParityDesign.residuals` uses them.
 
     Returns
     -------
@@ -206,6 +216,7 @@ def robust_lpv_parity(
         raise ParameterError(f"unknown method {method!r}; use 'lmi' (paper, (40)) or 'adjugate'")
     if not (isinstance(order, int) and order >= 0):
         raise ParameterError(f"order must be an integer >= 0, got {order!r}")
+    res, iso = residual_labels(lpv, 1, names, isolates, default_names=("robust_parity",))
     unc = tuple(uncertainties)
     rho_nominal = (rho_min + rho_max) / 2 if rho_nominal is None else float(rho_nominal)
     if rows is None:
@@ -262,5 +273,5 @@ def robust_lpv_parity(
         gamma = None
     return RobustParityDesign(
         lpv, unc, s, rows, float(kappa), k_max, float(rho_min), float(rho_max), N, method, c, Wv, vertices,
-        repaired, n_rep, gamma, degrees, 2 ** degrees["adjugate"], err, dict(criteria_kw),
+        repaired, n_rep, gamma, degrees, 2 ** degrees["adjugate"], err, dict(criteria_kw), names=res, isolates=iso,
     )

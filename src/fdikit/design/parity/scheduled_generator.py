@@ -57,6 +57,10 @@ class ScheduledResidualGenerator:
     schedule : name of the trace column holding ``ρ``.
     reference : the LTI :class:`~fdikit.design.parity.polynomial.PolynomialParityDesign` at the design point.
     fast_path : whether the family's ``dae_matrices`` is used (see :meth:`dae`).
+    grid : spacing ``h`` of the ``ρ`` grid (nodes ``ρ_ref + i h``) on which the family is evaluated, the DAE
+        coefficients linear in ``ρ`` between nodes (error ≤ ``h²/8 · max‖∂²M/∂ρ²‖``); None (default): the family
+        at every distinct ``ρ`` (exact; one ``family(ρ)`` per sample for a measured, noisy ``ρ``).
+    design_point : the ``ρ`` of the design (``reference``), a node of ``grid``.
 
     Examples
     --------
@@ -85,6 +89,8 @@ class ScheduledResidualGenerator:
     schedule: str
     reference: PolynomialParityDesign
     fast_path: bool = False
+    grid: float | None = None
+    design_point: float = 0.0
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     @property
@@ -93,7 +99,37 @@ class ScheduledResidualGenerator:
         return self.poles.size
 
     def _coefficients(self, rho: float) -> tuple[tuple[np.ndarray, ...], ...]:
-        """``(H, L, F)`` coefficient tuples at ``rho`` (``F``: the fault column), cached per value."""
+        """``(H, L, F)`` coefficient tuples at ``rho`` (``F``: the fault column): exact, or interpolated on ``grid``."""
+        if self.grid is None:
+            return self._exact(rho)
+        stacks = self._stacks(np.array([float(rho)]))
+        return tuple(tuple(S[0, j] for j in range(S.shape[1])) for S in stacks)
+
+    def _stacks(self, vals: np.ndarray) -> list[np.ndarray]:
+        """``H``, ``L``, ``F`` coefficient stacks ``(values, degree + 1, rows, cols)`` at the values ``vals``.
+
+        With ``grid = h``: node ``i = ⌊(ρ − ρ_ref)/h⌋``, ``θ = (ρ − ρ_ref)/h − i``, ``M = (1 − θ) M_i + θ M_{i+1}``
+        (exactly ``M_i`` on a node, so the design point and constant schedules on a node are exact).
+        """
+        if self.grid is None:
+            coeffs = [self._exact(v) for v in vals]
+            return [np.stack([np.stack(c[part]) for c in coeffs]) for part in range(3)]
+        ref, h = float(self.design_point), float(self.grid)
+        u = (vals - ref) / h
+        i = np.floor(u)
+        theta = (u - i)[:, None, None, None]
+        nodes, inv = np.unique(i, return_inverse=True)
+        lo = [self._exact(ref + n * h) for n in nodes]
+        hi = [self._exact(ref + (n + 1) * h) for n in nodes]
+        out = []
+        for part in range(3):
+            a = np.stack([np.stack(c[part]) for c in lo])[inv]
+            b = np.stack([np.stack(c[part]) for c in hi])[inv]
+            out.append(np.where(theta == 0.0, a, (1.0 - theta) * a + theta * b))
+        return out
+
+    def _exact(self, rho: float) -> tuple[tuple[np.ndarray, ...], ...]:
+        """``(H, L, F)`` of ``family(rho)`` (through ``dae_matrices`` on the fast path), cached per value."""
         key = float(rho)
         hit = self._cache.get(key)
         if hit is None:
@@ -133,10 +169,8 @@ class ScheduledResidualGenerator:
         windows = np.atleast_2d(np.asarray(windows, dtype=float))
         vals, idx = np.unique(windows, return_inverse=True)
         idx = idx.reshape(windows.shape)
-        coeffs = [self._coefficients(v) for v in vals]
         out = []
-        for part in range(3):
-            C = np.stack([np.stack(c[part]) for c in coeffs])  # (values, degree + 1, rows, cols)
+        for C in self._stacks(vals):  # (values, degree + 1, rows, cols)
             _, deg1, r, c = C.shape
             K, n_rows = windows.shape
             M = np.zeros((K, n_rows * r, (n_rows + deg1 - 1) * c))
@@ -196,10 +230,19 @@ class ScheduledResidualGenerator:
         tail = np.cumsum((h**2)[::-1])[::-1]  # tail[d] = Σ_{i≥d} h_i²
         return int(np.argmax(tail <= tol**2 * tail[0]))
 
-    def run(self, trace: Trace, schedule: np.ndarray | str | None = None, *, recovery_tol: float = 0.1) -> Residuals:
+    def run(self, trace: Trace, schedule: np.ndarray | str | None = None, *, recovery_tol: float = 0.1,
+            smoothing: float | None = None, smoothing_kind: str = "lowpass") -> Residuals:
         """Residuals of a whole trace; ``schedule`` is an array (N,), a column name, or None (``self.schedule``).
 
         Vectorised, and identical to :meth:`online` stepping (same residuals to rounding, same flags).
+
+        ``smoothing`` (time constant ``τ`` in s; default None, no smoothing) smooths a *measured* schedule
+        causally before it schedules the filter, so ``online`` gives the same result:
+        ``smoothing_kind="lowpass"`` (default) is the first-order low-pass ``s(k) = a s(k−1) + (1 − a) ρ(k)``,
+        ``a = e^{−dt/τ}``, white noise variance × ``(1 − a)/(1 + a) ≈ dt/(2τ)``, lag ``τ ρ'`` on a ramp;
+        ``"ramp"`` is Brown's double exponential smoothing (no steady lag on a ramp).  The default is off
+        because an exact schedule needs none and a low-pass only adds lag; see
+        docs/methods/lateral_fault_isolation.md for measured effects and a recommended ``τ``.
 
         Gap rule (a sample is *invalid* when a used signal or the schedule is NaN/inf): its residual
         is NaN.  The parity value ``w(k) = N̄_k L̄_k [z(τ_0) … z(τ_{d_N+d_L})]`` is formed only when
@@ -210,7 +253,7 @@ class ScheduledResidualGenerator:
         start of a run that begins with a valid sample the window is padded with zeros as before
         (the start-up transient is not flagged).
         """
-        rho = self.checked_schedule(trace, schedule)
+        rho = _Smoother(smoothing, smoothing_kind, self.dt).run(self.checked_schedule(trace, schedule))
         n_dec = self.recovery_length(recovery_tol)
         z = np.hstack([trace.columns("y", self.outputs), trace.columns("u", self.controls)])
         N = len(trace)
@@ -230,7 +273,8 @@ class ScheduledResidualGenerator:
         last_fill = np.maximum.accumulate(np.where(~win_ok, idx, -(n_dec + 1)))
         valid = ok & (idx - last_fill >= n_dec)
         r = np.where(ok, w, np.nan)
-        meta = {"trace": dict(trace.meta), "schedule": schedule if isinstance(schedule, str) else self.schedule}
+        meta = {"trace": dict(trace.meta), "schedule": schedule if isinstance(schedule, str) else self.schedule,
+                "smoothing": smoothing, "smoothing_kind": smoothing_kind}
         return Residuals(trace.t, r[:, None], self.residuals, self.isolates, valid, meta=meta,
                          recovering=ok & ~valid)
 
@@ -267,9 +311,10 @@ class ScheduledResidualGenerator:
             raise DataError(f"the schedule must be {len(trace)} values (one per sample), got shape {rho.shape}")
         return rho
 
-    def online(self, *, recovery_tol: float = 0.1) -> ScheduledStepper:
-        """A stepper with zero initial history (like ``run``) and the same gap rule."""
-        return ScheduledStepper(self, recovery_tol=recovery_tol)
+    def online(self, *, recovery_tol: float = 0.1, smoothing: float | None = None,
+               smoothing_kind: str = "lowpass") -> ScheduledStepper:
+        """A stepper with zero initial history (like ``run``), the same gap rule and schedule smoothing."""
+        return ScheduledStepper(self, recovery_tol=recovery_tol, smoothing=smoothing, smoothing_kind=smoothing_kind)
 
     @property
     def generator(self) -> ScheduledResidualGenerator:
@@ -293,6 +338,47 @@ class ScheduledResidualGenerator:
                 "reference": self.reference.report()}
 
 
+SMOOTHING_KINDS = ("lowpass", "ramp")
+
+
+class _Smoother:
+    """Causal smoothing of the schedule, one sample at a time (the same arithmetic in ``run`` and ``online``).
+
+    ``lowpass``: ``s(k) = a s(k−1) + (1 − a) ρ(k)``, ``a = exp(−dt/τ)`` (lag ``τ ρ'`` on a ramp).
+    ``ramp``: Brown's double exponential smoothing, ``s₁ ← a s₁ + (1 − a) ρ``, ``s₂ ← a s₂ + (1 − a) s₁``,
+    output ``2 s₁ − s₂`` (no steady lag on a ramp, ~1.7× the low-pass noise for the same ``τ``).
+    State starts at the first finite ``ρ``; a NaN/inf sample is passed through (NaN) and leaves the state.
+    """
+
+    def __init__(self, tau: float | None, kind: str, dt: float) -> None:
+        if tau is not None:
+            if isinstance(tau, bool) or not isinstance(tau, (int, float, np.integer, np.floating)) or not (
+                    np.isfinite(tau) and tau > 0):
+                raise ParameterError(f"smoothing must be a positive time constant in s (or None: no smoothing), "
+                                     f"got {tau!r}")
+        if kind not in SMOOTHING_KINDS:
+            raise ParameterError(f"smoothing_kind must be one of {list(SMOOTHING_KINDS)}, got {kind!r}")
+        self.tau, self.kind = tau, kind
+        self.a = 0.0 if tau is None else float(np.exp(-dt / float(tau)))
+        self.s1 = self.s2 = None
+
+    def __call__(self, rho: float) -> float:
+        if self.tau is None or not np.isfinite(rho):
+            return rho
+        a = self.a
+        if self.s1 is None:
+            self.s1 = self.s2 = rho
+        else:
+            self.s1 = a * self.s1 + (1.0 - a) * rho
+            self.s2 = a * self.s2 + (1.0 - a) * self.s1
+        return self.s1 if self.kind == "lowpass" else 2.0 * self.s1 - self.s2
+
+    def run(self, rho: np.ndarray) -> np.ndarray:
+        if self.tau is None:
+            return rho
+        return np.array([self(float(v)) for v in rho])
+
+
 class ScheduledStepper:
     """Online scheduled residuals: ``step(u, y, rho)`` returns ``r(k)`` for the sample ``(u(k), y(k), ρ(k))``.
 
@@ -306,6 +392,12 @@ class ScheduledStepper:
     ----------
     generator : ScheduledResidualGenerator, the filter to step.
     recovery_tol : float in (0, 1], the recovery tolerance (see ``recovery_length``; default 0.1).
+    smoothing, smoothing_kind : the causal smoothing of ``rho`` (see :meth:`ScheduledResidualGenerator.run`).
+
+    Raises
+    ------
+    ParameterError
+        A bad ``recovery_tol``, ``smoothing`` or ``smoothing_kind``.
 
     Examples
     --------
@@ -320,9 +412,12 @@ class ScheduledStepper:
     van der Ploeg 2018, Cor. 3-3.5.
     """
 
-    def __init__(self, generator: ScheduledResidualGenerator, *, recovery_tol: float = 0.1) -> None:
+    def __init__(self, generator: ScheduledResidualGenerator, *, recovery_tol: float = 0.1,
+                 smoothing: float | None = None, smoothing_kind: str = "lowpass") -> None:
         self.generator = generator
         self._n_dec = generator.recovery_length(recovery_tol)
+        self._smoothing = (smoothing, smoothing_kind)
+        _Smoother(smoothing, smoothing_kind, generator.dt)  # check the arguments now
         self.reset()
 
     def reset(self) -> None:
@@ -334,6 +429,7 @@ class ScheduledStepper:
         self._ok = np.ones(n, bool)
         self._x = np.zeros(n)
         self._k = 0
+        self._smoother = _Smoother(*self._smoothing, g.dt)
         self._last_fill = -(self._n_dec + 1)
         self.invalid = 0
         self.last_valid = True
@@ -350,6 +446,7 @@ class ScheduledStepper:
         if u.size != len(g.controls) or y.size != len(g.outputs):
             raise DataError(f"step() needs {len(g.controls)} controls {list(g.controls)} and {len(g.outputs)} "
                             f"outputs {list(g.outputs)}, got {u.size} and {y.size}")
+        rho = self._smoother(rho)
         ok = bool(np.all(np.isfinite(u)) and np.all(np.isfinite(y)) and np.isfinite(rho))
         if self._rho is None:
             self._rho = np.full(g.window, rho if ok else np.nan)
@@ -386,5 +483,6 @@ class ScheduledStepper:
         for k in range(len(trace)):
             r[k] = self.step(U[k], Y[k], rho[k])
             valid[k], rec[k] = self.last_valid, self.last_recovering
-        meta = {"trace": dict(trace.meta), "schedule": schedule if isinstance(schedule, str) else g.schedule}
+        meta = {"trace": dict(trace.meta), "schedule": schedule if isinstance(schedule, str) else g.schedule,
+                "smoothing": self._smoothing[0], "smoothing_kind": self._smoothing[1]}
         return Residuals(trace.t, r[:, None], g.residuals, g.isolates, valid, meta=meta, recovering=rec)

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fdikit import linalg, validate
-from fdikit.design.residual_labels import fault_label, label_generator, warn_unlisted_faults
+from fdikit.design.labels import fault_label, label_generator, residual_labels, warn_unlisted_faults
 from fdikit.errors import DataError, DesignError, ModelError, ParameterError
 from fdikit.fault_maps import split_fault_name
 from fdikit.lpv import LPVModel, StackedMatrices, check_horizon, lpv_stacked_matrices, stacked_matrices
@@ -377,7 +377,7 @@ def parity_design(model: FaultModel, s: int | None = None, *, W2=None, rows: Seq
         ``'others'`` every fault input of the model that is not a target, fault names or explicit maps.
     names, isolates : optional
         Residual names (default ``parity_0, …``) and the fault each residual isolates (default the target when
-        there is one, else None), as :func:`~fdikit.design.residual_labels.residual_labels`.
+        there is one, else None), as :func:`~fdikit.design.labels.residual_labels`.
 
     Returns
     -------
@@ -490,6 +490,7 @@ def lpv_parity_residuals(
     mode: str = "frozen",
     rows: Sequence[int] | None = None,
     names: Sequence[str] | None = None,
+    isolates: Sequence[str | None] | None = None,
 ) -> Residuals:
     """LPV parity residual ``r(k) = W₂(ρ_k)ᵀ P(ρ) (Y_s(k) − H_us(ρ) U_s(k))``, P recomputed every sample.
 
@@ -511,6 +512,7 @@ def lpv_parity_residuals(
         (time-varying stacking with ρ_{k−s}, …, ρ_k).
     rows : rows of ``H_os1``; default :func:`regular_rows` at the median ρ.
     names : residual names; default ``parity_0, …``.
+    isolates : the fault each residual isolates (None: detection only); default none.
 
     Returns
     -------
@@ -580,6 +582,6 @@ def lpv_parity_residuals(
     out = np.full((N, k), np.nan)
     out[s:] = r
     valid = np.arange(N) >= s
-    names = tuple(f"parity_{i}" for i in range(k)) if names is None else tuple(names)
+    names, isolates = residual_labels(lpv, k, names, isolates, default_names=[f"parity_{i}" for i in range(k)])
     meta = {"trace": dict(trace.meta), "s": s, "mode": mode, "rows": list(rows)}
-    return Residuals(trace.t, out, names, (), valid, meta)
+    return Residuals(trace.t, out, names, isolates, valid, meta)
