@@ -147,6 +147,9 @@ def test_online_takes_mappings_or_vectors_and_flags_invalid_samples(all_detector
     assert a.invalid == 6  # 3 gap samples, 2 flagged, 1 control dropout
     with pytest.raises(DataError, match="missing"):
         a.step({"u": 1.0}, {"y1": 1.0})
+    for bad in (None, [1.0, 2.0, 3.0], [[1.0], [2.0, 3.0]]):  # a flagged sample is still checked
+        with pytest.raises(DataError):
+            a.step([1.0], bad, valid=False)
 
 
 def test_steppers_are_independent_of_each_other_and_of_batch(all_detectors):

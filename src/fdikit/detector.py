@@ -1,20 +1,15 @@
 """Deployable detectors: a residual generator and a fitted evaluator, packaged to run on logs and online.
 
-A :class:`Detector` holds everything needed to run a designed detector away from its design
-script: the :class:`~fdikit.residuals.ResidualGenerator` (one filter or a stacked bank), a fitted
-evaluator of :mod:`fdikit.decision`, the signals the generator reads, how each is read from a log
-(its unit and its column, so a CSV log is re-read the same way: :meth:`Detector.read_log`), the
-operating point the generator subtracts from the absolute signals (its ``operating_point``), the
-gap options, and metadata (name, description, creation time, fdikit version).
-
-* ``run(trace) -> Diagnosis`` — a whole trace (batch);
-* ``online() -> DetectorStepper`` whose ``step(u, y)`` returns the evaluator's
-  :class:`~fdikit.diagnosis.StepDecision` sample by sample.  Bad samples (NaN) and samples flagged
-  invalid (``valid=False``, as ``trace.valid``) are gaps for the generator's gap rule
-  (:mod:`fdikit.gaps`), and the evaluator holds its decision over them and over the recovering samples
-  after them, so the online decisions are the batch ones;
-* ``save(path)`` / ``Detector.load(path)`` — the data-only, digest-checked file of
-  :mod:`fdikit.detector_file` (``docs/methods/deployment.md``).
+A :class:`Detector` holds what a deployment needs: the :class:`~fdikit.residuals.ResidualGenerator` (one
+filter or a stacked bank), a fitted evaluator of :mod:`fdikit.decision`, the signals the generator reads,
+how each is read from a log (unit and column: :meth:`Detector.read_log`), the operating point the generator
+subtracts from the absolute signals, the gap options, and metadata (name, description, creation time,
+fdikit version).  ``run(trace) -> Diagnosis`` is the batch; ``online()`` gives a :class:`DetectorStepper`
+whose ``step(u, y)`` returns the evaluator's :class:`~fdikit.diagnosis.StepDecision`.  Bad samples (NaN)
+and samples flagged invalid (``valid=False``, as ``trace.valid``) are gaps for the generator's gap rule
+(:mod:`fdikit.gaps`); the evaluator holds its decision over them and over the recovering samples after
+them, so online decisions are the batch ones.  ``save(path)`` / ``Detector.load(path)`` use the data-only,
+digest-checked file of :mod:`fdikit.detector_file` (``docs/methods/deployment.md``).
 
 Examples
 --------
@@ -536,13 +531,13 @@ class DetectorStepper:
         return self._gen.invalid
 
     @staticmethod
-    def _bad(values, names: tuple[str, ...]):
-        """NaN in place of every value (the sample was flagged invalid), keeping the shape checks."""
+    def _bad(values):
+        """NaN in place of every value (the sample was flagged invalid), keeping the names and shape checked."""
         if isinstance(values, Mapping):
             return {k: float("nan") for k in values}
         try:
-            return np.full(np.shape(values), np.nan)
-        except (TypeError, ValueError):  # pragma: no cover - ragged input; the generator's step reports it
+            return values if values is None or isinstance(values, (str, bytes)) else np.full(np.shape(values), np.nan)
+        except ValueError:  # ragged: the generator's step reports it
             return values
 
     def step(self, u, y, *, valid: bool = True):
@@ -567,9 +562,8 @@ class DetectorStepper:
         DataError
             For values that are not numbers, a mapping with other names, or the wrong number of values.
         """
-        g = self._gen.generator
         if not valid:
-            u, y = self._bad(u, g.controls), self._bad(y, g.outputs)
+            u, y = self._bad(u), self._bad(y)
         r = self._gen.step(u, y)
         idx = self.detector._index
         r = r if idx is None else r[idx]
