@@ -4,7 +4,7 @@
 * :mod:`fdikit.identify.subspace` — N4SID / PO-MOESP identification of ``x⁺ = A x + B u + K e``, ``y = C x + D u + e``
   with the order from the singular-value gap (Van Overschee & De Moor 1996, Ch. 4; Verhaegen 1994).
 * :mod:`fdikit.identify.greybox` — Physical parameters of a model by output-error least squares, with their
-  standard errors (Ljung 1999, Ch. 7, §9.3).
+  standard errors (Ljung 1999, Ch. 7, Ch. 9).
 * :mod:`fdikit.identify.correlation` — Residual whiteness (Ljung–Box) and input–residual independence tests
   (Ljung 1999, §16.6).
 * :mod:`fdikit.identify.validation` — Validation on held-out data: fit per output, the two residual tests.

@@ -7,7 +7,7 @@ data's inputs (each gap-free segment from the plant's initial state) and
 
     V(θ) = Σ_k Σ_i ((ŷ_i(k; θ) − y_i(k)) / s_i)²
 
-with ``s_i`` the scale of output ``i`` (Ljung 1999, §7.3 and §4.3: the output-error model).
+with ``s_i`` the scale of output ``i`` (Ljung 1999, Ch. 7: the prediction-error criterion with the output-error predictor).
 Each trace is one experiment, simulated as a whole from ``x0`` (the state is not known after a gap, so the
 simulation runs through it): an output sample that is not finite or has ``valid == False`` is left out of
 the error; a non-finite control cannot be simulated through and is refused (split the trace into
@@ -15,7 +15,7 @@ separate experiments, each starting at ``x0``).
 With ``s_i`` the noise standard deviation of output ``i`` (or any scale under which the scaled
 errors have one common variance), the covariance of the estimate is asymptotically
 ``σ̂² (JᵀJ)⁻¹``, ``J`` the Jacobian of the scaled errors at the optimum and
-``σ̂² = V(θ̂) / (N − d)`` (N residuals, d parameters; Ljung 1999, §9.3, (9.17)).
+``σ̂² = V(θ̂) / (N − d)`` (N residuals, d parameters; Ljung 1999, Ch. 9: the asymptotic distribution of the estimate).
 """
 
 from __future__ import annotations
@@ -156,7 +156,7 @@ def fit_parameters(
 
     References
     ----------
-    Ljung 1999, §7.3 (prediction-error / output-error criterion), §9.3 (asymptotic covariance of the estimate).
+    Ljung 1999, Ch. 7 (the prediction-error criterion, output-error predictor), Ch. 9 (asymptotic covariance).
     """
     from scipy.optimize import least_squares
 

@@ -1,6 +1,6 @@
 """Subspace identification (N4SID, PO-MOESP) of a discrete state-space model with its noise model.
 
-The model is identified in innovation form (Van Overschee & De Moor 1996, Ch. 4, (4.1)–(4.2))::
+The model is identified in innovation form (Van Overschee & De Moor 1996, Ch. 4)::
 
     x[k+1] = A x[k] + B u[k] + K e[k]
     y[k]   = C x[k] + D u[k] + e[k],        Cov e = R
@@ -9,7 +9,7 @@ from block Hankel matrices of past and future data (``horizon`` block rows each)
 factorisation of ``[U_f; U_p; Y_p; Y_f]`` gives
 
 * ``method="n4sid"``: the oblique projection ``O = Y_f /_{U_f} W_p`` (``W_p = [U_p; Y_p]``),
-  weights ``W_1 = W_2 = I`` (Van Overschee & De Moor 1996, §4.3, Theorem 12); its SVD gives the
+  weights ``W_1 = W_2 = I`` (Van Overschee & De Moor 1996, Ch. 4, Theorem 12); its SVD gives the
   order and the extended observability matrix ``Γ``, the state sequence ``X = Γ⁺ O`` and
   ``[A B; C D]`` by least squares on ``[X_{k+1}; y_k] = [A B; C D] [X_k; u_k]`` (§4.3.2);
 * ``method="moesp"``: the SVD of ``L_32`` (the future outputs with the future inputs projected
@@ -18,7 +18,7 @@ factorisation of ``[U_f; U_p; Y_p; Y_f]`` gives
 
 The residuals of the state regression estimate the noise covariances ``Q, S, R``; the steady
 Kalman gain of those (discrete Riccati equation) is ``K`` and ``C P Cᵀ + R`` the innovation
-covariance (Van Overschee & De Moor 1996, §4.3.2, §3.1.4).  The data are scaled to unit
+covariance (Van Overschee & De Moor 1996, Ch. 4).  The data are scaled to unit
 standard deviation per signal before the SVD (so the singular values do not depend on units).
 
 Why not a packaged implementation: ``benchmarks/bench_identify.py`` compares ``nfoursid`` 1.0.2
@@ -29,9 +29,9 @@ innovation noise (output SNR 11) the RMS eigenvalue error over 20 seeds is 0.008
 ``nfoursid`` and SIPPY alike (0.009 for PO-MOESP here).  They differ in what they accept and in
 cost: neither peer takes several experiments or a record split by gaps (both build the Hankel
 matrices of one continuous record; here each segment gives its own columns), ``nfoursid`` gives
-``(Q, S, R)`` but no gain ``K``, needs pandas and matplotlib at import and takes 11x the time
-(1.76 s against 0.16 s), SIPPY takes 4.5x (0.74 s), prints to stdout and pulls in casadi and
-sympy.  ``harold`` 1.0.3 has no subspace method and python-control has none.  So the method is
+``(Q, S, R)`` but no gain ``K``, needs pandas and matplotlib at import and takes 11–31x the time
+(two runs under different load: 1.76 s against 0.16 s, 0.49 s against 16 ms), SIPPY takes 4.5–27x
+(0.74 s, 0.42 s), prints to stdout and pulls in casadi and sympy.  ``harold`` 1.0.3 has no subspace method and python-control has none.  So the method is
 written here with numpy/scipy (one LQ factorisation, two SVDs, least squares).
 
 Order selection (``order=None``): the order is the index ``k`` of the largest gap
@@ -191,7 +191,7 @@ def subspace_id(
     References
     ----------
     Van Overschee & De Moor 1996, Ch. 4 (N4SID: oblique projection, Theorem 12, the state-sequence
-    regression of §4.3.2); Verhaegen 1994 (PO-MOESP).
+    regression); Verhaegen 1994 (PO-MOESP).
     """
     validate.choice("method", method, ("n4sid", "moesp"))
     if order is not None:

@@ -181,7 +181,7 @@ def validate_model(model, data, *, lags: int = 20, level: float = 0.01, gain=Non
 
     References
     ----------
-    Ljung 1999, §16.6 (residual analysis), §16.4 (simulation fit on validation data).
+    Ljung 1999, §16.6 (residual analysis), §16.5 (model validation: simulation on fresh data).
     """
     K = None
     if isinstance(model, IdentifiedModel):
