@@ -56,6 +56,17 @@ class CorrelationTest:
         Per-lag confidence bound ``z_{1−α/2} / √N``.
     samples : int
         ``N``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> res = whiteness_test(np.random.default_rng(0).standard_normal((500, 2)), lags=10, level=0.05)
+    >>> res.kind, res.dof, res.statistic.shape, round(res.threshold, 2)
+    ('whiteness', 10, (2,), 18.31)
+
+    References
+    ----------
+    Ljung 1999, §16.6.
     """
 
     kind: str
@@ -141,7 +152,7 @@ def whiteness_test(residual, lags: int = 20, level: float = 0.01) -> Correlation
     mean = np.concatenate(segs).mean(axis=0)
     segs = [s - mean for s in segs]
     c = np.array([sum(np.sum(s[k:] * s[:len(s) - k], axis=0) for s in segs) for k in range(lags + 1)]) / N
-    rho = c / c[0]
+    rho = c / np.where(c[0] > 0, c[0], 1.0)  # a zero residual has no correlation (Q = 0)
     k = np.arange(1, lags + 1)[:, None]
     Q = N * (N + 2) * np.sum(rho[1:] ** 2 / (N - k), axis=0)
     thr = float(stats.chi2.ppf(1 - level, lags))
@@ -212,8 +223,9 @@ def cross_correlation_test(residual, u, lags: int = 20, level: float = 0.01) -> 
         P = Phi[:, :, j]
         Ru = P.T @ P / N
         r = P.T @ E / N  # (M+1, p)
-        stat[:, j] = N * np.sum(r * np.linalg.solve(Ru, r), axis=0) / lam
-        corr[:, :, j] = r / np.sqrt(lam * np.sum(P[:, 0] ** 2) / N)
+        lam_ = np.where(lam > 0, lam, 1.0)  # a zero residual is uncorrelated with anything
+        stat[:, j] = N * np.sum(r * np.linalg.solve(Ru, r), axis=0) / lam_
+        corr[:, :, j] = r / np.sqrt(lam_ * np.sum(P[:, 0] ** 2) / N)
     thr = float(stats.chi2.ppf(1 - level, lags + 1))
     return CorrelationTest("cross-correlation", stat, stats.chi2.sf(stat, lags + 1), stat <= thr, thr, lags + 1,
                            level, lags, corr, float(stats.norm.ppf(1 - level / 2) / np.sqrt(N)), N)

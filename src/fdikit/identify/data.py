@@ -40,6 +40,19 @@ class IdentificationData:
         The means removed (over every usable sample of every segment kept; zeros with ``detrend=False``).
     dropped : int
         Usable samples lost in segments that were too short.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.trace import Trace
+    >>> tr = Trace(t=np.arange(4) * 0.5, u=np.ones((4, 1)), y=np.arange(4.0)[:, None], controls=["u"], outputs=["y"])
+    >>> d = segments(tr)
+    >>> d.dt, d.samples, d.y_mean.tolist()
+    (0.5, 4, [1.5])
+
+    References
+    ----------
+    Van Overschee & De Moor 1996, Ch. 4 (the Hankel matrices need gap-free stretches).
     """
 
     u: list

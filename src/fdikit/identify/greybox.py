@@ -58,6 +58,22 @@ class ParameterFit:
         ``build(params)``.
     result : scipy.optimize.OptimizeResult
         The raw least-squares result (``nfev``, ``status``, ``message`` …).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit import FaultModel
+    >>> from fdikit.simulate import simulate
+    >>> def build(p):
+    ...     return FaultModel(A=[[-1.0]], C=[[1.0]], Bu=[[p[0]]], controls=["u"], outputs=["y"])
+    >>> tr = simulate(build([3.0]), t=np.arange(100) * 0.1, u=np.ones((100, 1)), measurement_noise_std=0.01, rng=0)
+    >>> est = fit_parameters(build, [1.0], tr, scale=0.01, names=["gain"])
+    >>> list(est.as_dict()), bool(abs(est.params[0] - 3.0) < 5 * est.std[0])
+    (['gain'], True)
+
+    References
+    ----------
+    Ljung 1999, Ch. 9 (the asymptotic covariance).
     """
 
     params: np.ndarray

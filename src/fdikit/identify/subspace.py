@@ -88,6 +88,21 @@ class IdentifiedModel:
         The same means by signal name (``u0``, ``y0``).
     samples : int
         Samples used; ``segments`` is the number of gap-free segments.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit import FaultModel
+    >>> from fdikit.simulate import simulate
+    >>> plant = FaultModel(A=[[0.5]], C=[[1.0]], Bu=[[1.0]], dt=1.0)
+    >>> tr = simulate(plant, t=np.arange(300.0), u=np.random.default_rng(1).standard_normal((300, 1)))
+    >>> ident = subspace_id(tr, 1, detrend=False)
+    >>> ident, ident.model.noise, round(float(ident.poles[0].real), 9)
+    (IdentifiedModel(n4sid, n=1, p=1, m=1, dt=1, samples=300, segments=1), ('y0_innovation',), 0.5)
+
+    References
+    ----------
+    Van Overschee & De Moor 1996, Ch. 4 (the innovation form).
     """
 
     model: FaultModel

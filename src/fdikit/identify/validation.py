@@ -48,6 +48,21 @@ class ValidationReport:
         The tests' level ``α`` and largest lag ``M``.
     samples : int
         Samples compared.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit import FaultModel
+    >>> from fdikit.simulate import simulate
+    >>> plant = FaultModel(A=[[0.5]], C=[[1.0]], Bu=[[1.0]], dt=1.0)
+    >>> tr = simulate(plant, t=np.arange(200.0), u=np.random.default_rng(2).standard_normal((200, 1)))
+    >>> rep = validate_model(plant, tr)
+    >>> rep.fit.round(6).tolist(), list(rep.to_pandas().columns[:2])
+    ([100.0], ['fit_percent', 'whiteness_statistic'])
+
+    References
+    ----------
+    Ljung 1999, §16.5–16.6.
     """
 
     outputs: tuple[str, ...]
