@@ -7,7 +7,8 @@ data's inputs (each gap-free segment from the plant's initial state) and
 
     V(θ) = Σ_k Σ_i ((ŷ_i(k; θ) − y_i(k)) / s_i)²
 
-with ``s_i`` the scale of output ``i`` (Ljung 1999, Ch. 7: the prediction-error criterion with the output-error predictor).
+with ``s_i`` the scale of output ``i`` (Ljung 1999, Ch. 7: the prediction-error criterion with
+the output-error predictor).
 Each trace is one experiment, simulated as a whole from ``x0`` (the state is not known after a gap, so the
 simulation runs through it): an output sample that is not finite or has ``valid == False`` is left out of
 the error; a non-finite control cannot be simulated through and is refused (split the trace into

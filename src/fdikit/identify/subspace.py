@@ -31,8 +31,9 @@ cost: neither peer takes several experiments or a record split by gaps (both bui
 matrices of one continuous record; here each segment gives its own columns), ``nfoursid`` gives
 ``(Q, S, R)`` but no gain ``K``, needs pandas and matplotlib at import and takes 11–31x the time
 (two runs under different load: 1.76 s against 0.16 s, 0.49 s against 16 ms), SIPPY takes 4.5–27x
-(0.74 s, 0.42 s), prints to stdout and pulls in casadi and sympy.  ``harold`` 1.0.3 has no subspace method and python-control has none.  So the method is
-written here with numpy/scipy (one LQ factorisation, two SVDs, least squares).
+(0.74 s, 0.42 s), prints to stdout and pulls in casadi and sympy.  ``harold`` 1.0.3 has no
+subspace method and python-control has none.  So the method is written here with numpy/scipy
+(one LQ factorisation, one SVD, least squares).
 
 Order selection (``order=None``): the order is the index ``k`` of the largest gap
 ``s_k / s_{k+1}`` of the singular values (``k`` from 1 to ``min(max_order, p (horizon − 1))``).
