@@ -247,6 +247,10 @@ def isolate(
     discarded (the fault is outside its design set); the fault is named when the
     remaining filters that point to one fault all point to the same one.
 
+    A fault that fires residuals tied to *different* faults (one actuator seen by two
+    observer groups) is thus ``'unknown'`` here; a fault-signature table names it
+    (:class:`fdikit.decision.signature.SignatureTable`, the evaluators' ``signatures=``).
+
     Parameters
     ----------
     fired : (N, q) bool array_like

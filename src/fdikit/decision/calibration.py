@@ -42,6 +42,10 @@ class CalibrationRuns:
         Total duration [h]: every run's samples times its median time step (``dt`` for a one-sample run),
         as :func:`fdikit.metrics.score` counts fault-free hours.
 
+    References
+    ----------
+    No source document: bookkeeping shared by the evaluators of ``fdikit.decision``.
+
     Examples
     --------
     >>> import numpy as np
@@ -148,6 +152,11 @@ class CalibrationReport:
     min_resolvable_rate : float
         The smallest rate the data can resolve [1/h]: the upper end of the interval for zero alarms,
         ``χ²_{(1+c)/2}(2) / (2 T)`` (``≈ 3.69 / T`` at 95 %) — a rate below it cannot be told from zero.
+
+    References
+    ----------
+    Douglas et al. 1996, Ch. 1 (thresholds set from empirical studies of the false-alarm rate); the interval is
+    :func:`fdikit.metrics.rate_interval`.
 
     Examples
     --------

@@ -41,6 +41,7 @@ import scipy.linalg
 from scipy.stats import chi2
 
 from fdikit import validate
+from fdikit.decision.calibration import CalibrationRuns, calibration_report, calibration_runs
 from fdikit.decision.common import (
     checked_names,
     checked_residuals,
@@ -327,9 +328,8 @@ def fit_moments(residuals: Residuals | Sequence[Residuals], minimum: int = 10) -
 
     Parameters
     ----------
-    residuals : Residuals or sequence of Residuals
-        Fault-free residuals, one run or several with the same residuals
-        (:func:`~fdikit.decision.calibration.calibration_runs`); invalid and non-finite rows are skipped.
+    residuals : Residuals, sequence of Residuals or CalibrationRuns
+        Fault-free runs (:func:`~fdikit.decision.calibration.calibration_runs`); invalid, non-finite rows skipped.
     minimum : int, default 10
         Fewest usable rows accepted.
 
@@ -341,8 +341,7 @@ def fit_moments(residuals: Residuals | Sequence[Residuals], minimum: int = 10) -
     Raises
     ------
     DataError
-        When ``residuals`` is not a ``Residuals`` (or a list of them with the same names), or has fewer than
-        ``minimum`` usable rows.
+        When ``residuals`` is not a ``Residuals`` (or runs of the same residuals), or has < ``minimum`` usable rows.
 
     References
     ----------
@@ -356,9 +355,7 @@ def fit_moments(residuals: Residuals | Sequence[Residuals], minimum: int = 10) -
     >>> mean.shape, cov.shape
     ((2,), (2, 2))
     """
-    from fdikit.decision.calibration import calibration_runs
-
-    r = calibration_runs(residuals, minimum).rows
+    r = (residuals if isinstance(residuals, CalibrationRuns) else calibration_runs(residuals, minimum)).rows
     return r.mean(axis=0), np.atleast_2d(np.cov(r, rowvar=False, ddof=1))
 
 
@@ -384,14 +381,9 @@ class GlrEvaluator:
         Fault tied to each residual and filter of each residual (bank); a block's fault is
         its residuals' common fault (None when they differ).
     signatures : SignatureTable, mapping or DataFrame, optional
-        Isolate by the fault-signature table (:mod:`fdikit.decision.signature`): its groups are matched
-        against the fired *blocks* (by block name or the block's fault).
-
-    Attributes
-    ----------
-    calibration : CalibrationReport or None
-        After :meth:`fit` with a threshold: the alarms raised on the calibration runs over their hours, with the
-        Garwood interval (:class:`~fdikit.decision.calibration.CalibrationReport`).
+        Isolate by a fault-signature table (:mod:`fdikit.decision.signature`), matched against the fired blocks.
+        After :meth:`fit` with a threshold, ``calibration`` is the false-alarm report on the fault-free runs
+        (:class:`~fdikit.decision.calibration.CalibrationReport`).
 
     Notes
     -----
@@ -441,15 +433,10 @@ class GlrEvaluator:
         self.alpha: float | None = None
         self.reset()
 
-    def fit(
-        self, residuals: Residuals | Sequence[Residuals], false_alarm_prob: float | None = None,
-        false_alarms_per_hour: float | None = None,
-    ) -> GlrEvaluator:
-        """Estimate ``μ0`` and ``Σ`` on fault-free residuals (one run or a list); optionally set ``h`` per block.
-
-        A list of runs is pooled for the moments (:func:`fit_moments`); each run is evaluated on its own for the
-        ``calibration`` report (no GLR window crosses a run boundary).
-
+    def fit(self, residuals: Residuals | Sequence[Residuals], false_alarm_prob: float | None = None,
+            false_alarms_per_hour: float | None = None) -> GlrEvaluator:
+        """Estimate ``μ0`` and ``Σ`` on fault-free residuals (one run, or a list pooled; each run evaluated on its
+        own for ``calibration``, so no window crosses a run boundary); optionally set ``h`` per block.
         ``false_alarm_prob`` (or a rate per hour, ``α = rate·dt/3600``) is the
         per-sample probability of any block alarming, split evenly over the ``G`` blocks,
         each given ``h_g = glr_threshold(α/G, M, p_g)`` (an upper bound; see the module
@@ -457,16 +444,12 @@ class GlrEvaluator:
         """
         if false_alarm_prob is not None and false_alarms_per_hour is not None:
             raise ParameterError("give at most one of false_alarm_prob and false_alarms_per_hour")
-        from fdikit.decision.calibration import calibration_report, calibration_runs
-
         runs = calibration_runs(residuals)
-        mean, cov = fit_moments(residuals)
+        mean, cov = fit_moments(runs)
         if false_alarms_per_hour is not None:
             dt = runs.dt
             if not false_alarms_per_hour > 0 or not dt > 0:
-                raise ParameterError(
-                    f"need a positive rate and sample time, got {false_alarms_per_hour}/h and dt={dt}"
-                )
+                raise ParameterError(f"need a positive rate and sample time, got {false_alarms_per_hour}/h and dt={dt}")
             false_alarm_prob = min(0.5, false_alarms_per_hour * dt / 3600.0)
         iso = self.isolates if self.isolates is not None else runs.isolates
         layout = BlockLayout(self.blocks, runs.names, iso, self.groups, cov)
@@ -480,10 +463,8 @@ class GlrEvaluator:
         self.names = runs.names
         self.isolates = tuple(iso)
         self.reset()
-        self.calibration = None
-        if self.threshold is not None:
-            target = self.alpha * 3600.0 / runs.dt if false_alarm_prob is not None else None
-            self.calibration = calibration_report(self, runs, target_rate=target)
+        target = self.alpha * 3600.0 / runs.dt if false_alarm_prob is not None else None
+        self.calibration = None if self.threshold is None else calibration_report(self, runs, target_rate=target)
         return self
 
     def _ready(self, q: int, residuals: Residuals | None = None):
@@ -612,9 +593,8 @@ class GlrEvaluator:
         return StepDecision(bool(fired.any()), self._isolate(fired), fired.copy(), True)
 
     def _isolate(self, fired: np.ndarray) -> str:
-        layout = self._state["layout"]
-        return isolate_cached(self._state["cache"], fired, layout.isolates, layout.groups, self.signatures,
-                              layout.names)
+        lay = self._state["layout"]
+        return isolate_cached(self._state["cache"], fired, lay.isolates, lay.groups, self.signatures, lay.names)
 
     def __repr__(self) -> str:
         return f"GlrEvaluator(window={self.window}, threshold={self.threshold}, blocks={self.blocks!r})"

@@ -294,7 +294,7 @@ class SprtEvaluator:
         from fdikit.decision.calibration import calibration_report, calibration_runs
 
         runs = calibration_runs(residuals)
-        self.mean, self.cov = fit_moments(residuals)
+        self.mean, self.cov = fit_moments(runs)
         self.names = runs.names
         if self.isolates is None:
             self.isolates = runs.isolates
