@@ -43,8 +43,8 @@ import numpy as np
 
 from fdikit import linalg, validate
 from fdikit.design.game.setup import GameProblem, game_problem, per_target, weight
-from fdikit.design.observers.full_order import observer_generator
 from fdikit.design.labels import label_generator
+from fdikit.design.observers.full_order import observer_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.residuals import ResidualGenerator

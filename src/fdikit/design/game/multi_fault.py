@@ -52,8 +52,8 @@ from fdikit.design.game.single_fault import (
     residual_names,
     single_fault_game_filter,
 )
-from fdikit.design.observers.full_order import observer_generator
 from fdikit.design.labels import label_generator
+from fdikit.design.observers.full_order import observer_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import ProblemDesign

@@ -29,8 +29,8 @@ from fdikit.design.game.discrete import DiscreteGtfdfDesign, dgtfdf
 from fdikit.design.game.discrete_setup import DiscreteGameSetup, discrete_game_setup
 from fdikit.design.game.riccati import checked_gamma, require_continuous, solve_game_are
 from fdikit.design.game.setup import GameProblem, game_problem, per_target, weight
-from fdikit.design.observers.full_order import observer_generator
 from fdikit.design.labels import label_generator
+from fdikit.design.observers.full_order import observer_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.fault_maps import resolve_nuisance
 from fdikit.model import FaultModel

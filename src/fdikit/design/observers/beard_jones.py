@@ -50,8 +50,8 @@ import numpy as np
 import scipy.linalg
 
 from fdikit import linalg, lti, validate
-from fdikit.design.observers.full_order import observer_generator
 from fdikit.design.labels import label_generator
+from fdikit.design.observers.full_order import observer_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.fault_maps import resolve_faults
 from fdikit.model import FaultModel

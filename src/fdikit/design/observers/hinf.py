@@ -52,9 +52,9 @@ import numpy as np
 import scipy.linalg
 
 from fdikit import linalg, validate
+from fdikit.design.labels import label_generator
 from fdikit.design.observers.detection_gain import DetectionGainFamily, detection_gain_family
 from fdikit.design.observers.full_order import observer_generator
-from fdikit.design.labels import label_generator
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import FieldReport

@@ -44,8 +44,8 @@ import numpy as np
 
 from fdikit import linalg
 from fdikit.dae import DAEModel, dae_form
-from fdikit.design.parity.polynomial_rank import bar, bar_matrices, detectability, minimal_degree, target_fault
 from fdikit.design.labels import fault_label, label_generator, warn_unlisted_faults
+from fdikit.design.parity.polynomial_rank import bar, bar_matrices, detectability, minimal_degree, target_fault
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import FieldReport, joined_form, no_internal_form

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from fdikit.design.labels import residual_labels
 from fdikit.design.parity.criteria import robust_criteria, theorem1, theorem1_batch
 from fdikit.design.parity.polytope import (
     adjugate,
@@ -35,7 +36,6 @@ from fdikit.design.parity.polytope import (
     scheduling_weights,
 )
 from fdikit.design.parity.state_space import lpv_parity_residuals, regular_rows
-from fdikit.design.labels import residual_labels
 from fdikit.errors import DesignError, ParameterError
 from fdikit.lpv import LPVModel, Uncertainty, lpv_stacked_matrices
 from fdikit.protocols import no_internal_form

@@ -446,8 +446,8 @@ def parity_design(model: FaultModel, s: int | None = None, *, W2=None, rows: Seq
             raise DesignError(
                 f"the q = {P.shape[0]} parity directions at horizon s={s} cannot be decoupled from nuisance "
                 f"{list(nu)}: P H_f has rank {linalg.rank(M)} = q (the nuisance faults over the window span the parity "
-                f"space; each step adds p = {model.p} directions and {kk} nuisance columns); decoupling needs "
-                "fewer nuisance faults than outputs, or a longer horizon")
+                f"space; each step adds p = {model.p} directions and {kk} nuisance columns); use a longer horizon s or "
+                "fewer nuisance faults")
         W2 = basis @ _as_w2(W2, basis.shape[1])
     else:
         W2 = _as_w2(W2, P.shape[0])
