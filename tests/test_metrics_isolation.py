@@ -32,6 +32,7 @@ def test_unknown_never_counts_as_correct():
     # even a truth label spelled 'unknown' is never a correct isolation
     s2 = score(np.array(["none"] * 2 + ["unknown"] * 10), d)
     assert s2.isolated == "unknown" and s2.isolation_correct is False
+    assert s2.correct_fraction == 0.0 and s2.isolation_delay is None
     assert summarize([s]).isolation_accuracy == 0.0
 
 

@@ -187,7 +187,8 @@ def score(truth: Trace | np.ndarray, diagnosis: Diagnosis, hold: float | None = 
     hit[:onset_idx] = False
     det = np.flatnonzero(hit)
     end = onset_idx + int(np.argmax(np.append(labels[onset_idx:] != label, True)))  # one past the interval
-    iso_delay = _isolation_delay(t, np.asarray(diagnosis.isolated) == label, diagnosis.valid, onset_idx, end, hold)
+    right = (np.asarray(diagnosis.isolated) == label) & (label != UNKNOWN_FAULT)  # 'unknown' is never right
+    iso_delay = _isolation_delay(t, right, diagnosis.valid, onset_idx, end, hold)
     if det.size == 0:
         return Score(label, onset, False, None, false_alarms, hours, True, NO_FAULT, False, iso_delay, None)
     said = np.asarray(diagnosis.isolated)[det].astype(str)
@@ -195,7 +196,7 @@ def score(truth: Trace | np.ndarray, diagnosis: Diagnosis, hold: float | None = 
     isolated = str(names[np.lexsort((first, -counts))[0]])
     correct = isolated == label and label != UNKNOWN_FAULT
     return Score(label, onset, True, float(t[det[0]] - onset), false_alarms, hours, False, isolated,
-                 correct, iso_delay, float(np.mean(said == label)))
+                 correct, iso_delay, float(np.mean(right[det])))
 
 
 def _isolation_delay(t, right, valid, start: int, end: int, hold: float | None) -> float | None:
