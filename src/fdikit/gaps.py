@@ -29,8 +29,12 @@ every residual's transient standard deviation is at most ``recovery_tol`` times 
 deviation.  The recovery therefore grows with the gap (as ``log`` of the open-loop error growth)
 and shrinks with the spectral radius ``ρ(A)``.  Parts fed a held value (not predicted) add an error
 the filter matrices cannot bound; for them the recovery lasts at least
-``ceil(log tol / log ρ(A))`` samples (the filter forgetting its state by the factor ``tol``), and a
-filter with ``ρ(A) ≥ 1`` and held values never recovers.
+``ceil(log tol / log ρ)`` samples (the filter forgetting its state by the factor ``tol``), and a
+filter with ``ρ ≥ 1`` and held values never recovers.  ``ρ`` is the spectral radius of the part of
+``A`` the residuals see (the observable part of ``(A, C)``, SLICOT TB01PD): a mode no residual
+reads cannot show its transient — a Kalman filter that reads one of two tanks in series carries the
+other tank's open-loop mode, unobservable from its residual, which would otherwise hold every sample
+after a dropout for thousands of samples.
 
 >>> from fdikit.residuals import ResidualGenerator
 >>> g = ResidualGenerator([[0.5]], [[0.0, 1.0]], [[-1.0]], [[0.0, 1.0]], ["u"], ["y"], ["r"], dt=1.0)
@@ -126,10 +130,10 @@ class GapRule:
     Attributes
     ----------
     rho : float
-        Spectral radius of the filter's ``A``.
+        Spectral radius of the observable part of the filter's ``(A, C)`` (the modes a residual shows).
     settle : int
         Least number of recovering samples after a gap in which a part is fed held values,
-        ``ceil(log tol / log ρ(A))`` (``-1``: never, for ``ρ(A) >= 1``).
+        ``ceil(log tol / log ρ)`` (``-1``: never, for ``ρ >= 1``).
 
     Examples
     --------
@@ -145,7 +149,7 @@ class GapRule:
         self.limit = self.tol**2 * np.diag(S)
         self.mu = len(g.controls)
         n = g.n
-        rho = float(np.max(np.abs(np.linalg.eigvals(g.A)))) if n else 0.0
+        rho = _visible_radius(g.A, g.C) if n else 0.0
         self.rho = rho
         self.settle = 0 if n == 0 else (1 if rho == 0 else (
             int(np.ceil(np.log(self.tol) / np.log(rho))) if rho < 1 else -1))
@@ -280,3 +284,17 @@ def _components(A: np.ndarray, C: np.ndarray) -> list[tuple[np.ndarray, np.ndarr
         rows = np.array([i - n for i in members if i >= n], dtype=int)
         out.append((states, rows))
     return out
+
+
+def _visible_radius(A: np.ndarray, C: np.ndarray) -> float:
+    """Spectral radius of the observable part of ``(A, C)`` (SLICOT TB01PD, ``job='O'``); 0 when nothing is seen."""
+    from slycot import tb01pd
+
+    n, q = A.shape[0], C.shape[0]
+    if q == 0 or not np.any(C):
+        return 0.0
+    try:
+        Ao, _, _, nr = tb01pd(n, 1, q, A.copy(), np.zeros((n, max(1, q))), C.copy(), job="O", equil="N", tol=0.0)
+    except Exception:  # noqa: BLE001 - SLICOT failing on a pathological filter: fall back to every mode
+        return float(np.max(np.abs(np.linalg.eigvals(A))))
+    return float(np.max(np.abs(np.linalg.eigvals(Ao[:nr, :nr])))) if nr else 0.0
