@@ -231,18 +231,21 @@ class ScheduledResidualGenerator:
         return int(np.argmax(tail <= tol**2 * tail[0]))
 
     def run(self, trace: Trace, schedule: np.ndarray | str | None = None, *, recovery_tol: float = 0.1,
-            smoothing: float | None = None, smoothing_kind: str = "lowpass") -> Residuals:
+            smoothing: float | None = None, smoothing_kind: str = "ramp") -> Residuals:
         """Residuals of a whole trace; ``schedule`` is an array (N,), a column name, or None (``self.schedule``).
 
         Vectorised, and identical to :meth:`online` stepping (same residuals to rounding, same flags).
 
         ``smoothing`` (time constant ``τ`` in s; default None, no smoothing) smooths a *measured* schedule
         causally before it schedules the filter, so ``online`` gives the same result:
-        ``smoothing_kind="lowpass"`` (default) is the first-order low-pass ``s(k) = a s(k−1) + (1 − a) ρ(k)``,
-        ``a = e^{−dt/τ}``, white noise variance × ``(1 − a)/(1 + a) ≈ dt/(2τ)``, lag ``τ ρ'`` on a ramp;
-        ``"ramp"`` is Brown's double exponential smoothing (no steady lag on a ramp).  The default is off
-        because an exact schedule needs none and a low-pass only adds lag; see
-        docs/methods/lateral_fault_isolation.md for measured effects and a recommended ``τ``.
+        ``smoothing_kind="ramp"`` (default) is Brown's double exponential smoothing (``s₁ ← a s₁ + (1 − a) ρ``,
+        ``s₂ ← a s₂ + (1 − a) s₁``, output ``2 s₁ − s₂``, ``a = e^{−dt/τ}``): no steady lag while the speed
+        ramps; ``"lowpass"`` is the first-order low-pass ``s(k) = a s(k−1) + (1 − a) ρ(k)`` (white noise
+        variance × ``(1 − a)/(1 + a) ≈ dt/(2τ)``, but a lag ``τ ρ'`` that the residual sees as a speed error).
+        Smoothing is off by default: an exact schedule needs none, and the filter's own ``d(q)`` already
+        averages white speed noise (benchmarks/bench_scheduled.py: 0.1 m/s noise raised the residual rms by
+        8–25 %, and a 1 s low-pass made it 9× worse on a 0.65 m/s² speed change, the ramp kind ≤ 0.3 s did
+        not); see docs/methods/lateral_fault_isolation.md.
 
         Gap rule (a sample is *invalid* when a used signal or the schedule is NaN/inf): its residual
         is NaN.  The parity value ``w(k) = N̄_k L̄_k [z(τ_0) … z(τ_{d_N+d_L})]`` is formed only when
@@ -312,7 +315,7 @@ class ScheduledResidualGenerator:
         return rho
 
     def online(self, *, recovery_tol: float = 0.1, smoothing: float | None = None,
-               smoothing_kind: str = "lowpass") -> ScheduledStepper:
+               smoothing_kind: str = "ramp") -> ScheduledStepper:
         """A stepper with zero initial history (like ``run``), the same gap rule and schedule smoothing."""
         return ScheduledStepper(self, recovery_tol=recovery_tol, smoothing=smoothing, smoothing_kind=smoothing_kind)
 
@@ -413,7 +416,7 @@ class ScheduledStepper:
     """
 
     def __init__(self, generator: ScheduledResidualGenerator, *, recovery_tol: float = 0.1,
-                 smoothing: float | None = None, smoothing_kind: str = "lowpass") -> None:
+                 smoothing: float | None = None, smoothing_kind: str = "ramp") -> None:
         self.generator = generator
         self._n_dec = generator.recovery_length(recovery_tol)
         self._smoothing = (smoothing, smoothing_kind)
