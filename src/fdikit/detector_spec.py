@@ -45,6 +45,7 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import os
+import sys
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -61,7 +62,13 @@ _STRICT = ConfigDict(extra="forbid", arbitrary_types_allowed=True)
 
 
 class ModelSpec(BaseModel):
-    """The LTI model of a YAML spec (deviation coordinates; see the module docstring)."""
+    """The LTI model of a YAML spec (deviation coordinates; see the module docstring).
+
+    Examples
+    --------
+    >>> ModelSpec(A=[[0.9]], B=[[1.0]], C=[[1.0]], dt=0.1, operating_point={"y0": {"y0": 2.0}}).dt
+    0.1
+    """
 
     model_config = _STRICT
     A: list[list[float]]
@@ -100,7 +107,13 @@ class ModelSpec(BaseModel):
 
 
 class FilterSpec(BaseModel):
-    """One Kalman filter of the bank: its name, the outputs it reads and its noise covariances."""
+    """One Kalman filter of the bank: its name, the outputs it reads and its noise covariances.
+
+    Examples
+    --------
+    >>> FilterSpec(name="yaw", outputs=["yaw_rate"], measurement_noise_std=0.002).process_noise_cov
+    1e-06
+    """
 
     model_config = _STRICT
     name: str = Field(min_length=1, pattern=r"^[^:]+$")
@@ -110,7 +123,13 @@ class FilterSpec(BaseModel):
 
 
 class LogSpec(BaseModel):
-    """How a log reads: its time column, the column of each signal and each signal's unit."""
+    """How a log reads: its time column, the column of each signal and each signal's unit.
+
+    Examples
+    --------
+    >>> LogSpec(time="time", units={"yaw_rate": "deg/s"}).units
+    {'yaw_rate': 'deg/s'}
+    """
 
     model_config = _STRICT
     time: str | None = None
@@ -119,7 +138,13 @@ class LogSpec(BaseModel):
 
 
 class CalibrationSpec(BaseModel):
-    """The false-alarm target, the persistence and the signature match rule of the thresholds."""
+    """The false-alarm target, the persistence and the signature match rule of the thresholds.
+
+    Examples
+    --------
+    >>> CalibrationSpec(persistence=(3, 5)).false_alarms_per_hour
+    1.0
+    """
 
     model_config = _STRICT
     false_alarms_per_hour: float = Field(default=1.0, gt=0)
@@ -128,7 +153,13 @@ class CalibrationSpec(BaseModel):
 
 
 class DesignSpec(BaseModel):
-    """A whole design spec (module docstring); ``model`` is a :class:`ModelSpec` or a FaultModel."""
+    """A whole design spec (module docstring); ``model`` is a :class:`ModelSpec` or a FaultModel.
+
+    Examples
+    --------
+    >>> DesignSpec(model={"A": [[0.9]], "C": [[1.0]], "dt": 0.1}, name="demo").filters[0].outputs is None
+    True
+    """
 
     model_config = _STRICT
     name: str = "detector"
@@ -228,7 +259,8 @@ def load_spec(source: str | os.PathLike) -> DesignSpec:
     Parameters
     ----------
     source : str or PathLike
-        ``spec.yaml`` / ``spec.yml``, ``plant.py``, or a module name such as ``mypkg.car_spec``.
+        ``spec.yaml`` / ``spec.yml``, ``plant.py`` (run with its folder on ``sys.path``, so it may import a
+        module beside it), or a module name such as ``mypkg.car_spec``.
 
     Returns
     -------
@@ -280,7 +312,12 @@ def _import(text: str, path: Path):
             raise DataError(f"design spec {path} does not exist")
         spec = importlib.util.spec_from_file_location(path.stem, path)
         module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
+        folder = str(path.resolve().parent)
+        sys.path.insert(0, folder)   # the spec may import the plant module beside it, as a script would
+        try:
+            spec.loader.exec_module(module)
+        finally:
+            sys.path.remove(folder)
         return module
     try:
         return importlib.import_module(text)
@@ -362,7 +399,24 @@ def build_detector(spec: DesignSpec, healthy: Sequence[str | os.PathLike]):
 
     Examples
     --------
-    See ``docs/tutorial.md`` and ``tests/test_detector_spec.py``.
+    A first-order plant ``y⁺ = 0.9 y + 0.1 u`` logged in degrees, one fault-free log (see ``docs/tutorial.md``):
+
+    >>> import pathlib, tempfile
+    >>> import numpy as np, pandas as pd
+    >>> rng = np.random.default_rng(0)
+    >>> u = rng.standard_normal(3000)
+    >>> y = np.zeros(3000)
+    >>> for k in range(2999):
+    ...     y[k + 1] = 0.9 * y[k] + 0.1 * u[k]
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "healthy.csv"
+    >>> pd.DataFrame({"t": np.arange(3000) * 0.1, "u": u, "y_deg": np.rad2deg(y + 0.01 * rng.standard_normal(3000))}
+    ...              ).to_csv(path, index=False)
+    >>> spec = DesignSpec(model={"A": [[0.9]], "B": [[0.1]], "C": [[1.0]], "dt": 0.1, "controls": ["u"],
+    ...                          "outputs": ["y"]}, filters=[{"name": "k", "measurement_noise_std": 0.01}],
+    ...                   log={"time": "t", "columns": {"y": "y_deg"}, "units": {"y": "deg"}})
+    >>> det = build_detector(spec, [path])
+    >>> det.evaluator.names, det.evaluator.signatures.signature("y_sensor")
+    (('k:y',), ('k:y',))
     """
     from fdikit.decision import SignatureTable, ThresholdEvaluator
     from fdikit.design import kalman

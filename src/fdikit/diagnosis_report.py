@@ -8,20 +8,6 @@ Files written atomically (:mod:`fdikit.atomic`) into one folder:
 * ``report.html`` — the detector, the log, the alarm events, the score against the log's truth labels
   when it has any (:func:`fdikit.metrics.score`), the residual plots with their thresholds and the
   isolated fault over time.
-
-Examples
---------
->>> import numpy as np, tempfile
->>> from fdikit.decision import ThresholdEvaluator
->>> from fdikit.detector import Detector
->>> from fdikit.residuals import ResidualGenerator
->>> from fdikit.trace import Trace
->>> g = ResidualGenerator([[0.4]], [[1.0, 0.5]], [[-1.0]], [[0.0, 1.0]], ("u",), ("y",), ("r",), dt=1.0)
->>> det = Detector(g, ThresholdEvaluator(thresholds=[0.5], isolates=("y_sensor",)))
->>> tr = Trace(np.arange(6.0), np.ones((6, 1)), np.c_[[0.0, 1.0, 1.9, 3.71, 4.439, 5.0951]], ("u",), ("y",))
->>> diagnosis, files = write_diagnosis(tempfile.mkdtemp(), det, tr)
->>> diagnosis.first_alarm().fault, sorted(p.name for p in files.values())
-('y_sensor', ['alarms.csv', 'diagnosis.csv', 'report.html'])
 """
 
 from __future__ import annotations
@@ -114,6 +100,20 @@ def write_diagnosis(folder: str | os.PathLike, detector, trace, *, log_name: str
         When the trace lacks a signal the detector reads.
     OSError
         When the folder cannot be written.
+
+    Examples
+    --------
+    >>> import numpy as np, tempfile
+    >>> from fdikit.decision import ThresholdEvaluator
+    >>> from fdikit.detector import Detector
+    >>> from fdikit.residuals import ResidualGenerator
+    >>> from fdikit.trace import Trace
+    >>> g = ResidualGenerator([[0.4]], [[1.0, 0.5]], [[-1.0]], [[0.0, 1.0]], ("u",), ("y",), ("r",), dt=1.0)
+    >>> det = Detector(g, ThresholdEvaluator(thresholds=[0.5], isolates=("y_sensor",)))
+    >>> tr = Trace(np.arange(6.0), np.ones((6, 1)), np.c_[[0.0, 1.0, 1.9, 3.71, 4.439, 5.0951]], ("u",), ("y",))
+    >>> diagnosis, files = write_diagnosis(tempfile.mkdtemp(), det, tr)
+    >>> diagnosis.first_alarm().fault, sorted(p.name for p in files.values())
+    ('y_sensor', ['alarms.csv', 'diagnosis.csv', 'report.html'])
     """
     import matplotlib.pyplot as plt
     import pandas as pd

@@ -27,7 +27,7 @@ MODULES = sorted(
     for p in SRC.rglob("*.py") if p.name != "__init__.py" and p.name != "cli.py"
 )
 METHOD_PACKAGES = ("fdikit.design.", "fdikit.decision.", "fdikit.multimodel.", "fdikit.estimate.", "fdikit.plants.",
-                   "fdikit.studies.", "fdikit.nonlinear.")
+                   "fdikit.studies.", "fdikit.nonlinear.", "fdikit.identify.")
 
 
 def sections(doc: str) -> set[str]:
