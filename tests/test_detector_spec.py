@@ -20,6 +20,7 @@ A = [[0.9, 0.05], [0.1, 0.8]]
 B = [[0.1], [0.2]]
 U0, Y0 = 5.0, (20.0, -3.0)   # absolute operating point [deg]
 NOISE = 0.01                 # sensor noise [rad] per sample
+OP = {"u0": {"steer": float(np.deg2rad(U0))}, "y0": {"y1": float(np.deg2rad(Y0[0])), "y2": float(np.deg2rad(Y0[1]))}}
 SPEC = f"""
 name: two-sensor
 description: two filters, each reading one sensor
@@ -30,7 +31,7 @@ model:
   dt: {DT}
   controls: [steer]
   outputs: [y1, y2]
-  operating_point: {{u0: {{steer: {float(np.deg2rad(U0))!r}}}, y0: {{y1: {float(np.deg2rad(Y0[0]))!r}, y2: {float(np.deg2rad(Y0[1]))!r}}}}}
+  operating_point: {OP}
 filters:
   - {{name: A, outputs: [y1], process_noise_cov: 1.0e-6, measurement_noise_std: {NOISE}}}
   - {{name: B, outputs: [y2], process_noise_cov: 1.0e-6, measurement_noise_std: {NOISE}}}
