@@ -413,7 +413,7 @@ def rate_interval(count: int, hours: float, confidence: float = 0.95) -> tuple[f
         ``lower = χ²_{a/2}(2k) / (2T)`` (0 for ``k = 0``),  ``upper = χ²_{1−a/2}(2k + 2) / (2T)``,
 
     ``χ²_p(ν)`` the ``p`` quantile of the chi-square distribution with ``ν`` degrees of freedom (the exact interval
-    of F. Garwood, "Fiducial limits for the Poisson distribution", Biometrika 28 (3/4): 437–442, in 1936).
+    of Garwood 1936).
     The interval is conservative: it covers the true rate with probability at least ``confidence``.  With no
     events, the upper end ``−ln(a/2) / T`` (``≈ 3.69 / T`` at 95 %) is the smallest rate the data can resolve.
 
