@@ -243,9 +243,9 @@ class ScheduledResidualGenerator:
         ramps; ``"lowpass"`` is the first-order low-pass ``s(k) = a s(k−1) + (1 − a) ρ(k)`` (white noise
         variance × ``(1 − a)/(1 + a) ≈ dt/(2τ)``, but a lag ``τ ρ'`` that the residual sees as a speed error).
         Smoothing is off by default: an exact schedule needs none, and the filter's own ``d(q)`` already
-        averages white speed noise (benchmarks/bench_scheduled.py: 0.1 m/s noise raised the residual rms by
-        8–25 %, and a 1 s low-pass made it 9× worse on a 0.65 m/s² speed change, the ramp kind ≤ 0.3 s did
-        not); see docs/methods/lateral_fault_isolation.md.
+        averages white speed noise (benchmarks/bench_scheduled.py: 0.05–0.1 m/s noise raised the residual rms
+        by 5–15 % at realistic output noise; a 1 s low-pass made it 9× worse on a 0.65 m/s² speed change, the
+        ramp kind with τ ≤ 0.3 s did not); see docs/methods/lateral_fault_isolation.md.
 
         Gap rule (a sample is *invalid* when a used signal or the schedule is NaN/inf): its residual
         is NaN.  The parity value ``w(k) = N̄_k L̄_k [z(τ_0) … z(τ_{d_N+d_L})]`` is formed only when
