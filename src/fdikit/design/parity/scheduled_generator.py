@@ -154,7 +154,8 @@ class ScheduledResidualGenerator:
         A family with a ``dae_matrices(rho) -> (H_0, H_1, L, F)`` method (e.g.
         :class:`~fdikit.plants.single_track.SingleTrackLPV`) whose matrices equal
         ``dae_form(family(reference), [fault])`` at the design point is read through it
-        (``fast_path``); otherwise ``dae_form(family(rho), [fault])``.  Values are cached.
+        (``fast_path``); otherwise ``dae_form(family(rho), [fault])``.  Values are cached.  With ``grid`` set,
+        the coefficients are interpolated between the grid nodes (what the filter runs on).
         """
         H, L, F = self._coefficients(rho)
         ref = self.reference.dae
@@ -335,9 +336,10 @@ class ScheduledResidualGenerator:
 
     def report(self) -> dict:
         """``fault``, ``degree``, ``poles``, ``gamma`` (None: exact projection), ``column``, ``schedule`` (the trace
-        column of ρ), ``window`` (past samples read) and ``reference`` (the design-point report)."""
+        column of ρ), ``window`` (past samples read), ``grid`` (None: exact per value) and ``reference`` (the
+        design-point report)."""
         return {"fault": self.fault, "degree": self.degree, "poles": self.poles, "gamma": self.gamma,
-                "column": self.column, "schedule": self.schedule, "window": self.window,
+                "column": self.column, "schedule": self.schedule, "window": self.window, "grid": self.grid,
                 "reference": self.reference.report()}
 
 
