@@ -133,3 +133,26 @@ def test_report_on_gaussian_data():
     # the count is Poisson-like with mean ≤ 10 (the per-sample α makes ≤ 1 exceedance/h on average): the
     # probability of more than 25 alarms is poisson.sf(25, 10) = 1.1e−5
     assert rep.alarms <= 25
+
+
+def test_whitened_fit_on_a_list_pools_the_runs_without_crossing_them():
+    import scipy.signal
+
+    from fdikit.decision import ThresholdEvaluator
+    from fdikit.decision.whiten import Whitened, yule_walker
+    from fdikit.residuals import Residuals
+
+    rng = np.random.default_rng(5)
+    runs = []
+    for _ in range(3):
+        x = scipy.signal.lfilter([1.0], [1.0, -0.8], rng.standard_normal(4000))
+        runs.append(Residuals(np.arange(4000) * 0.01, x[:, None], ("r",), ("f",)))
+    w = Whitened(ThresholdEvaluator(), order=1).fit(runs, false_alarms_per_hour=1.0)
+    # pooled Yule-Walker: the sum of within-run lag-1 products over the sum of squares (mean removed)
+    xs = [r.r[:, 0] - w.center[0] for r in runs]
+    ref = sum(x[:-1] @ x[1:] for x in xs) / sum(x @ x for x in xs)
+    assert w.coef[0, 0] == pytest.approx(ref, rel=1e-12)
+    assert yule_walker(xs, 1)[0] == pytest.approx(ref, rel=1e-12)
+    # AR(1) with a = 0.8 from 12000 samples: standard error sqrt((1 - a²)/N) ≈ 0.0055; 5 standard errors
+    assert abs(w.coef[0, 0] - 0.8) < 5 * np.sqrt((1 - 0.8**2) / 12000)
+    assert w.evaluator.calibration.runs == 3

@@ -31,8 +31,9 @@ def yule_walker(x: np.ndarray, order: int) -> np.ndarray:
 
     Parameters
     ----------
-    x : (N,) array_like
-        The series, mean already removed.
+    x : (N,) array_like, or a list of them
+        The series, mean already removed; several runs pool their autocovariances (no lag product
+        crosses from one run into the next).
     order : int
         ``p``, the AR order; ``N > 2 p`` needed.
 
@@ -59,11 +60,11 @@ def yule_walker(x: np.ndarray, order: int) -> np.ndarray:
     >>> np.round(yule_walker(x, 1), 2).tolist()
     [0.9]
     """
-    x = np.asarray(x, dtype=float)
-    n = x.size
+    runs = [np.asarray(seg, dtype=float) for seg in x] if isinstance(x, list) else [np.asarray(x, dtype=float)]
+    n = sum(seg.size for seg in runs)
     if n <= 2 * order:
         raise DataError(f"need more than {2 * order} samples for an AR({order}) fit, got {n}")
-    acf = np.array([x[: n - k] @ x[k:] for k in range(order + 1)]) / n
+    acf = np.array([sum(seg[: seg.size - k] @ seg[k:] for seg in runs if seg.size > k) for k in range(order + 1)]) / n
     if acf[0] <= 0:
         raise DataError("the residual is constant; nothing to whiten")
     return scipy.linalg.solve_toeplitz(acf[:order], acf[1 : order + 1])
@@ -118,13 +119,20 @@ class Whitened:
         self.center: np.ndarray | None = None
         self.reset()
 
-    def fit(self, residuals: Residuals, **fit_kwargs) -> Whitened:
-        """AR models from fault-free residuals, then the wrapped evaluator on their innovations."""
-        r = residuals.r[residuals.valid]
-        r = r[np.all(np.isfinite(r), axis=1)]
-        self.center = r.mean(axis=0)
-        self.coef = np.array([yule_walker(r[:, j] - self.center[j], self.order) for j in range(r.shape[1])])
-        self.evaluator.fit(self.whiten(residuals), **fit_kwargs)
+    def fit(self, residuals: Residuals | list[Residuals], **fit_kwargs) -> Whitened:
+        """AR models from fault-free residuals (one run or a list), then the wrapped evaluator on their innovations.
+
+        Several runs pool their mean and autocovariances (no lag crosses a run boundary) and the wrapped
+        evaluator is fitted on the list of whitened runs.
+        """
+        runs = residuals if isinstance(residuals, list) else [residuals]
+        rows = [res.r[res.valid] for res in runs]
+        rows = [r[np.all(np.isfinite(r), axis=1)] for r in rows]
+        self.center = np.concatenate(rows).mean(axis=0)
+        self.coef = np.array([yule_walker([r[:, j] - self.center[j] for r in rows], self.order)
+                              for j in range(self.center.size)])
+        white = [self.whiten(res) for res in runs]
+        self.evaluator.fit(white if isinstance(residuals, list) else white[0], **fit_kwargs)
         self.reset()
         return self
 

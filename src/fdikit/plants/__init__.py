@@ -63,8 +63,8 @@ __getattr__, __dir__, __all__ = lazy.attach(
             "PATH7_OUTPUTS", "path_longitudinal_7", "path_longitudinal_7_fault_maps",
         ],
         "single_track": [
-            "CONTROLS", "DISTURBANCES", "OUTPUTS", "PRIUS_2010", "STATES", "SingleTrackLPV", "SingleTrackParameters",
-            "single_track", "single_track_lpv", "understeer_gradient",
+            "CONTROLS", "DISTURBANCES", "OUTPUTS", "PRIUS_2010", "SENSORS", "STATES", "SingleTrackLPV",
+            "SingleTrackParameters", "sensor_selection", "single_track", "single_track_lpv", "understeer_gradient",
         ],
         "f16xl": [
             "F16XL_A", "F16XL_DRYDEN_GAIN", "F16XL_GUST_POLE", "f16xl_gust", "f16xl_longitudinal",
