@@ -19,30 +19,51 @@ factorisation of ``[U_f; U_p; Y_p; Y_f]`` gives
 The residuals of the state regression estimate the noise covariances ``Q, S, R``; the steady
 Kalman gain of those (discrete Riccati equation) is ``K`` and ``C P Cᵀ + R`` the innovation
 covariance (Van Overschee & De Moor 1996, Ch. 4).  The data are scaled to unit
-standard deviation per signal before the SVD (so the singular values do not depend on units).
+standard deviation per signal before the projections and the scaling is undone on the result
+(so the singular values and the poles do not depend on units).
+
+``focus="simulation"`` (default, MATLAB's ``Focus``): given ``A`` and ``C``, the simulated output is
+linear in ``B``, ``D`` and the initial state of each segment, so these are refitted by one linear
+least-squares problem on the simulation error (the output-error criterion, Ljung 1999, §4.2 and
+Ch. 7, solved exactly for a fixed ``A, C``); ``focus="prediction"`` keeps ``B, D`` of the state
+regression.  The noise model ``K, R`` is the state regression's in both cases.
+
+Stability (``stable=True``, default): an estimated ``A`` with eigenvalues ``|λ| ≥ 1`` has each such
+eigenvalue replaced by its reflection ``1/conj(λ)`` (eigenvectors kept; a defective ``A`` is divided
+by ``ρ(A)²``), ``B, D`` are refitted for the new ``A`` and an :class:`~fdikit.errors.FdiWarning` lists
+what moved.  The reflection keeps a mode's frequency and the shape of its magnitude response
+(``|e^{jω} − λ| = |λ| |e^{jω} − 1/conj(λ)|``) but changes its phase and damping: the model is
+biased (an unstable estimate says the order or the horizon do not suit the data).  It is the
+cheap alternative to a stability-constrained least squares for ``A`` (an LMI problem).
+
+Order selection (``order=None``): ``criterion="bic"`` (default) or ``"aic"`` identifies every order
+``k = 1 … min(max_order, p (horizon − 1))`` from the one SVD and takes the least
+``N log det Σ̂_k + c d_k`` (``c = log N`` or 2), ``Σ̂_k`` the covariance of the one-step prediction
+error of the order-``k`` predictor on the identification data (initial state fitted) and
+``d_k = k (m + 2 p) + p m`` the parameters of ``(A, B, C, D, K)`` up to a change of basis (Ljung
+1999, §16.4); prediction errors below ``1e-8`` of a signal's standard deviation count as zero, so
+noise-free data give the minimal order.  ``criterion="gap"`` takes the largest singular-value gap
+``s_k / s_{k+1}``: right when the noise floor of the singular values lies clearly below the smallest
+system singular value, wrong on realistic data where they decay smoothly.  Example: the tutorial
+car logs (``docs/tutorial/car_train.csv.gz``, steering multisine 0.1–2 Hz at 100 Hz, sensor noise
+and an unmeasured road): the singular values fall as 1, 0.14, 3e-3, 2.7e-4, 8e-5, … and the gap rule
+picks 2 (fits 79 % / 54 % on ``car_healthy``); the BIC picks 10 (fits 89 % / 85 %, the reference
+linearisation 88 % / 85 %).
 
 Why not a packaged implementation: ``benchmarks/bench_identify.py`` compares ``nfoursid`` 1.0.2
 (PyPI), SIPPY (``sippy_unipi`` 1.0.1, its ``N4SID``) and this module on a known 4-state,
-1-input, 2-output system (docs/PERFORMANCE.md, "Subspace identification").  All are accurate:
-noise-free (4000 samples, horizon 10) each recovers the eigenvalues to 2e-15 (relative); with
-innovation noise (output SNR 11) the RMS eigenvalue error over 20 seeds is 0.008 for N4SID here,
-``nfoursid`` and SIPPY alike (0.009 for PO-MOESP here).  They differ in what they accept and in
-cost: neither peer takes several experiments or a record split by gaps (both build the Hankel
-matrices of one continuous record; here each segment gives its own columns), ``nfoursid`` gives
-``(Q, S, R)`` but no gain ``K``, needs pandas and matplotlib at import and takes 11–31x the time
-(two runs under different load: 1.76 s against 0.16 s, 0.49 s against 16 ms), SIPPY takes 4.5–27x
-(0.74 s, 0.42 s), prints to stdout and pulls in casadi and sympy.  ``harold`` 1.0.3 has no
-subspace method and python-control has none.  So the method is written here with numpy/scipy
-(one LQ factorisation, one SVD, least squares).
-
-Order selection (``order=None``): the order is the index ``k`` of the largest gap
-``s_k / s_{k+1}`` of the singular values (``k`` from 1 to ``min(max_order, p (horizon − 1))``).
-It finds the order when the noise floor of the singular values lies clearly below the smallest
-system singular value; read :attr:`IdentifiedModel.singular_values` when it does not.
+1-input, 2-output system and on the car logs (docs/PERFORMANCE.md, "Subspace identification";
+docs/methods/identification.md).  On the known system all are accurate: noise-free each recovers
+the eigenvalues to 2e-15 (relative); with innovation noise (output SNR 11) the RMS eigenvalue error
+over 20 seeds is 0.008 for N4SID here, ``nfoursid`` and SIPPY alike.  Neither peer takes several
+experiments or a record split by gaps, ``nfoursid`` gives no gain ``K`` and needs pandas and
+matplotlib at import, SIPPY prints to stdout and pulls in casadi and sympy; ``harold`` and
+python-control have no subspace method.
 """
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -50,8 +71,9 @@ import numpy as np
 import scipy.linalg
 
 from fdikit import validate
-from fdikit.errors import DataError, ParameterError
+from fdikit.errors import DataError, FdiWarning, ParameterError
 from fdikit.identify.data import segments
+from fdikit.lti import dlsim_blocked
 from fdikit.model import FaultModel
 from fdikit.operating_point import OperatingPoint
 
@@ -152,6 +174,9 @@ def subspace_id(
     max_order: int | None = None,
     feedthrough: bool = True,
     detrend: bool = True,
+    criterion: str = "bic",
+    focus: str = "simulation",
+    stable: bool = True,
 ) -> IdentifiedModel:
     """Identify ``x⁺ = A x + B u + K e``, ``y = C x + D u + e`` from one or more traces.
 
@@ -162,7 +187,7 @@ def subspace_id(
         ``valid == False``, split a trace into segments; segments shorter than
         ``2 horizon + 1`` samples are dropped with an :class:`~fdikit.errors.FdiWarning`.
     order : int, optional
-        Model order ``n``; None picks it at the largest singular-value gap (module docstring).
+        Model order ``n``; None picks it by ``criterion`` (module docstring).
     controls, outputs : sequence of str, optional
         The signals to use (default: all of the first trace's).
     horizon : int, optional
@@ -178,6 +203,15 @@ def subspace_id(
         noise-free data from rest the sample means are not an equilibrium pair
         (``ȳ ≠ G(1) ū`` by the transient): the difference shows as a mode at 1 of tiny
         singular value; use ``detrend=False`` for data about a known zero operating point.
+    criterion : {"bic", "aic", "gap"}, default "bic"
+        The order rule of ``order=None``: the least BIC or AIC of the one-step prediction error over
+        the orders, or the largest singular-value gap (module docstring).
+    focus : {"simulation", "prediction"}, default "simulation"
+        ``B``, ``D`` by least squares on the simulation error given ``A``, ``C``, or from the state
+        regression.
+    stable : bool, default True
+        Reflect eigenvalues of ``A`` with ``|λ| ≥ 1`` to ``1/conj(λ)`` (and refit ``B``, ``D``), with an
+        :class:`~fdikit.errors.FdiWarning`; False returns the raw estimate.
 
     Returns
     -------
@@ -187,7 +221,7 @@ def subspace_id(
     Raises
     ------
     ParameterError
-        For a bad order, horizon, method or max_order.
+        For a bad order, horizon, method, max_order, criterion or focus.
     DataError
         For unusable data: too few samples for the Hankel matrices, a constant control, a
         trace without the named signals (see :func:`fdikit.identify.data.segments`).
@@ -203,13 +237,17 @@ def subspace_id(
     >>> ident = subspace_id(tr, detrend=False)  # zero operating point (a removed mean is a constant mode)
     >>> ident.order, np.sort_complex(ident.poles).round(6).tolist()
     (2, [(0.9-0.2j), (0.9+0.2j)])
+    >>> ident.order_rule.split(" (")[0]
+    'least BIC of the one-step prediction error for k in 1..9: k = 2'
 
     References
     ----------
     Van Overschee & De Moor 1996, Ch. 4 (N4SID: oblique projection, Theorem 12, the state-sequence
-    regression); Verhaegen 1994 (PO-MOESP).
+    regression); Verhaegen 1994 (PO-MOESP); Ljung 1999, §16.4 (AIC, BIC) and §4.2 (output error).
     """
     validate.choice("method", method, ("n4sid", "moesp"))
+    validate.choice("criterion", criterion, ("bic", "aic", "gap"))
+    validate.choice("focus", focus, ("simulation", "prediction"))
     if order is not None:
         order = validate.integer("order", order, minimum=1)
     if max_order is not None:
@@ -250,39 +288,27 @@ def subspace_id(
     L22i = np.linalg.pinv(L22, rcond=1e3 * rows * np.finfo(float).eps)
     Ob = L32 @ L22i @ np.hstack([L21, L22])
     U, s, _ = np.linalg.svd(Ob if method == "n4sid" else L32)
+    est = _Estimator(method, i, p, us, ys, cols, L32 @ L22i, U, s, feedthrough, focus, stable)
     if order is None:
         top = limit if max_order is None else max_order
-        order = _gap_order(s, top)
-        rule = (f"largest singular-value gap s_k/s_(k+1) for k in 1..{top}: k = {order} "
-                f"(s_{order}/s_{order + 1} = {s[order - 1] / max(s[order], s[0] * np.finfo(float).eps):.3g})")
+        if criterion == "gap":
+            order = _gap_order(s, top)
+            rule = (f"largest singular-value gap s_k/s_(k+1) for k in 1..{top}: k = {order} "
+                    f"(s_{order}/s_{order + 1} = {s[order - 1] / max(s[order], s[0] * np.finfo(float).eps):.3g})")
+        else:
+            scores = [est.score(k, criterion) for k in range(1, top + 1)]
+            order = int(np.argmin(scores)) + 1
+            rule = (f"least {criterion.upper()} of the one-step prediction error for k in 1..{top}: k = {order} "
+                    f"({criterion.upper()}/N by order: " + ", ".join(f"{v / est.N:.3f}" for v in scores) + ")")
     else:
         rule = "given"
     n = order
-    G = U[:, :n] * np.sqrt(s[:n])
-    M = np.linalg.pinv(G) @ L32 @ L22i
-    Xn, Xc, Uc, Yc = [], [], [], []
-    for u, y, c in zip(us, ys, cols):
-        X = M @ np.vstack([_hankel(u, 0, i, c), _hankel(y, 0, i, c)])
-        Xn.append(X[:, 1:])
-        Xc.append(X[:, :-1])
-        Uc.append(u[i:i + c - 1].T)
-        Yc.append(y[i:i + c - 1].T)
-    Xn, Xc, Uc, Yc = (np.hstack(a) for a in (Xn, Xc, Uc, Yc))
-    Ur = Uc if feedthrough else np.zeros((0, Uc.shape[1]))
-    if method == "n4sid":
-        Th = np.linalg.lstsq(np.vstack([Xc, Uc]).T, Xn.T, rcond=None)[0].T
-        A, B = Th[:, :n], Th[:, n:]
-        Th = np.linalg.lstsq(np.vstack([Xc, Ur]).T, Yc.T, rcond=None)[0].T
-        C, D = Th[:, :n], Th[:, n:] if feedthrough else np.zeros((p, m))
-    else:
-        C = G[:p]
-        A = np.linalg.lstsq(G[:-p], G[p:], rcond=None)[0]
-        B = np.linalg.lstsq(Uc.T, (Xn - A @ Xc).T, rcond=None)[0].T if m else np.zeros((n, 0))
-        D = np.linalg.lstsq(Ur.T, (Yc - C @ Xc).T, rcond=None)[0].T if feedthrough and m else np.zeros((p, m))
-    W = Xn - A @ Xc - B @ Uc
-    E = Yc - C @ Xc - D @ Uc
-    N = W.shape[1]
-    Qn, S, Rn = W @ W.T / N, W @ E.T / N, E @ E.T / N
+    A, B, C, D, Qn, S, Rn, moved = est.fit(n)
+    if moved.size:
+        warnings.warn(f"the {method} estimate of order {n} has the unstable eigenvalues "
+                      f"{np.round(moved, 4).tolist()}; they were reflected into the unit circle (1/conj(λ)) and B, D "
+                      "refitted (stable=False keeps the raw estimate; a lower order or a longer horizon may avoid it)",
+                      FdiWarning, stacklevel=2)
     K, Re = _innovation_gain(A, C, (Qn + Qn.T) / 2, S, (Rn + Rn.T) / 2)
     B, C, D = B / su, sy[:, None] * C, sy[:, None] * D / su
     K, Re = K / sy, sy[:, None] * Re * sy
@@ -292,6 +318,130 @@ def subspace_id(
                        dt=ds.dt).with_operating_point(u0=ds.u_mean, y0=ds.y_mean)
     return IdentifiedModel(model, K, Re, s, n, rule, method, i, ds.u_mean, ds.y_mean, model.operating_point,
                            ds.samples, len(ds.y))
+
+
+class _Estimator:
+    """``A, B, C, D`` and the noise covariances of each order from one SVD (scaled data)."""
+
+    def __init__(self, method, i, p, us, ys, cols, P, U, s, feedthrough, focus, stable):
+        self.method, self.i, self.p, self.us, self.ys, self.cols = method, i, p, us, ys, cols
+        self.P, self.U, self.s, self.feedthrough, self.focus, self.stable = P, U, s, feedthrough, focus, stable
+        self.m = us[0].shape[1]
+        self.N = sum(len(y) for y in ys)
+        self._cache: dict = {}
+
+    def fit(self, n: int):
+        """``(A, B, C, D, Q, S, R, eigenvalues moved)`` of order ``n`` (scaled signals)."""
+        if n in self._cache:
+            return self._cache[n]
+        p, m, i = self.p, self.m, self.i
+        G = self.U[:, :n] * np.sqrt(self.s[:n])
+        M = np.linalg.pinv(G) @ self.P
+        Xn, Xc, Uc, Yc = [], [], [], []
+        for u, y, c in zip(self.us, self.ys, self.cols):
+            X = M @ np.vstack([_hankel(u, 0, i, c), _hankel(y, 0, i, c)])
+            Xn.append(X[:, 1:])
+            Xc.append(X[:, :-1])
+            Uc.append(u[i:i + c - 1].T)
+            Yc.append(y[i:i + c - 1].T)
+        Xn, Xc, Uc, Yc = (np.hstack(a) for a in (Xn, Xc, Uc, Yc))
+        Ur = Uc if self.feedthrough else np.zeros((0, Uc.shape[1]))
+        if self.method == "n4sid":
+            A = np.linalg.lstsq(np.vstack([Xc, Uc]).T, Xn.T, rcond=None)[0].T[:, :n]
+            C = np.linalg.lstsq(np.vstack([Xc, Ur]).T, Yc.T, rcond=None)[0].T[:, :n]
+        else:
+            C = G[:p]
+            A = np.linalg.lstsq(G[:-p], G[p:], rcond=None)[0]
+        moved = np.zeros(0, complex)
+        if self.stable:
+            A, moved = _reflect_unstable(A)
+        # the state-sequence regression given A and C: B, D (focus="prediction") and the noise covariances
+        B = np.linalg.lstsq(Uc.T, (Xn - A @ Xc).T, rcond=None)[0].T if m else np.zeros((n, 0))
+        D = (np.linalg.lstsq(Ur.T, (Yc - C @ Xc).T, rcond=None)[0].T if self.feedthrough and m
+             else np.zeros((p, m)))
+        W, E = Xn - A @ Xc - B @ Uc, Yc - C @ Xc - D @ Uc
+        N = W.shape[1]
+        noise = (W @ W.T / N, W @ E.T / N, E @ E.T / N)
+        if self.focus == "simulation" and m and np.all(np.abs(np.linalg.eigvals(A)) < 1):
+            B, D = _output_error_fit(A, C, self.us, self.ys, self.feedthrough)
+        self._cache[n] = (A, B, C, D, *noise, moved)
+        return self._cache[n]
+
+    def score(self, n: int, criterion: str) -> float:
+        """AIC or BIC of the one-step prediction error of order ``n`` (innovation form, Gaussian)."""
+        A, B, C, D, Q, S, R, _ = self.fit(n)
+        if np.any(np.abs(np.linalg.eigvals(A)) >= 1):  # unstable (stable=False): refused
+            return np.inf
+        K, _ = _innovation_gain(A, C, (Q + Q.T) / 2, S, (R + R.T) / 2)
+        if not np.all(np.isfinite(K)) or np.any(np.abs(np.linalg.eigvals(A - K @ C)) >= 1):
+            K = np.zeros_like(K)  # no usable Kalman gain (noise-free data): the simulation error
+        F = A - K @ C
+        m, p = self.m, self.p
+        E = []
+        for u, y in zip(self.us, self.ys):
+            e = dlsim_blocked(F, np.hstack([B - K @ D, K]), -C, np.hstack([-D, np.eye(p)]), np.hstack([u, y]))[0]
+            Qx = np.linalg.qr(_free_response(F, C, len(y)).reshape(-1, n))[0]  # the initial state fitted
+            ev = e.reshape(-1)
+            E.append((ev - Qx @ (Qx.T @ ev)).reshape(-1, p))
+        E = np.concatenate(E)
+        d = n * (m + 2 * p) + p * m * self.feedthrough
+        # errors below 1e-8 of a signal's standard deviation count as zero (noise-free data: rounding only)
+        logdet = np.linalg.slogdet(E.T @ E / len(E) + 1e-16 * np.eye(p))[1]
+        return float(self.N * logdet + (2.0 if criterion == "aic" else np.log(self.N)) * d)
+
+
+def _reflect_unstable(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``A`` with every eigenvalue ``|λ| ≥ 1`` replaced by ``1/conj(λ)`` (eigenvectors kept), and those moved."""
+    lam, V = np.linalg.eig(A)
+    bad = np.abs(lam) >= 1
+    if not bad.any():
+        return A, np.zeros(0, complex)
+    if np.linalg.cond(V) < 1e8:
+        new = np.where(bad, lam / np.abs(lam) ** 2 * (1 - 1e-9), lam)
+        A2 = ((V * new) @ np.linalg.inv(V)).real
+    else:  # defective: scale A so that its spectral radius becomes 1/ρ
+        rho = float(np.max(np.abs(lam)))
+        A2 = A / rho ** 2 * (1 - 1e-9)
+    return A2, lam[bad]
+
+
+def _free_response(A: np.ndarray, C: np.ndarray, N: int) -> np.ndarray:
+    """``[C; C A; …; C A^{N−1}]`` as an (N, p, n) array, by doubling."""
+    O = C[None]
+    Ak = A
+    while len(O) < N:
+        O = np.concatenate([O, O @ Ak])
+        Ak = Ak @ Ak
+    return O[:N]
+
+
+def _output_error_fit(A, C, us, ys, feedthrough):
+    """``B``, ``D`` and one initial state per segment minimising the simulation error given ``A``, ``C``.
+
+    The simulated output is linear in ``(B, D, x0)``: one least-squares problem.  The regressor of
+    ``B[i, j]`` in output ``k`` is ``Σ_l (C A^(t−1−l))[k, i] u_j(l)``, the state ``z_i(t)`` of
+    ``z⁺ = Aᵀ z + C[k]ᵀ u_j`` (``p m`` simulations); that of ``x0`` of a segment is ``C A^t``, projected
+    out segment by segment (a QR factorisation of its ``N p × n`` block) before the solve for ``B, D``.
+    """
+    n, p, m = A.shape[0], C.shape[0], us[0].shape[1]
+    nb = n * m + (p * m if feedthrough else 0)
+    rows, rhs = [], []
+    for u, y in zip(us, ys):
+        N = len(y)
+        Phi = np.zeros((N, p, nb))
+        for k in range(p):
+            for j in range(m):
+                z = dlsim_blocked(A.T, C[k][:, None], np.zeros((1, n)), np.zeros((1, 1)), u[:, [j]])[1]
+                Phi[:, k, j:n * m:m] = z
+                if feedthrough:
+                    Phi[:, k, n * m + k * m + j] = u[:, j]
+        Phi, yv = Phi.reshape(N * p, nb), y.reshape(-1)
+        Q = np.linalg.qr(_free_response(A, C, N).reshape(N * p, n))[0]
+        rows.append(Phi - Q @ (Q.T @ Phi))
+        rhs.append(yv - Q @ (Q.T @ yv))
+    Phi, Y = np.vstack(rows), np.concatenate(rhs)
+    th = np.linalg.lstsq(Phi, Y, rcond=None)[0]
+    return th[:n * m].reshape(n, m), th[n * m:nb].reshape(p, m) if feedthrough else np.zeros((p, m))
 
 
 def _innovation_gain(A, C, Q, S, R) -> tuple[np.ndarray, np.ndarray]:

@@ -13,12 +13,13 @@ first.  Gaps (NaN, ``valid == False``) split the data into segments, each simula
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
 from fdikit import validate
-from fdikit.errors import DataError, ParameterError
+from fdikit.errors import DataError, FdiWarning, ParameterError
 from fdikit.identify.correlation import CorrelationTest, cross_correlation_test, whiteness_test
 from fdikit.identify.data import segments
 from fdikit.identify.subspace import IdentifiedModel
@@ -37,7 +38,8 @@ class ValidationReport:
     outputs, controls : tuple of str
         The signals compared and the inputs used.
     fit : (p,) array
-        Simulation fit per output in percent (100 is a perfect fit; it can be negative).
+        Simulation fit per output in percent (100 is a perfect fit; it can be negative; ``-inf`` for an
+        unstable model, whose simulation diverges: a :class:`~fdikit.errors.FdiWarning` says so).
     whiteness : CorrelationTest
         Ljung–Box test of each output's prediction error.
     cross : CorrelationTest or None
@@ -224,15 +226,21 @@ def validate_model(model, data, *, lags: int = 20, level: float = 0.01, gain=Non
     if np.any(np.abs(np.linalg.eigvals(F)) >= 1):
         raise ParameterError("the predictor A − K C is not stable; the prediction error would diverge (check the "
                              "gain, or pass gain= a stabilising Kalman gain)")
+    diverges = bool(np.any(np.abs(np.linalg.eigvals(A)) >= 1))
+    if diverges:
+        warnings.warn(f"the model has the unstable eigenvalues {np.round(_unstable(A), 4).tolist()}: its simulation "
+                      "diverges, so the fit is -inf (the prediction-error tests still run); identify a stable model "
+                      "(subspace_id(..., stable=True))", FdiWarning, stacklevel=2)
     sims, errs, us = [], [], []
     num = np.zeros(p)
     den_parts = []
     for u, y in zip(ds.u, ds.y):
         u, y = u - u0, y - y0
-        ys, _, _ = dlsim_blocked(A, B, C, D, u)
+        ys = np.full_like(y, np.nan) if diverges else dlsim_blocked(A, B, C, D, u)[0]
         eps, _, _ = dlsim_blocked(F, np.hstack([B - K @ D, K]), -C, np.hstack([-D, np.eye(p)]), np.hstack([u, y]))
         if initial_state == "estimate":
-            ys = ys + _response(A, C, _fit_x0(A, C, y - ys), len(y))
+            if not diverges:
+                ys = ys + _response(A, C, _fit_x0(A, C, y - ys), len(y))
             eps = eps - _response(F, C, _fit_x0(F, C, eps), len(y))
         sims.append(ys + y0)
         errs.append(eps)
@@ -242,10 +250,17 @@ def validate_model(model, data, *, lags: int = 20, level: float = 0.01, gain=Non
     yall = np.concatenate(den_parts)
     den = np.sum((yall - yall.mean(axis=0)) ** 2, axis=0)
     fit = 100.0 * (1.0 - np.sqrt(num) / np.sqrt(np.where(den > 0, den, np.nan)))
+    if diverges:
+        fit = np.full(p, -np.inf)
     white = whiteness_test(errs, lags, level)
     cross = cross_correlation_test(errs, us, lags, level) if model.controls else None
     return ValidationReport(model.outputs, model.controls, fit, white, cross, sims, errs, white.level, white.lags,
                             ds.samples)
+
+
+def _unstable(A: np.ndarray) -> np.ndarray:
+    lam = np.linalg.eigvals(A)
+    return lam[np.abs(lam) >= 1]
 
 
 def _response(F: np.ndarray, C: np.ndarray, x0: np.ndarray, N: int) -> np.ndarray:
