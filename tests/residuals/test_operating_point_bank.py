@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fdikit.errors import ModelError, ParameterError
+from fdikit.errors import DataError, ModelError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.operating_point import OperatingPoint
 from fdikit.residuals import ResidualGenerator, stack_generators
@@ -103,3 +103,13 @@ def test_stack_refuses_conflicting_operating_points():
     g2 = _observer(OperatingPoint(y0={"y": 2.0}), name="r2")
     with pytest.raises(ModelError, match="operating point"):
         stack_generators([g1, g2])
+
+
+def test_a_trace_with_a_gap_in_its_time_stamps_is_refused():
+    t = np.delete(np.arange(20.0), 7)          # a row dropped, as by DataFrame.dropna()
+    tr = Trace(t, np.ones((19, 1)), np.ones((19, 1)), ("u",), ("y",))
+    g = _observer()
+    with pytest.raises(DataError, match="not uniformly sampled.*from t=6 to 8"):
+        g.run(tr)
+    with pytest.raises(DataError, match="not uniformly sampled"):
+        g.online().run(tr)

@@ -153,6 +153,28 @@ class ResidualGenerator:
         if self.dt is not None and not np.isclose(dt, self.dt, rtol=1e-6):
             raise DataError(f"data sampled at dt={dt:g} but the generator is discrete with dt={self.dt:g}; resample")
 
+    @staticmethod
+    def check_uniform(trace: Trace) -> float:
+        """The trace's sample time, after checking that its samples are uniformly spaced (to 0.1 % of ``dt``).
+
+        A filter steps once per sample, so a gap in the time stamps (rows dropped from a log) would be stepped
+        over as if no time had passed.  Import logs with :meth:`fdikit.trace.Trace.from_csv` /
+        :meth:`~fdikit.trace.Trace.from_pandas`, which put invalid samples in the gaps.
+
+        Raises :class:`DataError` naming the first irregular step.
+        """
+        dt = trace.dt
+        steps = np.diff(trace.t)
+        bad = np.flatnonzero(np.abs(steps - dt) > 1e-3 * dt)
+        if bad.size:
+            k = int(bad[0])
+            raise DataError(
+                f"the trace is not uniformly sampled: the step from t={trace.t[k]:g} to {trace.t[k + 1]:g} s is "
+                f"{steps[k]:g} s, the sample time {dt:g} s ({bad.size} irregular steps); a filter would step over the "
+                "gap as if no time had passed. Import the log with Trace.from_csv / Trace.from_pandas, which "
+                "inserts invalid samples in the gaps")
+        return dt
+
     def _for_dt(self, dt: float) -> ResidualGenerator:
         if self.dt is None:
             return self.discretize(dt)
@@ -230,7 +252,7 @@ class ResidualGenerator:
         """
         v = self.inputs_from(trace)
         if len(trace) > 1:
-            g = self._for_dt(trace.dt)
+            g = self._for_dt(self.check_uniform(trace))
         elif self.dt is None:
             raise DataError("a continuous generator needs a trace of at least 2 samples (its sample time)")
         else:
@@ -523,7 +545,7 @@ class ResidualStepper:
         if not isinstance(trace, Trace):
             raise DataError(f"trace must be a fdikit.trace.Trace, got {type(trace).__name__}")
         if len(trace) > 1:
-            g._check_dt(trace.dt)
+            g._check_dt(g.check_uniform(trace))
         v = g.absolute_inputs(trace)
         mu = len(g.controls)
         r = np.empty((len(trace), len(g.residuals)))
