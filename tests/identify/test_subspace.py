@@ -137,3 +137,71 @@ def test_bad_arguments():
         subspace_id(const, 4)
     with pytest.raises(DataError, match="Trace"):
         subspace_id([], 4)
+
+
+def test_identification_does_not_depend_on_units():
+    # Every signal is divided by its standard deviation before the projections and the scaling is undone on the
+    # result, so an output in other units (here y0 x 1e3) gives the same poles, and the same model up to the
+    # output scaling.  Noise-free, both runs are exact up to rounding (~1e-13 for this conditioning): 1e-8.
+    tr = run(2000, 0)
+    scaled = Trace(t=tr.t, u=tr.u, y=tr.y * [1e3, 1.0], controls=tr.controls, outputs=tr.outputs)
+    a, b = subspace_id(tr, detrend=False), subspace_id(scaled, detrend=False)
+    assert a.order == b.order == 4
+    np.testing.assert_allclose(np.sort_complex(b.poles), np.sort_complex(a.poles), rtol=1e-8)
+    ma, mb = a.model, b.model
+    np.testing.assert_allclose(markov(mb.A, mb.Bu, mb.C, mb.Du) / [[1e3], [1.0]],
+                               markov(ma.A, ma.Bu, ma.C, ma.Du), atol=1e-8 * np.abs(markov(A, B, C, 0 * B[:2])).max())
+    # with noise the scaled data are the same numbers up to rounding (1e-16 relative), amplified by the condition
+    # of the LQ/SVD steps (s_1/s_4 < 1e3 here) and of the eigenvalues (< 1e2): far below 1e-8
+    tr = run(2000, 7, noise_std=0.3)
+    scaled = Trace(t=tr.t, u=tr.u * 1e-3, y=tr.y * [1e3, 1.0], controls=tr.controls, outputs=tr.outputs)
+    a, b = subspace_id(tr, 4), subspace_id(scaled, 4)
+    np.testing.assert_allclose(np.sort_complex(b.poles), np.sort_complex(a.poles), rtol=1e-8)
+    np.testing.assert_allclose(b.R, a.R * np.outer([1e3, 1.0], [1e3, 1.0]), rtol=1e-8)
+
+
+def test_order_criteria_on_innovation_data():
+    # noise-free: prediction errors at rounding level count as zero, so the BIC and the AIC take the least order
+    # that reaches it (4); with innovation noise the model is correctly specified and the BIC is consistent
+    tr = run(2000, 0)
+    for criterion in ("bic", "aic", "gap"):
+        ident = subspace_id(tr, criterion=criterion, detrend=False)
+        assert ident.order == 4, ident.order_rule
+    assert subspace_id(tr, criterion="gap", detrend=False).order_rule.startswith("largest singular-value gap")
+    with pytest.raises(ParameterError):
+        subspace_id(tr, criterion="hq")
+    with pytest.raises(ParameterError):
+        subspace_id(tr, 4, focus="output")
+
+
+def test_focus_simulation_refits_b_and_d_exactly_for_fixed_a_and_c():
+    # For fixed A, C the simulated output is linear in (B, D, x0): the refit is the least-squares minimiser of the
+    # simulation error.  Check against a brute-force linear least squares built from scipy.signal.dlsim.
+    from scipy import signal
+
+    tr = run(600, 11, noise_std=0.3)
+    sim = subspace_id(tr, 4, detrend=False)
+    Am, Cm = sim.model.A, sim.model.C
+    cols = []
+    for i in range(4):
+        e = np.zeros((4, 1))
+        e[i] = 1.0
+        cols.append(signal.dlsim((Am, e, Cm, np.zeros((2, 1)), 1.0), tr.u)[1].reshape(-1))
+    for k in range(2):
+        cols.append(np.kron(tr.u[:, 0], np.eye(2)[k]))
+    x0 = []
+    for i in range(4):
+        e = np.zeros(4)
+        e[i] = 1.0
+        x0.append(signal.dlsim((Am, np.zeros((4, 1)), Cm, np.zeros((2, 1)), 1.0), np.zeros((600, 1)), x0=e)[1]
+                  .reshape(-1))
+    # the criterion weighs each output by 1 / its standard deviation (the scaled signals)
+    w = np.tile(1.0 / tr.y.std(axis=0), 600)
+    Phi = np.column_stack(cols + x0) * w[:, None]
+    th = np.linalg.lstsq(Phi, tr.y.reshape(-1) * w, rcond=None)[0]
+    np.testing.assert_allclose(sim.model.Bu[:, 0], th[:4], rtol=1e-7, atol=1e-9)
+    np.testing.assert_allclose(sim.model.Du[:, 0], th[4:6], rtol=1e-7, atol=1e-9)
+    # the prediction focus keeps the state-regression B, D: same A, C, other B
+    pred = subspace_id(tr, 4, detrend=False, focus="prediction")
+    np.testing.assert_allclose(pred.model.A, Am)
+    assert not np.allclose(pred.model.Bu, sim.model.Bu, rtol=1e-6)

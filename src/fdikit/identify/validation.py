@@ -140,15 +140,19 @@ class ValidationReport:
         return ax
 
 
+def _observability(F: np.ndarray, C: np.ndarray, N: int) -> np.ndarray:
+    """``[C; C F; …; C F^{N−1}]`` as an (N, p, n) array, by doubling."""
+    O, Fk = C[None], F
+    while len(O) < N:
+        O = np.concatenate([O, O @ Fk])
+        Fk = Fk @ Fk
+    return O[:N]
+
+
 def _fit_x0(F: np.ndarray, C: np.ndarray, r: np.ndarray) -> np.ndarray:
     """``x0`` minimising ``Σ_k ‖r_k − C F^k x0‖²``."""
     N, p = r.shape
-    O = np.empty((N, p, F.shape[0]))
-    M = C.copy()
-    for k in range(N):
-        O[k] = M
-        M = M @ F
-    return np.linalg.lstsq(O.reshape(N * p, -1), r.reshape(-1), rcond=None)[0]
+    return np.linalg.lstsq(_observability(F, C, N).reshape(N * p, -1), r.reshape(-1), rcond=None)[0]
 
 
 def validate_model(model, data, *, lags: int = 20, level: float = 0.01, gain=None,
@@ -265,9 +269,4 @@ def _unstable(A: np.ndarray) -> np.ndarray:
 
 def _response(F: np.ndarray, C: np.ndarray, x0: np.ndarray, N: int) -> np.ndarray:
     """Free response ``C F^k x0`` for ``k = 0 … N−1``."""
-    out = np.empty((N, C.shape[0]))
-    x = x0.copy()
-    for k in range(N):
-        out[k] = C @ x
-        x = F @ x
-    return out
+    return _observability(F, C, N) @ x0
