@@ -167,7 +167,8 @@ def car(repeat: int) -> None:
         from fdikit.vehicle import Sedan
 
         car_ = Sedan()
-        return car_.linearize(car_.operating_point(speed=20.0)).submodel(outputs=["yaw_rate", "accel_y"])
+        return car_.linearize(car_.operating_point(speed=20.0)).submodel(outputs=["yaw_rate", "accel_y"],
+                                                                         inputs=["steering"])
 
     methods = {
         "fdikit n4sid (default: BIC)": fdi(),

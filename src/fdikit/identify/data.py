@@ -113,6 +113,10 @@ def segments(data, controls: Sequence[str] | None = None, outputs: Sequence[str]
     >>> d = segments(tr, min_length=3)
     >>> [len(s) for s in d.y], d.y_mean.tolist()
     ([4, 5], [4.555555555555555])
+
+    References
+    ----------
+    Van Overschee & De Moor 1996, Ch. 4 (the Hankel matrices need gap-free stretches).
     """
     min_length = validate.integer("min_length", min_length, minimum=2)
     traces = [data] if isinstance(data, Trace) else list(data) if isinstance(data, Sequence) else None
