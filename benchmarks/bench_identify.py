@@ -18,23 +18,28 @@ acceleration (horizon 10) and is scored by the simulation fit on ``car_healthy``
 record: the 5 unusable samples of ``car_train`` are interpolated linearly for them.  References: the
 linearisation of the car at the operating point and an ARX(4, 4) least-squares model.
 
-Run: ``python benchmarks/bench_identify.py [--car]``.
+Single-threaded BLAS (set before numpy is imported).  Run: ``python benchmarks/bench_identify.py [--car]``.
 """
 
 from __future__ import annotations
 
-import argparse
-import contextlib
-import io
-import warnings
-from pathlib import Path
+import os
 
-import numpy as np
+for _var in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "NUMBA_NUM_THREADS"):
+    os.environ[_var] = "1"  # single-threaded BLAS: comparable timings on a shared machine
 
-from fdikit import FaultModel
-from fdikit.identify import subspace_id
-from fdikit.simulate import simulate
-from timing import best, cpu_name
+import argparse  # noqa: E402
+import contextlib  # noqa: E402
+import io  # noqa: E402
+import warnings  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from fdikit import FaultModel  # noqa: E402
+from fdikit.identify import subspace_id  # noqa: E402
+from fdikit.simulate import simulate  # noqa: E402
+from timing import best, cpu_name  # noqa: E402
 
 A = np.array([[0.9, 0.3, 0, 0], [-0.3, 0.9, 0, 0], [0, 0, 0.7, 0], [0, 0, 0, -0.5]])
 B = np.array([[1.0], [0.5], [1.0], [1.0]])
