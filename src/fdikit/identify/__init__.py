@@ -2,7 +2,8 @@
 
 * :mod:`fdikit.identify.data` — Traces split into gap-free segments (NaN, ``valid == False``) with the means removed.
 * :mod:`fdikit.identify.subspace` — N4SID / PO-MOESP identification of ``x⁺ = A x + B u + K e``, ``y = C x + D u + e``
-  with the order from the singular-value gap (Van Overschee & De Moor 1996, Ch. 4; Verhaegen 1994).
+  with the order by BIC of the prediction error (or the singular-value gap), ``B, D`` refitted on the simulation
+  error, unstable eigenvalues reflected (Van Overschee & De Moor 1996, Ch. 4; Verhaegen 1994; Ljung 1999, §16.4).
 * :mod:`fdikit.identify.greybox` — Physical parameters of a model by output-error least squares, with their
   standard errors (Ljung 1999, Ch. 7, Ch. 9).
 * :mod:`fdikit.identify.correlation` — Residual whiteness (Ljung–Box) and input–residual independence tests
