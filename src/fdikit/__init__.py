@@ -24,7 +24,8 @@ __getattr__, __dir__, __all__ = lazy.attach(
     submodules=["analysis", "decision", "design", "estimate", "multimodel", "plants", "studies"],
     submod_attrs={
         "errors": ["DataError", "DesignError", "FdiError", "FdiWarning", "ModelError", "ParameterError"],
-        "detector": ["Detector", "DetectorStepper"],
+        "detector": ["Detector"],
+        "detector_online": ["DetectorStepper"],
         "model": ["FaultModel"],
     },
 )

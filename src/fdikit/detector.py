@@ -26,18 +26,17 @@ Examples
 
 from __future__ import annotations
 
-import copy
 import datetime
 import os
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
 from fdikit.errors import DataError, ParameterError
 
-__all__ = ["Detector", "DetectorStepper"]
+__all__ = ["Detector"]
 
 
 def _names_map(what: str, value, signals: tuple[str, ...]) -> dict[str, str]:
@@ -90,6 +89,10 @@ class Detector:
         The fdikit version that built the detector (default this one).
     residual_cov, recovery_tol
         The gap rule's options (:meth:`fdikit.residuals.ResidualGenerator.run`), used by ``run`` and ``online``.
+    warmup : float, default 0.0
+        Seconds at the start of a run (a trace, or an online stepper after :meth:`DetectorStepper.reset`) whose
+        samples are not valid for decisions: the filter starts at the operating point, so a plant that is not
+        there (a car already cornering) leaves an initial transient that decays with the filter's poles.
 
     Attributes
     ----------
@@ -127,6 +130,7 @@ class Detector:
     fdikit_version: str | None = None
     residual_cov: np.ndarray | None = None
     recovery_tol: float = 0.1
+    warmup: float = 0.0
 
     def __post_init__(self) -> None:
         from fdikit import __version__
@@ -158,6 +162,9 @@ class Detector:
             set_(self, "residual_cov", cov)
         if type(self.recovery_tol) is not float:
             set_(self, "recovery_tol", float(self.recovery_tol))
+        from fdikit import validate
+
+        set_(self, "warmup", float(validate.non_negative("warmup (seconds)", self.warmup)))
         if g.dt is not None:  # the gap options are checked now, not at the first gap of a deployment
             from fdikit.gaps import gap_options
 
@@ -226,7 +233,37 @@ class Detector:
         [0.0, 0.0, 0.0, 1.0]
         """
         res = self.generator.run(trace, residual_cov=self.residual_cov, recovery_tol=self.recovery_tol)
-        return res if self._index is None else res.select(self.residual_names)
+        res = res if self._index is None else res.select(self.residual_names)
+        n = self.warmup_samples(trace.dt if len(trace) > 1 else self.generator.dt)
+        if n:
+            valid = res.valid.copy()
+            valid[:n] = False
+            res = replace(res, valid=valid)
+        return res
+
+    def warmup_samples(self, dt: float | None) -> int:
+        """The number of samples ``warmup`` covers at sample time ``dt`` (``ceil(warmup / dt)``; 0 without one).
+
+        Parameters
+        ----------
+        dt : float or None
+            Sample time [s].
+
+        Returns
+        -------
+        int
+
+        Examples
+        --------
+        >>> from fdikit.decision import ThresholdEvaluator
+        >>> from fdikit.residuals import ResidualGenerator
+        >>> g = ResidualGenerator([[0.4]], [[1.0, 0.5]], [[-1.0]], [[0.0, 1.0]], ("u",), ("y",), ("r",), dt=0.1)
+        >>> Detector(g, ThresholdEvaluator(thresholds=[0.5]), warmup=1.0).warmup_samples(0.1)
+        10
+        """
+        if not self.warmup or dt is None:
+            return 0
+        return int(np.ceil(self.warmup / dt - 1e-9))
 
     def run(self, trace):
         """Decisions for a whole trace: the generator's residuals through the evaluator's ``run``.
@@ -261,7 +298,7 @@ class Detector:
         return self.evaluator.run(self.residuals(trace))
 
     # ------------------------------------------------------------------ online
-    def online(self, dt: float | None = None) -> DetectorStepper:
+    def online(self, dt: float | None = None):
         """A stepper for sample-by-sample deployment (its own copy of the evaluator, reset).
 
         Parameters
@@ -272,6 +309,7 @@ class Detector:
         Returns
         -------
         DetectorStepper
+            :class:`fdikit.detector_online.DetectorStepper`.
 
         Raises
         ------
@@ -290,6 +328,8 @@ class Detector:
         >>> d.alarm, d.valid, s.invalid
         (False, False, 1)
         """
+        from fdikit.detector_online import DetectorStepper
+
         return DetectorStepper(self, dt)
 
     # ------------------------------------------------------------------ logs and files
@@ -467,129 +507,3 @@ class Detector:
     def __repr__(self) -> str:
         return (f"Detector({self.name!r}: {type(self.evaluator).__name__} on {len(self.generator.residuals)} residuals "
                 f"of {list(self.controls)} + {list(self.outputs)}, fdikit {self.fdikit_version}, {self.created})")
-
-
-class DetectorStepper:
-    """Online deployment of a :class:`Detector`: ``step(u, y)`` -> the evaluator's StepDecision.
-
-    Parameters
-    ----------
-    detector : Detector
-        The detector; the stepper runs its own copy of the evaluator.
-    dt : float, optional
-        Sample time for a continuous generator.
-
-    Attributes
-    ----------
-    residuals : numpy.ndarray or None
-        The residuals of the last sample (NaN on a bad one), in the evaluator's order.
-    last_valid, last_recovering : bool
-        The generator's flags of the last sample.
-    invalid : int
-        Bad samples since creation or :meth:`reset`.
-
-    Raises
-    ------
-    ModelError
-        For a continuous generator without ``dt``.
-
-    Examples
-    --------
-    >>> from fdikit.decision import ThresholdEvaluator
-    >>> from fdikit.residuals import ResidualGenerator
-    >>> g = ResidualGenerator([[0.4]], [[1.0, 0.5]], [[-1.0]], [[0.0, 1.0]], ("u",), ("y",), ("r",), dt=1.0)
-    >>> s = Detector(g, ThresholdEvaluator(thresholds=[0.5])).online()
-    >>> s.step([1.0], [0.0], valid=False).valid, s.last_valid
-    (False, False)
-    """
-
-    def __init__(self, detector: Detector, dt: float | None = None) -> None:
-        if not isinstance(detector, Detector):
-            raise ParameterError(f"detector must be a fdikit.detector.Detector, got {type(detector).__name__}")
-        self.detector = detector
-        self._gen = detector.generator.online(dt=dt, residual_cov=detector.residual_cov,
-                                              recovery_tol=detector.recovery_tol)
-        self._ev = copy.deepcopy(detector.evaluator)
-        self.reset()
-
-    def reset(self) -> None:
-        """Start a new run: the filter at rest, the evaluator reset."""
-        self._gen.reset()
-        self._ev.reset()
-        self.residuals = None
-
-    @property
-    def last_valid(self) -> bool:
-        return self._gen.last_valid
-
-    @property
-    def last_recovering(self) -> bool:
-        return self._gen.last_recovering
-
-    @property
-    def invalid(self) -> int:
-        return self._gen.invalid
-
-    @staticmethod
-    def _bad(values):
-        """NaN in place of every value (the sample was flagged invalid), keeping the names and shape checked."""
-        if isinstance(values, Mapping):
-            return {k: float("nan") for k in values}
-        try:
-            return values if values is None or isinstance(values, (str, bytes)) else np.full(np.shape(values), np.nan)
-        except ValueError:  # ragged: the generator's step reports it
-            return values
-
-    def step(self, u, y, *, valid: bool = True):
-        """Decision for one sample.
-
-        Parameters
-        ----------
-        u, y : sequence of float or mapping of name to float
-            Absolute controls and outputs, in the detector's ``controls``/``outputs`` order or by name; NaN marks
-            a missing value.
-        valid : bool, default True
-            False for a sample the source flagged invalid (as ``trace.valid``): treated as a dropout of
-            every signal.
-
-        Returns
-        -------
-        StepDecision
-            The evaluator's decision (held, ``valid`` False, on a bad or recovering sample).
-
-        Raises
-        ------
-        DataError
-            For values that are not numbers, a mapping with other names, or the wrong number of values.
-        """
-        if not valid:
-            u, y = self._bad(u), self._bad(y)
-        r = self._gen.step(u, y)
-        idx = self.detector._index
-        r = r if idx is None else r[idx]
-        self.residuals = r
-        return self._ev.step(r, valid=self._gen.last_valid)
-
-    def run(self, trace) -> list:
-        """Step through a whole trace (its ``valid`` flags included): one StepDecision per sample.
-
-        Parameters
-        ----------
-        trace : Trace
-            Absolute signals, holding every control and output the detector reads.
-
-        Returns
-        -------
-        list of StepDecision
-
-        Raises
-        ------
-        DataError
-            On a missing signal.
-        """
-        g = self._gen.generator
-        g.check_trace(trace)
-        U, Y = trace.columns("u", g.controls), trace.columns("y", g.outputs)
-        ok = getattr(trace, "valid", None)
-        ok = np.ones(len(trace), bool) if ok is None else ok
-        return [self.step(U[k], Y[k], valid=bool(ok[k])) for k in range(len(trace))]

@@ -315,7 +315,8 @@ def _payload(detector) -> dict:
         "operating_point": None if op is None else op.as_dict(),
         "log": {"units": dict(detector.units), "columns": dict(detector.columns), "time": detector.time_column},
         "options": {"recovery_tol": _encode(detector.recovery_tol, "recovery_tol"),
-                    "residual_cov": _encode(detector.residual_cov, "residual_cov")},
+                    "residual_cov": _encode(detector.residual_cov, "residual_cov"),
+                    "warmup": _encode(detector.warmup, "warmup")},
         "generator": _encode(detector.generator, "the generator"),
         "evaluator": _encode(detector.evaluator, f"the evaluator {type(detector.evaluator).__name__}"),
     }
@@ -486,6 +487,7 @@ def _detector(payload: dict, where: str):
             fdikit_version=meta["fdikit_version"],
             residual_cov=_decode(options["residual_cov"], f"{where}: residual_cov"),
             recovery_tol=_decode(options["recovery_tol"], f"{where}: recovery_tol"),
+            warmup=_decode(options.get("warmup", 0.0), f"{where}: warmup"),   # absent in files before it existed
         )
     except (KeyError, TypeError, AttributeError, ValueError, IndexError) as exc:
         if isinstance(exc, DataError):
