@@ -26,8 +26,10 @@ returning one, e.g. after :func:`~fdikit.nonlinear.trim_and_linearize`):
     ``{time, columns: {signal: column}, units: {signal: unit}}``: how the logs are read
     (:meth:`fdikit.trace.Trace.from_csv`).
 ``calibration``
-    ``{false_alarms_per_hour, persistence: [k, n], match}``: thresholds set on the fault-free logs given to
-    :func:`build_detector` (a list of runs: :meth:`fdikit.decision.ThresholdEvaluator.fit`).
+    ``{false_alarms_per_hour, persistence: [k, n], match, warmup}``: thresholds set on the fault-free logs given
+    to :func:`build_detector` (a list of runs: :meth:`fdikit.decision.ThresholdEvaluator.fit`); ``warmup``
+    seconds at the start of every run are left out of the calibration and of the decisions
+    (:class:`~fdikit.detector.Detector`).
 
 The spec is checked by pydantic (the field names above, their types); a Python spec is user code and is
 executed when loaded — only the detector *files* (:mod:`fdikit.detector_file`) are data only.
@@ -150,6 +152,7 @@ class CalibrationSpec(BaseModel):
     false_alarms_per_hour: float = Field(default=1.0, gt=0)
     persistence: tuple[int, int] = (1, 1)
     match: str = "exact"
+    warmup: float = Field(default=0.0, ge=0)
 
 
 class DesignSpec(BaseModel):
@@ -438,8 +441,9 @@ def build_detector(spec: DesignSpec, healthy: Sequence[str | os.PathLike]):
     bank = stack_generators(gens)
     table = SignatureTable.from_generator(bank, model, match=spec.calibration.match)
     ev = ThresholdEvaluator(persistence=spec.calibration.persistence, signatures=table)
-    ev.fit([bank.run(tr) for tr in traces], false_alarms_per_hour=spec.calibration.false_alarms_per_hour)
     signals = set(bank.controls + bank.outputs)
-    return Detector(bank, ev, units={s: u for s, u in spec.log.units.items() if s in signals},
-                    columns={s: c for s, c in spec.log.columns.items() if s in signals}, time_column=spec.log.time,
-                    name=spec.name, description=spec.description)
+    det = Detector(bank, ev, units={s: u for s, u in spec.log.units.items() if s in signals},
+                   columns={s: c for s, c in spec.log.columns.items() if s in signals}, time_column=spec.log.time,
+                   name=spec.name, description=spec.description, warmup=spec.calibration.warmup)
+    ev.fit([det.residuals(tr) for tr in traces], false_alarms_per_hour=spec.calibration.false_alarms_per_hour)
+    return det
