@@ -180,7 +180,7 @@ def test_focus_simulation_refits_b_and_d_exactly_for_fixed_a_and_c():
     from scipy import signal
 
     tr = run(600, 11, noise_std=0.3)
-    sim = subspace_id(tr, 4, detrend=False)
+    sim = subspace_id(tr, 4, detrend=False, feedthrough=True)
     Am, Cm = sim.model.A, sim.model.C
     cols = []
     for i in range(4):
@@ -202,6 +202,30 @@ def test_focus_simulation_refits_b_and_d_exactly_for_fixed_a_and_c():
     np.testing.assert_allclose(sim.model.Bu[:, 0], th[:4], rtol=1e-7, atol=1e-9)
     np.testing.assert_allclose(sim.model.Du[:, 0], th[4:6], rtol=1e-7, atol=1e-9)
     # the prediction focus keeps the state-regression B, D: same A, C, other B
-    pred = subspace_id(tr, 4, detrend=False, focus="prediction")
+    pred = subspace_id(tr, 4, detrend=False, focus="prediction", feedthrough=True)
     np.testing.assert_allclose(pred.model.A, Am)
     assert not np.allclose(pred.model.Bu, sim.model.Bu, rtol=1e-6)
+
+
+def test_noise_model_is_that_of_the_returned_model():
+    # Innovation-form data (R_true = 0.3² I).  Whatever B, D the focus step returns, K and R are re-estimated for the
+    # returned (A, B, C, D), and R is the covariance of that predictor's error on the data: the Kalman residual of
+    # kalman(model, Q=R, R=0) run on the training trace (zero initial state instead of a fitted one) must have
+    # sample covariance ≈ R.  Tolerance: after the start-up transient (|λ(A − K C)| ≤ 0.95 here, so 300 samples
+    # take it below 0.95^300 ≈ 2e-7) the two error sequences coincide, and the sample variance over the full
+    # record differs from that over the last N − 300 by at most the 300 first samples' share: with N = 3000,
+    # |Δ var| / var ≲ 300/3000 · (1 + transient) — we compare the steady part, where both agree to rounding up to
+    # the initial-state fit, i.e. within the sampling error 3·√(2/N) ≈ 0.08 of a variance estimate (relative).
+    # Close to the true R: each variance estimate has relative standard error √(2/N) = 0.026, plus the model's
+    # estimation error O(d/N) with d = 4(1 + 4) + 2 parameters: 0.1 relative.
+    tr = run(3000, 21, noise_std=0.3)
+    R_true = 0.09 * np.eye(2)
+    for kw in ({}, {"feedthrough": True}, {"feedthrough": True, "focus": "prediction"}, {"method": "moesp"}):
+        ident = subspace_id(tr, 4, detrend=False, **kw)
+        res = kalman(ident.model, Q=ident.R, R=0.0).generator.run(tr)
+        r = res.r[300:][np.asarray(res.valid, bool)[300:]]
+        S = np.cov(r.T)
+        np.testing.assert_allclose(np.diag(S), np.diag(ident.R), rtol=3 * np.sqrt(2 / len(r)), err_msg=str(kw))
+        assert abs(S[0, 1]) < 3 * np.sqrt(S[0, 0] * S[1, 1] / len(r)) + abs(ident.R[0, 1])
+        np.testing.assert_allclose(np.diag(ident.R), np.diag(R_true), rtol=0.1, err_msg=str(kw))
+        assert abs(ident.R[0, 1]) < 0.1 * 0.09

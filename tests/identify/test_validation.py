@@ -48,7 +48,12 @@ def test_true_and_identified_models_pass_a_wrong_one_fails():
     # asserted for the plant itself on held-out data.
     val = run(3000, 2)
     assert validate_model(PLANT, val, level=1e-3).passed
-    ident = subspace_id(run(3000, 3), 4)
+    # An identified model's residual carries its estimation error (G − Ĝ) u, correlated with u: the cross test's
+    # χ² level holds for the true G only, and that error inflates the statistic by a term of order
+    # (parameters) · N_val / N_id.  Identified from twice the validation length, it stays well inside the level
+    # (from 3000 samples the u–residual p-value of y1 sat at the 1e-3 edge: 1.1e-3 with the state-regression K,
+    # 4e-4 with the re-estimated one).
+    ident = subspace_id(run(6000, 3), 4)
     rep = validate_model(ident, val, level=1e-3)  # the operating point (means) is subtracted from val
     assert rep.passed, rep.to_pandas()
     # A first-order model misses three modes: its prediction errors are strongly coloured (ρ_1 of order 0.5,

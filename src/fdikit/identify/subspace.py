@@ -17,8 +17,8 @@ factorisation of ``[U_f; U_p; Y_p; Y_f]`` gives
   invariance of ``Γ``, then ``B`` and ``D`` by least squares on the same state sequence.
 
 The residuals of the state regression estimate the noise covariances ``Q, S, R``; the steady
-Kalman gain of those (discrete Riccati equation) is ``K`` and ``C P Cᵀ + R`` the innovation
-covariance (Van Overschee & De Moor 1996, Ch. 4).  The data are scaled to unit
+Kalman gain of those (discrete Riccati equation) is the first estimate of ``K`` (Van Overschee &
+De Moor 1996, Ch. 4), re-estimated for the final model as below.  The data are scaled to unit
 standard deviation per signal before the projections and the scaling is undone on the result
 (so the singular values and the poles do not depend on units).
 
@@ -26,7 +26,13 @@ standard deviation per signal before the projections and the scaling is undone o
 linear in ``B``, ``D`` and the initial state of each segment, so these are refitted by one linear
 least-squares problem on the simulation error (the output-error criterion, Ljung 1999, §4.2 and
 Ch. 7, solved exactly for a fixed ``A, C``); ``focus="prediction"`` keeps ``B, D`` of the state
-regression.  The noise model ``K, R`` is the state regression's in both cases.
+regression.  The noise model is then re-estimated for the final ``(A, B, C, D)`` (whatever the focus
+and stability steps chose): a long autoregression of the output error estimates the innovation, ``K``
+follows by linear least squares, and ``R`` is the sample covariance of that predictor's one-step error
+on the data (two-stage least squares, Ljung 1999, §10.4), so that the residual of
+``kalman(ident.model, Q=ident.R, R=0)`` on the identification data has covariance ``R``.  (It used
+to be the state regression's ``K, R``: with refitted ``B, D`` the predictor's error on the car logs
+had 2.5 times the claimed standard deviation.)
 
 Stability (``stable=True``, default): an estimated ``A`` with eigenvalues ``|λ| ≥ 1`` has each such
 eigenvalue replaced by its reflection ``1/conj(λ)`` (eigenvectors kept; a defective ``A`` is divided
@@ -172,7 +178,7 @@ def subspace_id(
     horizon: int | None = None,
     method: str = "n4sid",
     max_order: int | None = None,
-    feedthrough: bool = True,
+    feedthrough: bool = False,
     detrend: bool = True,
     criterion: str = "bic",
     focus: str = "simulation",
@@ -196,8 +202,15 @@ def subspace_id(
     method : {"n4sid", "moesp"}, default "n4sid"
     max_order : int, optional
         Largest order ``order=None`` considers (default ``p (horizon − 1)``).
-    feedthrough : bool, default True
-        Estimate ``D``; False fixes ``D = 0``.
+    feedthrough : bool, default False
+        Estimate ``D``; False (default, as MATLAB's ``n4sid``) fixes ``D = 0``.  With a smooth,
+        band-limited input ``u[k]`` is nearly a linear function of the state, so ``D`` is nearly
+        collinear with ``C x``: the estimate can be huge and cancelled by ``B`` (the tutorial car:
+        ``D`` = −3355 m/s² per rad for the lateral acceleration, physically about 40), with a model
+        whose internal states and start-up transients are huge.  An :class:`~fdikit.errors.FdiWarning`
+        flags an estimated ``D`` for which ``D u`` alone would have more than 10 times the output's
+        standard deviation.  Pass True for a plant with a direct feedthrough and an input that
+        excites it (a white or wide-band input).
     detrend : bool, default True
         Remove the mean of every signal first (kept as the model's operating point).  On
         noise-free data from rest the sample means are not an equilibrium pair
@@ -309,7 +322,16 @@ def subspace_id(
                       f"{np.round(moved, 4).tolist()}; they were reflected into the unit circle (1/conj(λ)) and B, D "
                       "refitted (stable=False keeps the raw estimate; a lower order or a longer horizon may avoid it)",
                       FdiWarning, stacklevel=2)
+    big = np.abs(D) > 10.0  # scaled signals: D u alone would have 10x the standard deviation of the output
+    if big.any():
+        pairs = [f"{ds.controls[j]} -> {ds.outputs[k]}" for k, j in zip(*np.nonzero(big))]
+        warnings.warn(f"the estimated feedthrough D is implausibly large for {pairs} (D u alone would have "
+                      f"{np.abs(D).max():.3g} times the standard deviation of the output, cancelled by the dynamics): "
+                      "D is nearly collinear with C x for a smooth input; use feedthrough=False unless the plant "
+                      "has a direct feedthrough and the input excites high frequencies", FdiWarning, stacklevel=2)
     K, Re = _innovation_gain(A, C, (Qn + Qn.T) / 2, S, (Rn + Rn.T) / 2)
+    if np.all(np.abs(np.linalg.eigvals(A)) < 1):  # (stable=False may return an unstable A: its output error diverges)
+        K, Re = _noise_refit(A, B, C, D, est.us, est.ys, K, lags=3 * i)
     B, C, D = B / su, sy[:, None] * C, sy[:, None] * D / su
     K, Re = K / sy, sy[:, None] * Re * sy
     Re = (Re + Re.T) / 2
@@ -375,15 +397,8 @@ class _Estimator:
         K, _ = _innovation_gain(A, C, (Q + Q.T) / 2, S, (R + R.T) / 2)
         if not np.all(np.isfinite(K)) or np.any(np.abs(np.linalg.eigvals(A - K @ C)) >= 1):
             K = np.zeros_like(K)  # no usable Kalman gain (noise-free data): the simulation error
-        F = A - K @ C
+        E = _predictor_errors(A, B, C, D, K, self.us, self.ys)
         m, p = self.m, self.p
-        E = []
-        for u, y in zip(self.us, self.ys):
-            e = dlsim_blocked(F, np.hstack([B - K @ D, K]), -C, np.hstack([-D, np.eye(p)]), np.hstack([u, y]))[0]
-            O = _free_response(F, C, len(y)).reshape(-1, n)  # the initial state fitted
-            ev = e.reshape(-1)
-            E.append((ev - O @ _ls(O, ev)).reshape(-1, p))
-        E = np.concatenate(E)
         d = n * (m + 2 * p) + p * m * self.feedthrough
         # errors below 1e-8 of a signal's standard deviation count as zero (noise-free data: rounding only)
         logdet = np.linalg.slogdet(E.T @ E / len(E) + 1e-16 * np.eye(p))[1]
@@ -456,6 +471,65 @@ def _output_error_fit(A, C, us, ys, feedthrough):
     Phi, Y = np.vstack(rows), np.concatenate(rhs)
     th = _ls(Phi, Y)
     return th[:n * m].reshape(n, m), th[n * m:nb].reshape(p, m) if feedthrough else np.zeros((p, m))
+
+
+def _predictor_errors(A, B, C, D, K, us, ys) -> np.ndarray:
+    """One-step prediction errors of the predictor ``(A, B, C, D, K)``, the initial state fitted per segment."""
+    n, p = A.shape[0], C.shape[0]
+    F, E = A - K @ C, []
+    for u, y in zip(us, ys):
+        e = dlsim_blocked(F, np.hstack([B - K @ D, K]), -C, np.hstack([-D, np.eye(p)]), np.hstack([u, y]))[0]
+        O = _free_response(F, C, len(y)).reshape(-1, n)
+        ev = e.reshape(-1)
+        E.append((ev - O @ _ls(O, ev)).reshape(-1, p))
+    return np.concatenate(E)
+
+
+def _noise_refit(A, B, C, D, us, ys, K0, lags):
+    """``K`` and ``R = Cov e`` consistent with the final ``(A, B, C, D)`` (two-stage least squares).
+
+    The output error ``v = y − G(q) u`` (initial state fitted per segment) of the final model is
+    ``v = (I + C (qI − A)⁻¹ K) e``.  Stage 1: a long autoregression of ``v`` (``lags`` past values,
+    pre-windowed) estimates the innovation ``ê``; stage 2: ``v − ê = C x``, ``x⁺ = A x + K ê`` is
+    linear in ``K`` and the initial states, solved by least squares (the two-stage method of Hannan
+    and Rissanen, a pseudo-linear regression; Ljung 1999, §10.4); a second pass repeats stage 2 with
+    the prediction errors of the first.  Of these ``K`` and the state-regression ``K0``, the one whose
+    (stable) predictor has the least ``det`` of the error covariance on the data is taken (``0``,
+    the output error, when none is stable; ``A`` is stable), and ``R`` is the sample covariance of
+    that predictor's one-step error on the data: the Kalman residual of the returned
+    model has covariance ``R`` on the identification data, whatever ``B, D`` the focus step chose.
+    """
+    n, p = A.shape[0], C.shape[0]
+    vs = []
+    for u, y in zip(us, ys):
+        v = (y - dlsim_blocked(A, B, C, D, u)[0]).reshape(-1)
+        O = _free_response(A, C, len(y)).reshape(-1, n)
+        vs.append((v - O @ _ls(O, v)).reshape(-1, p))
+    L = max(1, min(lags, sum(len(v) for v in vs) // (4 * p)))
+    regs = []
+    for v in vs:
+        vp = np.vstack([np.zeros((L, p)), v])
+        regs.append(np.hstack([vp[L - j:L - j + len(v)] for j in range(1, L + 1)]))
+    th = _ls(np.vstack(regs), np.vstack(vs))
+    es = [v - P @ th for v, P in zip(vs, regs)]
+    best = None
+    for _ in range(2):  # the second pass takes the first pass's prediction errors as the innovation
+        K = _output_error_fit(A, C, es, [v - e for v, e in zip(vs, es)], False)[0]
+        for Kc in (K, K0):
+            if np.all(np.isfinite(Kc)) and np.all(np.abs(np.linalg.eigvals(A - Kc @ C)) < 1):
+                E = _predictor_errors(A, B, C, D, Kc, us, ys)
+                ld = np.linalg.slogdet(E.T @ E / len(E))[1]
+                if best is None or ld < best[0]:
+                    best = (ld, Kc, E)
+        if best is None:
+            break
+        cut = np.cumsum([len(y) for y in ys])[:-1]
+        es = np.split(best[2], cut)
+    if best is None:  # no stable predictor: the output error (A is stable)
+        K, E = np.zeros_like(K0), np.concatenate(vs)
+    else:
+        K, E = best[1], best[2]
+    return K, E.T @ E / len(E)
 
 
 def _innovation_gain(A, C, Q, S, R) -> tuple[np.ndarray, np.ndarray]:
