@@ -41,6 +41,36 @@ def _run(code: str) -> dict:
     return ns
 
 
+def test_the_car_part_runs_in_under_30_lines_and_gives_the_quoted_numbers(workdir):
+    from fdikit.analysis import fault_to_residual_gain
+
+    (code,) = _python(_section("## 1. A car, its model identified from a log"))
+    assert _user_lines(code) <= 30
+    ns = _run(code)
+    assert len(ns["train"].gaps) == 5 and (~ns["train"].valid).sum() == 5
+    ident, report = ns["ident"], ns["report"]
+    assert ident.order == 6
+    np.testing.assert_allclose(report.fit, [88.7, 84.8], atol=0.05)
+    assert not report.whiteness.passed.any()
+    table = ns["detector"].evaluator.signatures
+    assert table.signature("yaw_rate_sensor") == ("yaw_rate_filter",)
+    assert table.signature("accel_y_sensor") == ("accel_y_filter",)
+    assert table.signature("steering_actuator") == ("yaw_rate_filter", "accel_y_filter")
+    # detection limits: threshold / steady fault gain into each residual
+    ev, bank, model = ns["evaluator"], ns["bank"], ns["model"]
+    G = fault_to_residual_gain(bank, model, [1e-4]).peak()
+    limits = ev.thresholds / np.where(G > 1e-9, G, np.nan)
+    assert np.rad2deg(limits[0, 0]) == pytest.approx(0.6, abs=0.05)                  # yaw-rate bias [deg/s]
+    assert np.rad2deg(np.nanmax(limits[2])) == pytest.approx(0.13, abs=0.01)         # steering offset [deg]
+    yaw, steer = ns["car_scores"]
+    assert yaw.detected and yaw.detection_delay == pytest.approx(0.04) and yaw.isolated == "yaw_rate_sensor"
+    assert yaw.isolation_delay == pytest.approx(0.04) and yaw.correct_fraction == 1.0 and yaw.false_alarms == 0
+    assert steer.detected and steer.detection_delay == pytest.approx(0.05) and steer.isolated == "steering_actuator"
+    assert steer.isolation_delay == pytest.approx(0.09) and steer.correct_fraction > 0.995 and steer.false_alarms == 0
+    cal = ev.calibration
+    assert cal.alarms == 0 and cal.min_resolvable_rate == pytest.approx(22.1, abs=0.1)
+
+
 def test_the_tank_part_runs_in_under_30_lines_and_gives_the_quoted_numbers(workdir):
     (code,) = _python(_section("## 2. A plant written as a Python function"))
     assert _user_lines(code) <= 30
