@@ -53,8 +53,8 @@ noise-free data give the minimal order.  ``criterion="gap"`` takes the largest s
 system singular value, wrong on realistic data where they decay smoothly.  Example: the tutorial
 car logs (``docs/tutorial/car_train.csv.gz``, steering multisine 0.1–2 Hz at 100 Hz, sensor noise
 and an unmeasured road): the singular values fall as 1, 0.14, 3e-3, 2.7e-4, 8e-5, … and the gap rule
-picks 2 (fits 79 % / 54 % on ``car_healthy``); the BIC picks 10 (fits 89 % / 85 %, the reference
-linearisation 88 % / 85 %).
+picks 2 (fits 62 % / 41 % on ``car_healthy``); the BIC picks 6 (fits 89 % / 85 %, the reference
+linearisation 88 % / 85 %; with ``feedthrough=True`` 2 and 10).
 
 Why not a packaged implementation: ``benchmarks/bench_identify.py`` compares ``nfoursid`` 1.0.2
 (PyPI), SIPPY (``sippy_unipi`` 1.0.1, its ``N4SID``) and this module on a known 4-state,
