@@ -177,8 +177,10 @@ def car(repeat: int) -> None:
 
     methods = {
         "fdikit n4sid (default: BIC)": fdi(),
+        "fdikit n4sid feedthrough=True (the former default)": fdi(feedthrough=True),
         "fdikit n4sid criterion='gap'": fdi(criterion="gap"),
-        "fdikit n4sid gap, focus='prediction' (the former default)": fdi(criterion="gap", focus="prediction"),
+        "fdikit n4sid gap, focus='prediction', feedthrough=True (an older default)":
+            fdi(criterion="gap", focus="prediction", feedthrough=True),
         "fdikit n4sid order 4": fdi(order=4),
         "fdikit n4sid order 5": fdi(order=5),
         "fdikit n4sid order 6": fdi(order=6),
