@@ -29,7 +29,7 @@ Ch. 7, solved exactly for a fixed ``A, C``); ``focus="prediction"`` keeps ``B, D
 regression.  The noise model is then re-estimated for the final ``(A, B, C, D)`` (whatever the focus
 and stability steps chose): a long autoregression of the output error estimates the innovation, ``K``
 follows by linear least squares, and ``R`` is the sample covariance of that predictor's one-step error
-on the data (two-stage least squares, Ljung 1999, §10.4), so that the residual of
+on the data (two-stage least squares, Hannan & Rissanen 1982), so that the residual of
 ``kalman(ident.model, Q=ident.R, R=0)`` on the identification data has covariance ``R``.  (It used
 to be the state regression's ``K, R``: with refitted ``B, D`` the predictor's error on the car logs
 had 2.5 times the claimed standard deviation.)
@@ -492,7 +492,7 @@ def _noise_refit(A, B, C, D, us, ys, K0, lags):
     ``v = (I + C (qI − A)⁻¹ K) e``.  Stage 1: a long autoregression of ``v`` (``lags`` past values,
     pre-windowed) estimates the innovation ``ê``; stage 2: ``v − ê = C x``, ``x⁺ = A x + K ê`` is
     linear in ``K`` and the initial states, solved by least squares (the two-stage method of Hannan
-    and Rissanen, a pseudo-linear regression; Ljung 1999, §10.4); a second pass repeats stage 2 with
+    & Rissanen 1982, a pseudo-linear regression); a second pass repeats stage 2 with
     the prediction errors of the first.  Of these ``K`` and the state-regression ``K0``, the one whose
     (stable) predictor has the least ``det`` of the error covariance on the data is taken (``0``,
     the output error, when none is stable; ``A`` is stable), and ``R`` is the sample covariance of
