@@ -10,6 +10,8 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
+from fdikit.errors import FdiWarning
+
 ROOT = Path(__file__).resolve().parents[1]
 TEXT = (ROOT / "docs" / "tutorial.md").read_text()
 
@@ -52,6 +54,9 @@ def test_the_car_part_runs_in_under_30_lines_and_gives_the_quoted_numbers(workdi
     assert ident.order == 6
     np.testing.assert_allclose(report.fit, [88.7, 84.8], atol=0.05)
     assert not report.whiteness.passed.any()
+    with pytest.warns(FdiWarning, match="feedthrough|D "):       # the quoted ill-conditioned feedthrough
+        with_d = ns["subspace_id"](ns["train"], feedthrough=True)
+    assert with_d.model.Du[1, 0] == pytest.approx(-3355, rel=0.05)
     table = ns["detector"].evaluator.signatures
     assert table.signature("yaw_rate_sensor") == ("yaw_rate_filter",)
     assert table.signature("accel_y_sensor") == ("accel_y_filter",)
