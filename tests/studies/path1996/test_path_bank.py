@@ -99,7 +99,7 @@ def test_nominal_fault_gives_scaled_residual_one(bank, fault):
         assert np.linalg.norm(r.r[-1, cols]) == pytest.approx(1.0, rel=2e-3)
 
 
-def test_all_fifteen_faults_detected_fourteen_isolated(bank):
+def test_all_fifteen_faults_detected_and_isolated_but_roll_rate_on_the_boundary(bank):
     """All 12 sensor and 3 actuator faults of the report, nominal size, onset 5 s, on the 14-state linear plant
     with sensor noise at 1e-4 of each sensor's nominal fault; thresholds for 1 false alarm/h, persistence 5 of 10,
     bank logic (filters pointing to two or more faults are discarded)."""
@@ -117,10 +117,11 @@ def test_all_fifteen_faults_detected_fourteen_isolated(bank):
         assert s.detected and s.detection_delay < 0.5, fault
         assert s.false_alarms == 0, fault
         if fault == "roll_rate_sensor":
-            # the roll-rate filter's residuals also point elsewhere on most alarmed samples: the bank logic names
-            # the fault on 17 % of them and says 'unknown' on the rest, so the fault counts as not isolated
-            # ('unknown' is never a correct isolation, fdikit.metrics.score)
-            assert s.isolated == "unknown" and 0.05 < s.correct_fraction < 0.5, (fault, s.correct_fraction)
+            # on the decision boundary: on each alarmed sample the roll-rate pattern is either named or 'unknown'
+            # (another filter's residual fires too), and the share moves with the design's rounding — 17 % named
+            # under OpenBLAS's default kernels here, 79 % under Prescott (the left-eigenvector design has
+            # σ_min(V) ≈ 1e-3).  So the test asks only that it is named on some samples and never misnamed.
+            assert s.isolated in ("roll_rate_sensor", "unknown") and s.correct_fraction > 0.05, (fault, s.isolated)
         else:
             assert s.isolated == fault, (fault, s.isolated)
 
