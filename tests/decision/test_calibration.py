@@ -57,6 +57,10 @@ def test_no_persistence_window_crosses_a_run_boundary():
     r1[-1], r2[0] = 100.0, 100.0
     a, b = _run(r1, names=("r",), isolates=("f",)), _run(r2, names=("r",), isolates=("f",))
     ev = ThresholdEvaluator(persistence=(2, 2)).fit([a, b], false_alarm_prob=1e-3)
+    pooled = np.vstack([r1, r2])[:, 0]
+    from scipy.stats import norm
+
+    assert ev.thresholds[0] == pytest.approx(np.std(pooled, ddof=1) * norm.isf(1e-3 / 2), rel=1e-12)   # the pooled σ
     assert 1.0 < ev.thresholds[0] < 100.0
     assert ev.calibration.alarms == 0
     glued = _run(np.vstack([r1, r2]), names=("r",), isolates=("f",))
