@@ -35,6 +35,8 @@ PAGES = [
     ("identify", "fdikit.identify", "Identification: models from data"),
     ("vehicle", "fdikit.vehicle", "The nonlinear PATH vehicle"),
     ("aircraft", "fdikit.aircraft", "Nonlinear aircraft through JSBSim"),
+    ("spc", "fdikit.spc", "Subspace predictive control"),
+    ("ftc", "fdikit.ftc", "Fault-tolerant control"),
     ("studies-path1996", "fdikit.studies.path1996", "Study: Douglas et al. 1996 (PATH)"),
     ("studies-hallouzi2008", "fdikit.studies.hallouzi2008", "Study: Hallouzi 2008"),
     ("studies-vanderploeg2018", "fdikit.studies.vanderploeg2018", "Study: van der Ploeg 2018"),

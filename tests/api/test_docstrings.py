@@ -27,7 +27,8 @@ MODULES = sorted(
     for p in SRC.rglob("*.py") if p.name != "__init__.py" and p.name != "cli.py"
 )
 METHOD_PACKAGES = ("fdikit.design.", "fdikit.decision.", "fdikit.multimodel.", "fdikit.estimate.", "fdikit.plants.",
-                   "fdikit.studies.", "fdikit.nonlinear.", "fdikit.identify.")
+                   "fdikit.studies.", "fdikit.nonlinear.", "fdikit.identify.", "fdikit.spc.",
+                   "fdikit.ftc.")
 
 
 def sections(doc: str) -> set[str]:

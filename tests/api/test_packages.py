@@ -65,7 +65,8 @@ HEAVY = ("scipy.signal", "scipy.stats", "scipy.optimize", "scipy.integrate", "co
 
 @pytest.mark.parametrize("package", ["fdikit", "fdikit.design", "fdikit.decision", "fdikit.multimodel",
                                      "fdikit.plants", "fdikit.studies", "fdikit.analysis", "fdikit.estimate",
-                                     "fdikit.vehicle", "fdikit.aircraft", "fdikit.identify"])
+                                     "fdikit.vehicle", "fdikit.aircraft", "fdikit.identify",
+                                     "fdikit.spc", "fdikit.ftc"])
 def test_package_import_is_light(package):
     # A fresh interpreter: which modules does importing the package (not using it) load?  The wall time of the same
     # imports is measured in benchmarks/bench_import.py (docs/PERFORMANCE.md), not here.

@@ -1,0 +1,152 @@
+"""One closed-loop SPC step in the B747 rudder configuration: predictor update + multi-step matrices + QP.
+
+Hallouzi 2008, §6.6: ``p = f = N_p = 20``, ``N_c = 5``, ``m = 5`` inputs, ``l = 7`` outputs, so the QP has
+``N_c·m = 25`` variables; the step must fit the 10 Hz control period (goal ≤ 2 ms, 98 % slack).
+
+The data come from a random stable innovation-form system (8 states, 5 inputs, 7 outputs, ``ρ(A − KC) ≤ 0.6``)
+under white inputs: the step's cost depends on the dimensions, not on the aircraft.  The SPC limits are
+those a B747 configuration has (input and rate bounds on every input, output bounds on every output) so
+that the QP has all (5.36) rows; about a third of the steps have active bounds.
+
+Each step: :meth:`fdikit.spc.RecursiveVarx.update` (Givens, λ = 0.995), :meth:`VarxPredictor.multistep`
+(f = 20), :func:`fdikit.spc.spc_problem`, :meth:`fdikit.spc.QpSolver.solve` (OSQP, warm started).
+
+Peers, in the same run, on the same data:
+
+* the predictor update as a batch QR of the λ-weighted data window (``numpy.linalg.qr`` of the 1000-column
+  ``[Z; Y]ᵀ``), which is what a user without the recursive update would do;
+* the QP with cvxpy (a parametrised, DPP-compiled problem, so only the parameters change between steps)
+  and Clarabel, the solver the tests use as a reference.
+
+Single-threaded BLAS (set before numpy is imported).  Run: ``python benchmarks/bench_spc.py [--steps N]``.
+"""
+
+from __future__ import annotations
+
+import os
+
+for _var in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "NUMBA_NUM_THREADS"):
+    os.environ[_var] = "1"  # single-threaded BLAS: comparable timings on a shared machine
+
+import argparse  # noqa: E402
+import time  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from fdikit.spc import QpSolver, RecursiveVarx, SpcLimits, SpcWeights, spc_problem  # noqa: E402
+from timing import cpu_name  # noqa: E402
+
+P = F = 20
+NC = 5
+M_IN, L_OUT, N_X = 5, 7, 8
+FORGET = 0.995
+
+
+def system(rng):
+    """A random stable innovation-form system with ρ(A) ≤ 0.9 and ρ(A − KC) ≤ 0.6."""
+    while True:
+        A = rng.standard_normal((N_X, N_X))
+        A *= 0.9 / max(abs(np.linalg.eigvals(A)))
+        B = rng.standard_normal((N_X, M_IN))
+        C = rng.standard_normal((L_OUT, N_X))
+        K = 0.05 * rng.standard_normal((N_X, L_OUT))
+        if max(abs(np.linalg.eigvals(A - K @ C))) <= 0.6:
+            return A, B, C, K
+
+
+def simulate(sysm, u, rng, noise=0.05):
+    A, B, C, K = sysm
+    x = np.zeros(N_X)
+    y = np.empty((len(u), L_OUT))
+    for k, uk in enumerate(u):
+        e = noise * rng.standard_normal(L_OUT)
+        y[k] = C @ x + e
+        x = A @ x + B @ uk + K @ e
+    return y
+
+
+def percentiles(times):
+    t = np.asarray(times) * 1e3
+    return float(np.median(t)), float(np.percentile(t, 99)), float(t.max())
+
+
+def main(steps: int) -> None:
+    rng = np.random.default_rng(0)
+    sysm = system(rng)
+    n0 = 1000 + P
+    u = rng.standard_normal((n0 + steps + P, M_IN))
+    y = simulate(sysm, u, rng)
+    weights = SpcWeights(output=np.ones(L_OUT), input=0.01 * np.eye(M_IN), rate=0.1 * np.eye(M_IN))
+    limits = SpcLimits(u_min=-np.ones(M_IN), u_max=np.ones(M_IN), du_min=-0.3 * np.ones(M_IN),
+                       du_max=0.3 * np.ones(M_IN), y_min=-8 * np.ones(L_OUT), y_max=8 * np.ones(L_OUT))
+    rec = RecursiveVarx(P, M_IN, L_OUT, forgetting=FORGET)
+    rec.initialize(u[:n0], y[:n0])
+    solver = QpSolver()
+    reference = np.tile(rng.uniform(-1, 1, L_OUT), F)
+
+    fd_update, fd_qp, fd_step, batch_update, cvx_qp = [], [], [], [], []
+    problems = []
+    for k in range(n0, n0 + steps):
+        pred0 = rec.predictor
+        w_p = pred0.past(u[:k], y[:k])
+        t0 = time.perf_counter()
+        rec.update(w_p, y[k])
+        t1 = time.perf_counter()
+        pred = rec.predictor
+        gamma, lam = pred.multistep(F)
+        prob = spc_problem(gamma, lam, pred.past(u[:k + 1], y[:k + 1]), reference, u[k], weights, limits, NC)
+        sol = solver.solve(prob)
+        t2 = time.perf_counter()
+        fd_update.append(t1 - t0)
+        fd_qp.append(t2 - t1)
+        fd_step.append(t2 - t0)
+        problems.append((prob, sol.u))
+    # Batch QR of the weighted window (the recursive update's peer), on the same columns.
+    cols = 1000
+    for k in range(n0, n0 + min(steps, 200)):
+        wts = np.sqrt(FORGET ** np.arange(cols)[::-1])
+        t0 = time.perf_counter()
+        Z = np.stack([np.concatenate([np.r_[u[i - P + j], y[i - P + j]] for j in range(P)]) for i in range(k - cols, k)])
+        data = np.hstack([Z, y[k - cols:k]]) * wts[:, None]
+        np.linalg.qr(data, mode="r")
+        batch_update.append(time.perf_counter() - t0)
+    # cvxpy + Clarabel, DPP-parametrised.
+    import cvxpy as cp
+
+    prob0 = problems[0][0]
+    nv = prob0.H.shape[0]
+    x = cp.Variable(nv)
+    Hs = cp.Parameter((nv, nv), PSD=True)
+    c = cp.Parameter(nv)
+    A = cp.Parameter(prob0.A.shape)
+    b = cp.Parameter(prob0.b.shape)
+    qp = cp.Problem(cp.Minimize(0.5 * cp.quad_form(x, Hs) + c @ x), [A @ x <= b])
+    worst = 0.0
+    for prob, u_fd in problems[: min(steps, 200)]:
+        Hs.value = prob.H + prob.H.T
+        c.value = prob.c
+        A.value, b.value = prob.A, prob.b
+        t0 = time.perf_counter()
+        qp.solve(solver=cp.CLARABEL)
+        cvx_qp.append(time.perf_counter() - t0)
+        worst = max(worst, float(np.max(np.abs(x.value - u_fd)) / max(1.0, np.max(np.abs(x.value)))))
+
+    print(f"CPU: {cpu_name()}; {steps} steps; QP variables {nv}, constraints {prob0.A.shape[0]}")
+    rows = [("fdikit step (update + Γ, Λ + QP)", fd_step), ("  fdikit predictor update (Givens)", fd_update),
+            ("  fdikit Γ, Λ, QP set-up + OSQP", fd_qp), ("batch QR of the weighted window", batch_update),
+            ("cvxpy + Clarabel QP (DPP)", cvx_qp)]
+    print(f"{'':40s} {'median ms':>10s} {'p99 ms':>8s} {'max ms':>8s}")
+    for name, times in rows:
+        med, p99, mx = percentiles(times)
+        print(f"{name:40s} {med:10.3f} {p99:8.3f} {mx:8.3f}")
+    med_u, med_b = np.median(fd_update), np.median(batch_update)
+    med_q = np.median(np.asarray(fd_qp))
+    print(f"ratios: batch QR / Givens update {med_b / med_u:.1f}×; cvxpy+Clarabel / (fdikit Γ, Λ, QP) "
+          f"{np.median(cvx_qp) / med_q:.1f}×; largest move difference OSQP vs Clarabel {worst:.1e}")
+    print(f"10 Hz budget 100 ms: p99 of the fdikit step uses {percentiles(fd_step)[1] / 100:.1%}")
+
+
+if __name__ == "__main__":
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--steps", type=int, default=1000)
+    main(ap.parse_args().steps)
