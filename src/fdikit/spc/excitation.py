@@ -59,6 +59,10 @@ class LeastExcited:
         Inverse iterations used per triplet; equal to ``max_iter`` when the tolerance was not reached
         (the vector is then the last iterate, still a direction of small gain).
 
+    References
+    ----------
+    Hallouzi 2008, §5.3.1, (5.39).
+
     Examples
     --------
     >>> r = least_excited(np.diag([3.0, 1.0, 2.0]), count=1)

@@ -52,6 +52,10 @@ class SubspacePredictor:
     R22 : ndarray, shape (M·m, M·m)
         The ``U_f`` rows of the RQ factor under the ``U_f`` columns.
 
+    References
+    ----------
+    Hallouzi 2008, §5.2.1, (5.12)–(5.16).
+
     Examples
     --------
     >>> rng = np.random.default_rng(0)
