@@ -121,6 +121,7 @@ class SubspacePredictiveController:
         self.startup = startup
         self.predictor = predictor
         self.fixed = predictor is not None
+        self._given = predictor is not None
         self.frozen = bool(frozen)
         self._u: list[np.ndarray] = []
         self._y: list[np.ndarray] = []
@@ -142,7 +143,7 @@ class SubspacePredictiveController:
     @property
     def samples_needed(self) -> int:
         """Stored samples needed before the first QP: ``2M + window − 1`` (``M`` with a fixed predictor)."""
-        return self.horizon if self.fixed else 2 * self.horizon + self.window - 1
+        return self.horizon if self._given else 2 * self.horizon + self.window - 1
 
     def diagnostics(self) -> dict:
         """Per-step diagnostics as arrays: ``t``, ``spc`` (bool), ``rcond``, ``status``, ``iterations``.
@@ -206,13 +207,13 @@ class SubspacePredictiveController:
             raise DataError("u_t and y_t must be finite: replace missing samples before calling step()")
         self._u.append(u)
         self._y.append(y)
-        keep = max(self.samples_needed, self.horizon)
+        keep = self.horizon if self.fixed else self.samples_needed
         if len(self._u) > keep:
             del self._u[:-keep]
             del self._y[:-keep]
         t = len(self.history)
         m = u.size
-        if len(self._u) < self.samples_needed:
+        if len(self._u) < (self.horizon if self.fixed else self.samples_needed):
             self.history.append(_Step(t, "startup", float("nan"), "startup", 0))
             return self._startup(t + 1, m)
         from fdikit.spc.law import move_blocking, spc_problem
