@@ -61,3 +61,34 @@ def test_bad_arguments():
     ctl.step([0.0], [0.0], [1.0])
     with pytest.raises(DataError):
         ctl.step([0.0, 1.0], [0.0], [1.0])
+
+
+def test_first_adaptive_move_equals_the_true_model_problem():
+    # Noise-free data: ŷ_f = L_p v_p + L_f u_f is exact, with L_p v_p = [C A^i x_{t+1}]_{i<M} (free
+    # response from x_{t+1} = A x_t + B u_t) and L_f the lower block-Toeplitz of D = 0, CB, CAB, …
+    # The same QP built from these true matrices must give the controller's first move (to the
+    # round-off of the RQ fit, bounded by ~1e-8 relative on this well-conditioned dither, cf. the
+    # predictor tests).
+    M, Nc = 6, 2
+    rng = np.random.default_rng(1)
+    ctl = SubspacePredictiveController(M, Nc, law.SpcWeights([1.0], [0.01], [0.1]), window=30,
+                                       startup=rng.standard_normal((100, 1)))
+    x = np.zeros(2)
+    u = np.zeros(1)
+    for _ in range(ctl.samples_needed):
+        y = C @ x
+        x_t, u_t = x, u
+        u_next = ctl.step(u, y, [1.0])
+        x = A @ x + B @ u
+        u = u_next
+    assert ctl.diagnostics()["spc"][-1] and not ctl.diagnostics()["spc"][-2]
+    x_next = A @ x_t + B @ u_t
+    obs = np.vstack([C @ np.linalg.matrix_power(A, i) for i in range(M)])
+    markov = [np.zeros((1, 1))] + [C @ np.linalg.matrix_power(A, i) @ B for i in range(M - 1)]
+    Lf = np.zeros((M, M))
+    for i in range(M):
+        for j in range(i + 1):
+            Lf[i, j] = markov[i - j][0, 0]
+    problem = law.spc_problem(obs, Lf, x_next, [1.0], u_t, law.SpcWeights([1.0], [0.01], [0.1]), None, Nc)
+    expected = law.unconstrained_move(problem)[:1]
+    np.testing.assert_allclose(u_next, expected, rtol=1e-6, atol=1e-8)
