@@ -23,7 +23,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
         "excitation": ["LeastExcited", "excitation_cost", "least_excited"],
         "law": ["QpSolution", "QpSolver", "SpcLimits", "SpcProblem", "SpcWeights", "move_blocking", "rate_matrix",
                 "spc_problem", "unconstrained_move"],
-        "varx": ["VarxPredictor", "varx_fit"],
+        "varx": ["VarxPredictor", "varx_data", "varx_fit"],
         "givens": ["RecursiveVarx"],
         "controller": ["SubspacePredictiveController"],
         "closed_loop": ["ClosedLoopSPC"],

@@ -26,7 +26,7 @@ import numpy as np
 from fdikit import validate
 from fdikit.errors import DataError, ParameterError
 
-__all__ = ["VarxPredictor", "varx_fit"]
+__all__ = ["VarxPredictor", "varx_data", "varx_fit"]
 
 
 @dataclass(frozen=True)
