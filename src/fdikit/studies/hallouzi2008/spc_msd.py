@@ -103,9 +103,19 @@ def run_msd_spc(*, quick=False):
         ``"tracking"``: traces and RMSE per window for ``"spc"`` and ``"mpc"``; ``"pe"``: rcond traces
         and RMSE with and without excitation.
 
+    References
+    ----------
+    Hallouzi 2008, §5.4, Figs. 5.2–5.5.
+
     Examples
     --------
-    Not run here (takes about a minute): ``run_msd_spc(quick=True)["tracking"]["rmse"]``.
+    Not run here (about a minute):
+
+    >>> sorted(PE_SETTINGS)
+    ['count', 'rho', 'tau']
+    >>> res = run_msd_spc(quick=True)  # doctest: +SKIP
+    >>> sorted(res["tracking"]["rmse"])  # doctest: +SKIP
+    ['mpc', 'spc']
     """
     from fdikit.spc.predictor import subspace_predictor
     window = 250 if quick else 500
@@ -161,9 +171,17 @@ def write_msd_ftc(out_dir, *, quick=False, progress=None) -> dict:
     dict
         Figure name → matplotlib Figure.
 
+    References
+    ----------
+    Hallouzi 2008, §5.4, Figs. 5.2–5.5.
+
     Examples
     --------
-    Not run here (matplotlib, about a minute): ``write_msd_ftc("out", quick=True)``.
+    Not run here (matplotlib, about a minute):
+
+    >>> figs = write_msd_ftc("out", quick=True)  # doctest: +SKIP
+    >>> sorted(figs)  # doctest: +SKIP
+    ['msd_ftc_inputs', 'msd_ftc_outputs', 'msd_ftc_rcond']
     """
     import matplotlib
     matplotlib.use("Agg")
