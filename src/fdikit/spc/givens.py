@@ -167,8 +167,13 @@ class RecursiveVarx:
         if self._low is None:
             raise DataError("call initialize(u, y) before update().")
         col = self._col
-        col[: self._nz] = validate.as_vector("w_p", w_p, size=self._nz)
-        col[self._nz :] = validate.as_vector("y_t", y_t, size=self.l)
+        w = np.asarray(w_p, dtype=float).ravel()
+        yt = np.asarray(y_t, dtype=float).ravel()
+        if w.size != self._nz or yt.size != self.l:
+            raise DataError(f"w_p must have p·(m+l) = {self._nz} entries and y_t l = {self.l}; got {w.size} "
+                            f"and {yt.size} (build w_p with VarxPredictor.past).")
+        col[: self._nz] = w
+        col[self._nz :] = yt
         if not np.all(np.isfinite(col)):
             raise DataError("w_p and y_t must be finite; skip or repair the sample.")
         if self._sqrt != 1.0:
