@@ -106,7 +106,8 @@ def main(steps: int) -> None:
     for k in range(n0, n0 + min(steps, 200)):
         wts = np.sqrt(FORGET ** np.arange(cols)[::-1])
         t0 = time.perf_counter()
-        Z = np.stack([np.concatenate([np.r_[u[i - P + j], y[i - P + j]] for j in range(P)]) for i in range(k - cols, k)])
+        Z = np.stack([np.concatenate([np.r_[u[i - P + j], y[i - P + j]] for j in range(P)])
+                      for i in range(k - cols, k)])
         data = np.hstack([Z, y[k - cols:k]]) * wts[:, None]
         np.linalg.qr(data, mode="r")
         batch_update.append(time.perf_counter() - t0)
