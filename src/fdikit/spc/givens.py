@@ -12,7 +12,10 @@ resulting ``R_11(t)``, ``R_21(t)`` are the same. ``R_22`` is not needed (it does
 The rotation loop is hand-written: ``scipy.linalg.qr_insert`` / ``qr_update`` update a full ``Q`` and
 ``R`` (``O(n²)`` memory traffic on ``Q`` plus Python overhead); appending one row to the ``R`` of the
 transpose only needs ``n`` rotations on ``R``. The loop is compiled with numba (a dependency), ``O(n²)``
-flops per update, about 10 µs for ``n = 240``.
+flops per update: measured ≈ 60 µs for ``p = 20, m = 5, l = 7`` (240 regressors) against ≈ 2 ms for
+``scipy.linalg.qr_insert`` (which also updates ``Q``) and ≈ 6 ms for a numpy loop vectorised per
+rotation. ``Ξ̂_0 = R_21 R_11^{-1}`` is likewise a compiled back substitution (≈ 0.2 ms; a BLAS ``trsm``
+measured 8 ms on a loaded 2-core machine because of thread contention).
 
 References
 ----------
@@ -30,6 +33,7 @@ from fdikit.spc.varx import VarxPredictor, varx_data
 __all__ = ["RecursiveVarx"]
 
 _KERNEL = None
+_SOLVE = None
 
 
 def _rotate_python(low, col, nz):  # pragma: no cover - reference / fallback without numba
@@ -74,6 +78,34 @@ def _rotate_loop(low, col, nz):
             low[k, i] = c * x + s * z
             col[k] = -s * x + c * z
         col[i] = 0.0
+
+
+def _solve_loop(r11t, r21):
+    """``X`` with ``X R_11 = R_21`` by back substitution; ``r11t = R_11ᵀ`` (C-contiguous, upper)."""
+    n = r11t.shape[0]
+    x = np.empty_like(r21)
+    for j in range(n - 1, -1, -1):
+        row = r11t[j]
+        for r in range(r21.shape[0]):
+            s = r21[r, j]
+            for k in range(j + 1, n):
+                s -= x[r, k] * row[k]
+            x[r, j] = s / row[j]
+    return x
+
+
+def _solver():
+    global _SOLVE
+    if _SOLVE is None:
+        try:
+            import numba
+        except ImportError:  # pragma: no cover
+            from scipy.linalg import solve_triangular
+
+            _SOLVE = lambda r11t, r21: solve_triangular(r11t, r21.T, lower=False).T  # noqa: E731
+        else:
+            _SOLVE = numba.njit(cache=False, nogil=True)(_solve_loop)
+    return _SOLVE
 
 
 class RecursiveVarx:
@@ -148,7 +180,9 @@ class RecursiveVarx:
         upper = qr(np.vstack([Z, Y]).T, mode="r")[0][: self._nz, :]
         self._low = np.ascontiguousarray(upper.T)  # (nz + l, nz): [R11; R21]
         self.samples = Z.shape[1]
-        _kernel()
+        # compile both kernels now (numba JIT, ~1 s once per process), not inside the first real-time step
+        _kernel()(np.eye(2), np.zeros(2), 1)
+        _solver()(np.eye(2), np.zeros((1, 2)))
 
     def update(self, w_p, y_t) -> None:
         """Append ``[w_p; y_t]`` with forgetting and re-triangularise (6.17), (C.1)–(C.5).
@@ -194,14 +228,12 @@ class RecursiveVarx:
     @property
     def predictor(self) -> VarxPredictor:
         """The current :class:`~fdikit.spc.varx.VarxPredictor` with ``Ξ̂_0 = R_21 R_11^{-1}`` (6.12)."""
-        from scipy.linalg import solve_triangular
-
         low = self._state()
         r11, r21 = low[: self._nz], low[self._nz :]
         diag = np.abs(np.diag(r11))
         if diag.min() <= self._nz * np.finfo(float).eps * diag.max():
             raise DataError("R_11 is singular: the data are not persistently exciting; excite the inputs.")
-        xi0 = solve_triangular(r11.T, r21.T, lower=False).T
+        xi0 = _solver()(np.ascontiguousarray(r11.T), np.ascontiguousarray(r21))
         return VarxPredictor(xi0, self.p, self.m, self.l)
 
     def _state(self):
