@@ -202,6 +202,10 @@ def varx_data(u, y, p, columns=None):
     >>> Z, Y = varx_data(np.arange(4.0), np.arange(4.0) + 10, 2)
     >>> Z[:, 0], Y[:, 0]
     (array([ 0., 10.,  1., 11.]), array([12.]))
+
+    References
+    ----------
+    Hallouzi 2008, §6.3.1, (6.6)–(6.7).
     """
     p = validate.integer("p", p, minimum=1)
     u = np.asarray(u, dtype=float)
