@@ -37,6 +37,8 @@ Maciejowski 2002, Ch. 3.  Stellato et al. 2020.
 
 from __future__ import annotations
 
+import contextlib
+import io
 import time
 from dataclasses import dataclass
 
@@ -526,7 +528,8 @@ class QpSolver:
             self._shape = shape
         else:
             self._solver.update(Px=P_up.data, Ax=A_sp.data, q=problem.c, l=lower, u=upper)
-        res = self._solver.solve(raise_error=False)
+        with contextlib.redirect_stdout(io.StringIO()):   # OSQP prints polishing notes even with verbose=False
+            res = self._solver.solve(raise_error=False)
         seconds = time.perf_counter() - t0
         status = str(res.info.status)
         if "infeasible" in status or "non_convex" in status or "non-convex" in status or "unbounded" in status:
