@@ -160,3 +160,23 @@ def test_simulate_reports_a_fault_that_never_acts_as_one_warning_line(tmp_path):
     assert res.exit_code == 0, res.output
     assert "warning:" in res.output and "never acts" in res.output and "warnings.warn" not in res.output
     assert (tmp_path / "t.parquet").is_file()
+
+
+def test_ftc_command_writes_the_msd_figures_and_table(tmp_path, monkeypatch):
+    # The experiment itself takes minutes (docs/methods/ftc.md); here its result is replaced by a small one of
+    # the same structure so that the command's files and printed table are checked.
+    import fdikit.studies.hallouzi2008.spc_msd as spc_msd
+
+    n = 50
+    y, u = np.ones((n, 3)), np.zeros((n, 2))
+    rmse = {"0-50": 1.5, "50-200": 0.05}
+    fake = {"tracking": {"spc": {"y": y, "u": u}, "mpc": {"y": y, "u": u}, "rmse": {"spc": rmse, "mpc": rmse}},
+            "pe": {k: {"y": y, "u": u, "rcond": np.full(n, 1e-3), "rmse": 0.1} for k in ("with", "without")}}
+    monkeypatch.setattr(spc_msd, "run_msd_spc", lambda **kw: fake)
+    out = tmp_path / "ftc"
+    res = runner.invoke(app, ["ftc", "--out", str(out), "--quick"])
+    assert res.exit_code == 0, res.output
+    assert {p.name for p in out.iterdir()} == {"msd_ftc_outputs.png", "msd_ftc_inputs.png", "msd_ftc_rcond.png",
+                                              "msd_ftc_rmse.csv", "msd_ftc_rmse.md"}
+    assert "| spc | 1.5 | 0.05 |" in res.output
+    assert (out / "msd_ftc_rmse.csv").read_text().splitlines()[1] == "spc,1.5,0.05"

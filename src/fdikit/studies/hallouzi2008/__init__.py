@@ -20,6 +20,8 @@ methods, Table 3.1 and the model-set comparison (Table 3.3), and the report comm
 * :mod:`fdikit.studies.hallouzi2008.table_4_8` — Table 4.8 on the nonlinear B747: the lock-position sweep
   (Hallouzi 2008, §4.4.2).
 * :mod:`fdikit.studies.hallouzi2008.b747_report` — Files of ``fdikit b747`` (Table 4.8, plots, HTML).
+* :mod:`fdikit.studies.hallouzi2008.spc_msd` — Adaptive SPC against a fixed-model MPC on the MSD, and the
+  persistency-of-excitation experiment (Hallouzi 2008, §5.4).
 * :mod:`fdikit.studies.hallouzi2008.report` — One command for the multiple-model reproductions of Hallouzi 2008
   (§2.4, §3.3.1, §3.6).
 """
@@ -64,6 +66,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
         "example_3_1": [
             "Example31Result", "PAIRS", "example_3_1", "example_3_1_models",
         ],
+        "spc_msd": ["LIMITS", "PE_SETTINGS", "run_msd_spc", "write_msd_ftc"],
         "report": [
             "PARTS", "check_multiple_model_arguments", "multiple_model_report", "plot_b747", "plot_msd",
         ],

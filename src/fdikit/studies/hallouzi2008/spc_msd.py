@@ -5,7 +5,8 @@ Set-up (choices the thesis leaves open are marked *):
 * Plant :func:`fdikit.plants.msd.msd_matrices` (healthy, f1 = f2 = 1), discretised by zero-order hold
   at ``dt = 0.1 s`` (10 Hz, §5.4); controls u1, u2; tracked outputs y1 → 1, y3 → 0.5 (* values),
   y2 unweighted.
-* Horizons M = N_p = 20, N_c = 5; weights Q_c = diag(1, 0, 1), R_c = 1e-3·I, R_c^Δ = 0.1·I (*).
+* Horizons M = N_p = 20, N_c = 5; weights Q_c = diag(1, 0, 1), R_c = 1e-3·I, R_c^Δ = 0.1·I (*); inputs
+  limited to ±3 and their changes to ±0.5 per sample (:data:`LIMITS`, *).
 * Parameter trajectory (* Fig. 5.2's shape is not printed): k1 = m3 = 1 up to 50 s, then linear ramps
   to k1 = 1.6, m3 = 0.5 at 200 s, held afterwards (inside the ranges of §3.6).
 * Input delay: 0.25 s is 2.5 samples at 10 Hz; it is simulated as 3 samples (0.3 s, *) on both inputs
@@ -26,12 +27,14 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["PE_SETTINGS", "run_msd_spc", "write_msd_ftc"]
+__all__ = ["LIMITS", "PE_SETTINGS", "run_msd_spc", "write_msd_ftc"]
 
 DT = 0.1
 PE_SETTINGS = {"rho": 0.05, "tau": 1.0, "count": 2}
 REFERENCE = np.array([1.0, 0.0, 0.5])
 NOISE_STD = 1e-3
+#: Input and rate limits (* not given by the thesis): without them both loops diverge after the delay.
+LIMITS = {"u_min": -3.0, "u_max": 3.0, "du_min": -0.5, "du_max": 0.5}
 
 
 def _discrete(k1, m3):
@@ -53,10 +56,10 @@ def _parameters(t):
 
 def _controller(window, excitation=None, predictor=None, seed=0):
     from fdikit.spc.controller import SubspacePredictiveController
-    from fdikit.spc.law import SpcWeights
+    from fdikit.spc.law import SpcLimits, SpcWeights
     rng = np.random.default_rng(seed)
     return SubspacePredictiveController(
-        20, 5, SpcWeights([1.0, 0.0, 1.0], [1e-3, 1e-3], [0.1, 0.1]), window=window,
+        20, 5, SpcWeights([1.0, 0.0, 1.0], [1e-3, 1e-3], [0.1, 0.1]), SpcLimits(**LIMITS), window=window,
         excitation=excitation, predictor=predictor, startup=rng.standard_normal((4 * window + 100, 2)))
 
 
@@ -89,13 +92,21 @@ def _rmse(ys, lo, hi):
     return float(np.sqrt(np.mean(e ** 2)))
 
 
-def run_msd_spc(*, quick=False):
+def run_msd_spc(*, quick=False, duration=None, delay_at=200.0, window=None, pe_duration=None):
     """Run both §5.4 experiments and return traces and RMSE tables.
 
     Parameters
     ----------
     quick : bool, default False
         Shorter runs (300 s / 100 s) and a smaller window (250 instead of 500 columns).
+    duration : float, optional
+        Length of the tracking runs [s] (overrides ``quick``).
+    delay_at : float, default 200
+        Time the input delay appears [s] (§5.4: 200).
+    window : int, optional
+        Hankel columns of the receding window (overrides ``quick``).
+    pe_duration : float, optional
+        Length of the excitation runs [s]; 0 skips them.
 
     Returns
     -------
@@ -118,8 +129,9 @@ def run_msd_spc(*, quick=False):
     ['mpc', 'spc']
     """
     from fdikit.spc.predictor import subspace_predictor
-    window = 250 if quick else 500
-    duration = 300.0 if quick else 400.0
+    window = window or (250 if quick else 500)
+    duration = duration or (300.0 if quick else 400.0)
+    pe_duration = (100.0 if quick else 200.0) if pe_duration is None else pe_duration
     rng = np.random.default_rng(5)
     a, b, c = _discrete(1.0, 1.0)
     n_id = 2 * 20 + window - 1
@@ -130,15 +142,15 @@ def run_msd_spc(*, quick=False):
         x = a @ x + b @ u_id[k]
     fixed = subspace_predictor(u_id, y_id, 20)
     out = {"tracking": {}, "pe": {}}
-    windows = [(0, 50), (50, 200), (200, 210), (200, duration)]
+    d0 = delay_at
+    windows = [(0, 50), (50, d0), (d0, d0 + 10), (d0, duration), (d0 + 50, duration)]
     rmse = {}
     for name, ctl in (("spc", _controller(window)), ("mpc", _controller(window, predictor=fixed))):
-        ys, us = _simulate(ctl, duration)
+        ys, us = _simulate(ctl, duration, delay_at=delay_at)
         out["tracking"][name] = {"y": ys, "u": us, "diagnostics": ctl.diagnostics()}
-        rmse[name] = {f"{lo}-{hi:g}": _rmse(ys, lo, hi) for lo, hi in windows}
+        rmse[name] = {f"{lo:g}-{hi:g}": _rmse(ys, lo, hi) for lo, hi in windows}
     out["tracking"]["rmse"] = rmse
-    pe_duration = 100.0 if quick else 200.0
-    for name, exc in (("with", PE_SETTINGS), ("without", None)):
+    for name, exc in (("with", PE_SETTINGS), ("without", None)) if pe_duration > 0 else ():
         ctl = _controller(window, excitation=exc)
         ys, us = _simulate(ctl, pe_duration, varying=False, delay_at=None)
         d = ctl.diagnostics()
@@ -183,8 +195,6 @@ def write_msd_ftc(out_dir, *, quick=False, progress=None) -> dict:
     >>> sorted(figs)  # doctest: +SKIP
     ['msd_ftc_inputs', 'msd_ftc_outputs', 'msd_ftc_rcond']
     """
-    import matplotlib
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     from fdikit.atomic import write_bytes, write_text
