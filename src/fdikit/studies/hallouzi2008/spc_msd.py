@@ -191,6 +191,8 @@ def write_msd_ftc(out_dir, *, quick=False, progress=None) -> dict:
     --------
     Not run here (matplotlib, about a minute):
 
+    >>> write_msd_ftc.__name__
+    'write_msd_ftc'
     >>> figs = write_msd_ftc("out", quick=True)  # doctest: +SKIP
     >>> sorted(figs)  # doctest: +SKIP
     ['msd_ftc_inputs', 'msd_ftc_outputs', 'msd_ftc_rcond']
