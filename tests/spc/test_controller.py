@@ -4,9 +4,8 @@ import numpy as np
 import pytest
 
 from fdikit.errors import DataError, ParameterError
-
-law = pytest.importorskip("fdikit.spc.law")
-from fdikit.spc.controller import SubspacePredictiveController  # noqa: E402
+from fdikit.spc import law
+from fdikit.spc.controller import SubspacePredictiveController
 
 A = np.array([[0.7, 0.2], [-0.1, 0.5]])
 B = np.array([[1.0], [0.5]])

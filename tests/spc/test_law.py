@@ -99,7 +99,7 @@ def test_held_reference_equals_tiled_reference(data):
 
 
 def clarabel(prob):
-    cp = pytest.importorskip("cvxpy")
+    import cvxpy as cp
     x = cp.Variable(prob.H.shape[0])
     q = cp.Problem(cp.Minimize(cp.quad_form(x, prob.H) + prob.c @ x), [prob.A @ x <= prob.b])
     q.solve(solver=cp.CLARABEL)

@@ -62,7 +62,7 @@ class SubspacePredictor:
     >>> u = rng.standard_normal((60, 1))
     >>> y = np.r_[[[0.0]], 0.5 * u[:-1]]          # y_k = 0.5 u_{k−1}
     >>> P = subspace_predictor(u, y, 2)
-    >>> np.round(P.markov()[:, 0, 0], 6)          # D, CB
+    >>> np.round(P.markov()[:, 0, 0], 6) + 0.0    # D, CB
     array([0. , 0.5])
     """
 
@@ -213,7 +213,7 @@ def subspace_predictor(u, y, horizon: int, columns: int | None = None) -> Subspa
     >>> for k in range(1, 80):
     ...     y[k] = 0.8 * y[k - 1] + u[k - 1]        # x⁺ = 0.8x + u, y = x
     >>> P = subspace_predictor(u, y, 3)
-    >>> np.round(P.markov()[:, 0, 0], 6)            # D, CB, CAB
+    >>> np.round(P.markov()[:, 0, 0], 6) + 0.0      # D, CB, CAB (+ 0.0: no "-0." from round-off)
     array([0. , 1. , 0.8])
     """
     from scipy import linalg

@@ -256,7 +256,7 @@ def varx_fit(u, y, p, columns=None) -> VarxPredictor:
     >>> rng = np.random.default_rng(0)
     >>> u = rng.standard_normal((300, 1)); y = np.zeros((300, 1))
     >>> for k in range(1, 300): y[k] = 0.5 * y[k - 1] + u[k - 1]
-    >>> np.round(varx_fit(u, y, 1).Xi0, 8)
+    >>> np.round(varx_fit(u, y, 1).Xi0, 8) + 0.0
     array([[1. , 0.5]])
 
     References
