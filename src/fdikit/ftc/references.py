@@ -22,6 +22,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from fdikit import validate
+from fdikit.errors import ParameterError
 
 __all__ = ["FlightPlan", "nominal_plan"]
 
@@ -184,7 +185,8 @@ def nominal_plan(*, altitude: float = 980.0, airspeed: float = 92.6, heading: fl
     """
     gamma = np.radians(validate.number("flight_path_angle", flight_path_angle))
     if (target_altitude - altitude) * gamma < 0 or (gamma == 0 and target_altitude != altitude):
-        raise _sign_error(gamma, altitude, target_altitude)
+        raise ParameterError(f"flight_path_angle = {np.degrees(gamma):g} deg does not lead from {altitude:g} m to "
+                             f"{target_altitude:g} m; use a negative angle to descend and a positive one to climb.")
     return FlightPlan(heading0=np.radians(validate.number("heading", heading)),
                       heading1=np.radians(validate.number("new_heading", new_heading)),
                       turn_start=validate.number("turn_start", turn_start),
@@ -194,9 +196,3 @@ def nominal_plan(*, altitude: float = 980.0, airspeed: float = 92.6, heading: fl
                       descent_start=validate.number("descent_start", descent_start),
                       flight_path_angle=float(gamma), airspeed=validate.positive("airspeed", airspeed))
 
-
-def _sign_error(gamma, h0, h1):
-    from fdikit.errors import ParameterError
-
-    return ParameterError(f"flight_path_angle = {np.degrees(gamma):g} deg does not lead from {h0:g} m to {h1:g} m; "
-                          f"use a negative angle to descend and a positive one to climb.")

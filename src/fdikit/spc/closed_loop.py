@@ -101,7 +101,7 @@ class ClosedLoopSPC:
         self.forgetting = forgetting
         self.adapt = bool(adapt)
         self.solver = solver if solver is not None else QpSolver()
-        self._rec = None
+        self._rec = self._pred = None
         self._u = self._y = None
         self.history: list[_Record] = []
 
@@ -116,7 +116,7 @@ class ClosedLoopSPC:
         """
         if self._rec is None:
             raise DataError("call initialize(u, y) first.")
-        return self._rec.predictor
+        return self._pred
 
     def initialize(self, u, y) -> None:
         """Batch-initialise the predictor (the thesis's ``j = 1000`` columns, §6.5) and the past window.
@@ -146,6 +146,7 @@ class ClosedLoopSPC:
         if self._rec is not None and self._rec.m != rec.m:
             self.solver = QpSolver(self.solver.max_iter, self.solver.eps, self.solver.warm_start)
         self._rec = rec
+        self._pred = rec.predictor
         self._u = deque(u[-(self.p + 1):], maxlen=self.p + 1)
         self._y = deque(y[-(self.p + 1):], maxlen=self.p + 1)
 
@@ -183,13 +184,14 @@ class ClosedLoopSPC:
             raise DataError("call initialize(u, y) before step().")
         u_prev = validate.as_vector("u_prev", u_prev, size=self._rec.m, error=DataError)
         y_prev = validate.as_vector("y_prev", y_prev, size=self._rec.l, error=DataError)
-        if self.adapt:
-            w_old = self._rec.predictor.past(np.asarray(self._u)[-self.p:], np.asarray(self._y)[-self.p:])
+        # The window ending at t − 2 (the last predictor's past(): only p, m, l are used).
+        w_old = self._pred.past(np.asarray(self._u), np.asarray(self._y))
         self._u.append(u_prev)
         self._y.append(y_prev)
         if self.adapt:
             self._rec.update(w_old, y_prev)
-        pred = self._rec.predictor
+            self._pred = self._rec.predictor              # one back substitution per step
+        pred = self._pred
         gamma, lam = pred.multistep(self.f)
         w_p = pred.past(np.asarray(self._u), np.asarray(self._y))
         prob = spc_problem(gamma, lam, w_p, reference, u_prev, self.weights, self.limits, self.control_horizon)
