@@ -146,3 +146,50 @@ def test_varx_fit_columns_window_and_errors():
         pred.multistep(1, full=False)
     with pytest.raises(DataError):
         pred.past(u[:1], y[:1])
+
+
+def _reference_multistep(xi0, p, m, l, rows):
+    """(6.14)–(6.16) written out block by block, as printed: Γ_i, Λ's blocks, then the Toeplitz fill."""
+    d = m + l
+    blocks = [xi0[:, (p - 1 - j) * d : (p - j) * d] for j in range(p)]  # CΦ^j[B K], j = 0 first
+    cb = [b[:, :m] for b in blocks]
+    ck = [b[:, m:] for b in blocks]
+    gam = [xi0]
+    for i in range(1, rows + 1):
+        g = np.zeros_like(xi0)
+        if i < p:
+            g[:, i * d :] = xi0[:, : (p - i) * d]  # (6.16)
+        for j in range(i):
+            g = g + ck[i - j - 1] @ gam[j]  # (6.14)
+        gam.append(g)
+    lam = [np.zeros((l, m))]
+    for i in range(1, rows + 1):
+        b = cb[i - 1].copy()
+        for j in range(1, i):
+            b = b + ck[i - j - 1] @ lam[j]  # (6.15)
+        lam.append(b)
+    lam_big = np.zeros((rows * l, rows * m))
+    for r in range(rows):
+        for c in range(r + 1):
+            lam_big[r * l : (r + 1) * l, c * m : (c + 1) * m] = lam[r - c + 1]
+    return np.vstack(gam[1:]), lam_big
+
+
+@pytest.mark.parametrize(("p", "m", "l", "f", "full"), [(20, 5, 7, 20, True), (20, 5, 7, 12, False), (6, 1, 2, 1, True),
+                                                     (5, 3, 1, 5, False), (4, 2, 3, 3, True)])
+def test_multistep_equals_the_printed_recursion(p, m, l, f, full):
+    rng = np.random.default_rng(p * 100 + m * 10 + l)
+    xi0 = 0.3 * rng.standard_normal((l, p * (m + l)))
+    rows = f if full else f - 1
+    gamma, lam = VarxPredictor(xi0, p, m, l).multistep(f, full=full)
+    g_ref, l_ref = _reference_multistep(xi0, p, m, l, rows)
+    g_abs, l_abs = _reference_multistep(np.abs(xi0), p, m, l, rows)
+    assert gamma.shape == g_ref.shape and lam.shape == l_ref.shape
+    assert gamma.flags.c_contiguous and lam.flags.c_contiguous
+    # Both are sums of the same products in different orders (forward substitution vs the printed loop): the
+    # difference is within n·eps times the recursion run on |Ξ_0| (a bound on every partial sum), n the
+    # number of terms per entry ≤ (rows + 1)·l.
+    n = (rows + 1) * l
+    assert np.all(np.abs(gamma - g_ref) <= 2 * n * EPS * g_abs)
+    assert np.all(np.abs(lam - l_ref) <= 2 * n * EPS * l_abs)
+    assert np.array_equal(lam == 0, l_ref == 0)  # the zero blocks above the diagonal stay exactly zero

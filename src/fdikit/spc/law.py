@@ -21,24 +21,26 @@ Corrections to the printed text:
   ``u_f = −(H + Hᵀ)⁻¹ c`` (:func:`unconstrained_move`; the test checks the gradient is zero there).
 * (5.34) prints ``<``; the bounds are ``≤``.  (5.35) ``[I −I S_Δᵀ −S_Δᵀ …]ᵀ`` is a vertical stack.
 
-Solver: OSQP (Stellato et al. 2020), called directly rather than through cvxpy.  The SPC solves one small
-dense QP per control period whose matrices change a little from step to step: OSQP is set up once per
-problem shape and then only updated (``update(Px=, q=, Ax=, l=, u=)``) and warm started from the last
-solution, which is what makes a 10 Hz loop cheap; its iteration cap plays the role of the thesis's
-100-iteration cap (§6.6), and solution polishing makes the active constraints exact.  cvxpy with Clarabel
-is the reference the tests compare with.  Written here (not taken from a library) is only the SPC-specific
-assembly of (5.17)–(5.37), which no library provides.
+Solver (:class:`QpSolver`): one small dense QP per control period (§6.6: 25 variables, 100 rows) of a fixed
+shape: set up once with fixed CSC patterns, then only their ``.data`` updated.  Default ``method="clarabel"``
+(Clarabel's own API, interior point, Goulart & Chen 2024): 8–17 iterations whatever the conditioning (cond H ≈
+3e4 in §6.6), a bounded time, which a real-time loop needs more than a short median; a polishing step (the KKT
+system on the identified active set, kept only if the KKT conditions hold to ``eps``) makes active limits exact.
+``method="osqp"`` (ADMM, Stellato et al. 2020) warm starts and polishes, but needs hundreds to thousands of
+iterations at 1e-8 here: a similar median, a longer tail.  cvxpy with Clarabel is the tests' reference.
+Written here: only the SPC assembly (5.17)–(5.37) and the polishing step, which no library provides.
 
 References
 ----------
 Hallouzi 2008, §5.2.2, (5.17)–(5.37); §6.3.2, (6.18)–(6.28); §6.6.  Favoreel & De Moor 1999.
-Maciejowski 2002, Ch. 3.  Stellato et al. 2020.
+Maciejowski 2002, Ch. 3.  Stellato et al. 2020.  Goulart & Chen 2024.
 """
 
 from __future__ import annotations
 
 import contextlib
 import io
+import re
 import time
 from dataclasses import dataclass
 
@@ -58,7 +60,9 @@ def _square(name: str, value, size: int) -> np.ndarray:
     if a.shape != (size, size) or not np.all(np.isfinite(a)):
         raise ParameterError(f"{name} must be a finite {size}×{size} matrix or a vector of {size} diagonal "
                              f"weights; got shape {np.shape(value)}.")
-    if np.min(np.linalg.eigvalsh(0.5 * (a + a.T))) < -1e-12 * max(1.0, np.abs(a).max()):
+    d = np.diag(a)
+    lowest = np.min(d) if np.array_equal(a, np.diag(d)) else np.min(np.linalg.eigvalsh(0.5 * (a + a.T)))
+    if lowest < -1e-12 * max(1.0, np.abs(a).max()):
         raise ParameterError(f"{name} must be positive semidefinite (a weight); make its eigenvalues ≥ 0.")
     return a
 
@@ -365,19 +369,23 @@ def spc_problem(Lp, Lf, past, reference, u_last, weights: SpcWeights, limits: Sp
     if not np.all(np.isfinite(u_last)):
         raise ParameterError("u_last must be finite.")
     Qc, Rc, Rd = weights.matrices(l, m)
-    E = move_blocking(Np, Nc, m)
-    S = rate_matrix(Nc, m)
-    Qa = np.kron(np.eye(Np), Qc)
-    Ra = np.kron(np.eye(Nc), Rc)
-    Rda = np.kron(np.eye(Nc), Rd)
-    G = Lf @ E                                  # future outputs per move
+    Nc = validate.integer("Nc", Nc, minimum=1)
+    S = rate_matrix(Nc, m) if Nc <= Np else move_blocking(Np, Nc, m)   # the latter raises the horizon error
+    StS = S[::m, ::m].T @ S[::m, ::m]           # S_Δ = S₁ ⊗ I: S₁ᵀS₁
+    # G = L_f E (future outputs per move): E copies the first N_c − 1 moves and sums the held last one.
+    G = np.empty((Np * l, Nc * m))
+    G[:, : (Nc - 1) * m] = Lf[:, : (Nc - 1) * m]
+    G[:, (Nc - 1) * m :] = Lf[:, (Nc - 1) * m :].reshape(Np * l, Np - Nc + 1, m).sum(axis=1)
     free = Lp @ past                            # predicted outputs with u_f = 0
     sv = np.zeros(Nc * m)
     sv[:m] = u_last                             # S_v v_p: only the first block row is nonzero (5.21)
-    QG = Qa @ G
-    H = G.T @ QG + S.T @ Rda @ S + Ra
+    QG = (Qc @ G.reshape(Np, l, Nc * m)).reshape(Np * l, Nc * m)          # Q_a G, Q_a = I ⊗ Q_c
+    # S_Δᵀ(I ⊗ R_cᶿ)S_Δ + I ⊗ R_c = S₁ᵀS₁ ⊗ R_cᶿ + I ⊗ R_c, the Kronecker products by broadcasting
+    reg = StS[:, None, :, None] * Rd[:, None] + np.eye(Nc)[:, None, :, None] * Rc[:, None]
+    H = G.T @ QG + reg.reshape(Nc * m, Nc * m)
     H = 0.5 * (H + H.T)
-    c = 2.0 * ((free - r) @ QG - sv @ Rda @ S)
+    c = 2.0 * ((free - r) @ QG)
+    c[:m] -= 2.0 * (u_last @ Rd)                # sv (I ⊗ R_cᶿ) S_Δ: only the first block is nonzero
     u_min, u_max, du_min, du_max, y_min, y_max = (limits or SpcLimits()).vectors(l, m)
     rows, bounds = [], []
     eye = np.eye(Nc * m)
@@ -427,7 +435,7 @@ def unconstrained_move(problem: SpcProblem) -> np.ndarray:
 
 @dataclass(frozen=True)
 class QpSolution:
-    """One QP solve: the moves, OSQP's status, its iterations and the wall time.
+    """One QP solve: the moves, the solver's status, its iterations and the wall time.
 
     Attributes
     ----------
@@ -437,9 +445,11 @@ class QpSolution:
         ``"solved"``, ``"solved inaccurate"`` or ``"max_iter"`` (the iteration cap was hit: ``u`` is the
         last iterate, feasible to about the solver tolerance at best — the controller decides what to do).
     iterations : int
-        ADMM iterations.
+        Interior-point (Clarabel) or ADMM (OSQP) iterations.
     seconds : float
         Wall time of the solve.
+    polished : bool
+        ``u`` is the exact minimiser on the identified active set (KKT conditions checked), not an iterate.
 
     Examples
     --------
@@ -448,45 +458,86 @@ class QpSolution:
 
     References
     ----------
-    Stellato et al. 2020.
+    Stellato et al. 2020; Goulart & Chen 2024.
     """
 
     u: np.ndarray
     status: str
     iterations: int
     seconds: float
+    polished: bool = False
+
+
+def _status(raw, solver: str) -> str:
+    """Map a solver's status ("PrimalInfeasible", "primal_infeasible", "problem non convex", …) to ours."""
+    words = " ".join(re.sub(r"(?<=[a-z])(?=[A-Z])", " ", str(raw)).replace("_", " ").replace("-", " ").lower().split())
+    if "infeasible" in words or "non convex" in words or "unbounded" in words:
+        raise DesignError(f"the SPC quadratic program is {words}: " + (
+            "relax the output limits (y_min, y_max), then the rate limits, so that some input sequence meets them all."
+            if "infeasible" in words and "dual" not in words else
+            "H is not positive semidefinite or the cost is unbounded below; check the weights and the predictor."))
+    if words in ("solved", "solved inaccurate", "almost solved"):
+        return "solved" if words == "solved" else "solved inaccurate"
+    if words.startswith(("max", "time limit", "run time limit")):   # max_iter, "maximum iterations reached", …
+        return "max_iter"
+    raise DesignError(f"{solver} could not solve the SPC quadratic program (status {str(raw)!r}).")
 
 
 class QpSolver:
-    """OSQP for successive SPC problems of one shape: set up once, then updated and warm started.
+    """A QP solver for successive SPC problems of one shape: set up once, then only the numbers updated.
 
     Parameters
     ----------
-    max_iter : int, default 4000
-        ADMM iteration cap (the thesis caps its solver at 100 iterations, §6.6; OSQP's iterations are
-        cheaper and more are needed for 1e-8 accuracy).
+    max_iter : int, optional
+        Iteration cap: default 100 for Clarabel (the thesis's cap, §6.6; it needs 8–17), 4000 for OSQP.
     eps : float, default 1e-8
-        Absolute and relative tolerance.
+        Clarabel's gap and feasibility tolerances, OSQP's absolute and relative ones, and the KKT check's.
     warm_start : bool, default True
-        Start each solve from the last solution.
+        OSQP: start from the last solution (an interior-point method does not warm start).
+    method : {"clarabel", "osqp"}, default "clarabel"
+        Clarabel (interior point) or OSQP (ADMM); see the module notes for the choice.
 
     Examples
     --------
     >>> prob = SpcProblem(H=np.eye(2), c=np.array([-2.0, -2.0]), A=np.eye(2), b=np.array([0.5, 3.0]))
-    >>> np.round(QpSolver().solve(prob).u, 6)
-    array([0.5, 1. ])
+    >>> [np.round(QpSolver(method=m).solve(prob).u, 6) for m in ("clarabel", "osqp")]
+    [array([0.5, 1. ]), array([0.5, 1. ])]
 
     References
     ----------
-    Stellato et al. 2020; Hallouzi 2008, §6.6.
+    Goulart & Chen 2024; Stellato et al. 2020; Hallouzi 2008, §6.6.
     """
 
-    def __init__(self, max_iter: int = 4000, eps: float = 1e-8, warm_start: bool = True) -> None:
-        self.max_iter = validate.integer("max_iter", max_iter, minimum=1)
+    def __init__(self, max_iter: int | None = None, eps: float = 1e-8, warm_start: bool = True, *,
+                 method: str = "clarabel") -> None:
+        if method not in ("clarabel", "osqp"):
+            raise ParameterError(f"method must be 'clarabel' or 'osqp'; got {method!r}.")
+        self.max_iter = None if max_iter is None else validate.integer("max_iter", max_iter, minimum=1)
         self.eps = validate.positive("eps", eps)
-        self.warm_start = bool(warm_start)
-        self._solver = None
-        self._shape = None
+        self.method, self.warm_start = method, bool(warm_start)
+        self._solver = self._key = None
+
+    def _setup(self, P, c, A, b, key):  # a new solver; CSC patterns (P's upper triangle, A's nonzeros) kept
+        import scipy.sparse as sp
+
+        (n, k, _), cap = key, self.max_iter or (100 if self.method == "clarabel" else 4000)
+        self._pcol, self._prow = np.tril_indices(n)             # CSC order of the upper triangle
+        self._acol, self._arow = np.nonzero(A.T)                # CSC order of A's nonzeros
+        P_csc = sp.csc_matrix((P[self._prow, self._pcol], self._prow, np.r_[0, np.cumsum(np.arange(1, n + 1))]))
+        A_csc = sp.csc_matrix((A[self._arow, self._acol], self._arow,
+                               np.r_[0, np.cumsum(np.bincount(self._acol, minlength=n))]), shape=(k, n))
+        if self.method == "clarabel":
+            import clarabel
+            st = clarabel.DefaultSettings()
+            st.verbose, st.presolve_enable, st.input_sparse_dropzeros, st.max_iter = False, False, False, cap
+            st.tol_gap_abs = st.tol_gap_rel = st.tol_feas = self.eps
+            self._solver = clarabel.DefaultSolver(P_csc, c, A_csc, b, [clarabel.NonnegativeConeT(k)], st)
+        else:
+            import osqp
+            self._solver = osqp.OSQP()
+            self._solver.setup(P=P_csc, q=c, A=A_csc, l=np.full(k, -np.inf), u=b, eps_abs=self.eps, eps_rel=self.eps,
+                               max_iter=cap, polishing=True, verbose=False, warm_starting=self.warm_start)
+        self._key = key
 
     def solve(self, problem: SpcProblem) -> QpSolution:
         """Solve ``min uᵀHu + cᵀu s.t. A u ≤ b``.
@@ -502,44 +553,48 @@ class QpSolver:
         Raises
         ------
         DesignError
-            The constraints are infeasible (relax the output limits, which are the usual culprit, or the
-            rate limits) or the problem is non-convex / unbounded.
+            Infeasible constraints (relax the output limits, the usual culprit, or the rate limits), ``H`` not
+            positive semidefinite, or a solver failure.
+        ParameterError
+            A non-finite bound in ``b``.
         """
-        import osqp
-        import scipy.sparse as sp
-
-        n = problem.H.shape[0]
-        P = problem.H + problem.H.T                       # ½ uᵀ P u + cᵀ u  =  uᵀ H u + cᵀ u
-        # Dense patterns (all entries stored, zeros included) keep the sparsity fixed, so updates apply.
-        P_up = sp.csc_matrix(np.triu(np.ones((n, n))))
-        P_up.data = np.concatenate([P[: j + 1, j] for j in range(n)])   # CSC: column by column
-        k = problem.A.shape[0]
-        A_full = np.vstack([problem.A, np.eye(n)])        # a trailing identity keeps A nonempty
-        A_sp = sp.csc_matrix(np.ones_like(A_full))
-        A_sp.data = A_full.T.ravel()
-        lower = np.r_[np.full(k, -np.inf), np.full(n, -np.inf)]
-        upper = np.r_[problem.b, np.full(n, np.inf)]
-        shape = (n, k)
         t0 = time.perf_counter()
-        if self._solver is None or shape != self._shape:
-            self._solver = osqp.OSQP()
-            self._solver.setup(P=P_up, q=problem.c, A=A_sp, l=lower, u=upper, eps_abs=self.eps, eps_rel=self.eps,
-                               max_iter=self.max_iter, polishing=True, verbose=False, warm_starting=self.warm_start)
-            self._shape = shape
+        P = problem.H + problem.H.T                       # ½ uᵀ P u + cᵀ u  =  uᵀ H u + cᵀ u
+        c, A, b = np.asarray(problem.c, dtype=float), np.asarray(problem.A, dtype=float), problem.b
+        if not np.all(np.isfinite(b)):
+            raise ParameterError("the bounds b must be finite: drop the rows without a bound (as spc_problem does).")
+        try:                                              # a PSD H is the solvers' premise; Cholesky is cheap
+            np.linalg.cholesky(P + 1e-12 * max(1.0, np.abs(P).max()) * np.eye(len(c)))
+        except np.linalg.LinAlgError:
+            _status("non convex", self.method)
+        key = (len(c), A.shape[0], np.count_nonzero(A))
+        if self._solver is None or key != self._key or np.count_nonzero(A[self._arow, self._acol]) != key[2]:
+            self._setup(P, c, A, b, key)                  # a new shape, or A's nonzeros left the cached pattern
+        else:                                             # only the .data of the cached patterns
+            names = ("P", "q", "A", "b") if self.method == "clarabel" else ("Px", "q", "Ax", "u")
+            self._solver.update(**dict(zip(names, (P[self._prow, self._pcol], c, A[self._arow, self._acol], b))))
+        if self.method == "clarabel":
+            res = self._solver.solve()
+            status, x, iters = _status(res.status, "Clarabel"), np.array(res.x, dtype=float), int(res.iterations)
+            xp = None if status == "max_iter" else _polish(P, c, A, b, np.asarray(res.z) > np.asarray(res.s), self.eps)
+            polished, x = (True, xp) if xp is not None else (False, x)
         else:
-            self._solver.update(Px=P_up.data, Ax=A_sp.data, q=problem.c, l=lower, u=upper)
-        with contextlib.redirect_stdout(io.StringIO()):   # OSQP prints polishing notes even with verbose=False
-            res = self._solver.solve(raise_error=False)
-        seconds = time.perf_counter() - t0
-        status = str(res.info.status)
-        if "infeasible" in status or "non_convex" in status or "non-convex" in status or "unbounded" in status:
-            raise DesignError(f"the SPC quadratic program is {status}: relax the output limits (y_min, y_max), "
-                              f"then the rate limits, so that some input sequence meets them all.")
-        if status.startswith("maximum iterations"):
-            status = "max_iter"
-        elif status == "solved_inaccurate" or status == "solved inaccurate":
-            status = "solved inaccurate"
-        elif status != "solved":
-            raise DesignError(f"OSQP could not solve the SPC quadratic program (status {status!r}).")
-        return QpSolution(u=np.asarray(res.x, dtype=float).copy(), status=status, iterations=int(res.info.iter),
-                          seconds=seconds)
+            with contextlib.redirect_stdout(io.StringIO()):   # OSQP prints polishing notes even with verbose=False
+                res = self._solver.solve(raise_error=False)
+            status, x, iters = _status(res.info.status, "OSQP"), np.array(res.x, dtype=float), int(res.info.iter)
+            polished = int(res.info.status_polish) == 1
+        return QpSolution(u=x, status=status, iterations=iters, seconds=time.perf_counter() - t0, polished=polished)
+
+
+def _polish(P, c, A, b, active, tol):
+    """The KKT solution on the active set, or None unless it is primal and dual feasible and stationary."""
+    Aa, n = A[active], len(c)
+    try:
+        sol = np.linalg.solve(np.block([[P, Aa.T], [Aa, np.zeros((len(Aa), len(Aa)))]]), np.r_[-c, b[active]])
+    except np.linalg.LinAlgError:
+        return None                                   # dependent active rows: keep the interior-point iterate
+    xp, lam = sol[:n], sol[n:]                        # accept only a KKT point (optimal for a convex QP)
+    ok = (np.all(np.isfinite(sol)) and np.max(A @ xp - b, initial=0.0) <= tol * (1.0 + np.abs(b).max(initial=0.0))
+          and np.min(lam, initial=0.0) >= -tol * (1.0 + np.abs(lam).max(initial=0.0))
+          and np.abs(P @ xp + c + Aa.T @ lam).max() <= tol * (1.0 + np.abs(c).max() + np.abs(P @ xp).max()))
+    return xp if ok else None

@@ -111,25 +111,24 @@ class VarxPredictor:
         rows = f if full else f - 1
         if rows < 1:
             raise ParameterError("full=False needs f ≥ 2 (it gives f − 1 predictions); pass a larger f.")
+        from scipy.linalg import solve_triangular
+
         p, m, l, d = self.p, self.m, self.l, self.m + self.l
+        nz = p * d
         cb, ck = self.markov()
         xi0 = np.asarray(self.Xi0, dtype=float)
-        gam = [xi0]
-        for i in range(1, rows + 1):
-            xi_i = np.zeros_like(xi0)  # (6.16): Ξ_0 shifted i blocks to the right
-            if i < p:
-                xi_i[:, i * d :] = xi0[:, : (p - i) * d]
-            g = xi_i + sum(ck[i - j - 1] @ gam[j] for j in range(i))  # (6.14)
-            gam.append(g)
-        lam = [None]
-        for i in range(1, rows + 1):
-            lam.append(cb[i - 1] + sum((ck[i - j - 1] @ lam[j] for j in range(1, i)),
-                                       np.zeros((l, m))))  # (6.15)
-        gamma = np.vstack(gam[1:])
-        lambda_ = np.zeros((rows * l, rows * m))
-        for r in range(rows):
-            for c in range(r + 1):
-                lambda_[r * l : (r + 1) * l, c * m : (c + 1) * m] = lam[r - c + 1]
+        # (6.14) and (6.15) are one recursion X_i = R_i + Σ_{j<i} CΦ^{i−j−1}K X_j on X_i = [Γ_i  Λ_i], Λ_i the
+        # i-th block of Λ's first block column, with X_0 = [Ξ_0  0] and R_i = [Ξ_0 shifted i blocks to the right
+        # (6.16)  CΦ^{i−1}B]: a unit block lower-triangular Toeplitz system (I − T) X = R, solved by one
+        # forward substitution (BLAS trsm) instead of a Python loop of block products.
+        rhs = np.zeros(((rows + 1) * l, nz + m))
+        for i in range(rows + 1):
+            rhs[i * l : (i + 1) * l, i * d : nz] = xi0[:, : nz - i * d]
+        rhs[l:, nz:] = cb[:rows].reshape(rows * l, m)
+        lower = _block_toeplitz(np.concatenate([np.eye(l)[None], -ck[:rows]]), rows + 1)
+        x = solve_triangular(lower, rhs, lower=True, unit_diagonal=True, check_finite=False)
+        gamma = np.ascontiguousarray(x[l:, :nz])
+        lambda_ = _block_toeplitz(x[l:, nz:].reshape(rows, l, m), rows)
         return gamma, lambda_
 
     def past(self, u, y) -> np.ndarray:
@@ -161,6 +160,15 @@ class VarxPredictor:
             raise DataError(f"past() needs at least p = {self.p} rows of u and y; got {u.shape[0]}, "
                             f"{y.shape[0]}.")
         return np.hstack([u[-self.p :], y[-self.p :]]).ravel()
+
+
+def _block_toeplitz(blocks: np.ndarray, rows: int) -> np.ndarray:
+    """Block lower-triangular Toeplitz matrix, ``blocks[k]`` on the k-th block subdiagonal (k < rows)."""
+    a, b = blocks.shape[1:]
+    lag = np.subtract.outer(np.arange(rows), np.arange(rows))
+    padded = np.concatenate([blocks[:rows], np.zeros((1, a, b))])
+    lag[lag < 0] = len(padded) - 1                      # above the diagonal: the zero block
+    return padded[lag].transpose(0, 2, 1, 3).reshape(rows * a, rows * b)
 
 
 def _as2d(name, value, width):
