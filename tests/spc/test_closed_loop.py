@@ -100,3 +100,21 @@ def test_bad_use_is_refused():
     spc.initialize(u, y)
     with pytest.raises(DataError):
         spc.step([np.nan], [0.0], reference=[0.0])
+
+
+def test_past_window_is_the_plants_not_the_models():
+    rng = np.random.default_rng(5)
+    u, y = plant_data(300, rng)
+    spc = ClosedLoopSPC(6, 6, 2, SpcWeights(1.0, 0.01, 0.1), forgetting=1.0)
+    past_u, past_y = np.zeros((7, 1)), np.zeros((7, 1))
+    spc.initialize(u, y, past=(past_u, past_y))
+    spc.step([0.0], [0.0], reference=[0.0])
+    # λ = 1: the factor after one update is the batch fit of the data plus the column
+    # [zero window; y = 0] — the plant at rest, not the model data's last window.
+    pred = varx_fit(u, y, 6)
+    Z = np.column_stack([pred.past(u[: k + 1], y[: k + 1]) for k in range(5, 299)] + [np.zeros(6 * 2)])
+    Y = np.column_stack([y[k + 1] for k in range(5, 299)] + [np.zeros(1)])
+    want = np.linalg.lstsq(Z.T, Y.T, rcond=None)[0].T
+    assert spc.predictor.Xi0 == pytest.approx(want, rel=1e-8, abs=1e-10)
+    with pytest.raises(DataError, match="past must be"):
+        spc.initialize(u, y, past=(past_u[:3], past_y[:3]))

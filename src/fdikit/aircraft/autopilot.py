@@ -67,20 +67,30 @@ class LQRAutopilot:
     u0: dict
     thrust_slope: float
 
-    def commands(self, y) -> dict:
+    def commands(self, y, setpoint: Mapping | None = None) -> dict:
         """Commands for :meth:`fdikit.aircraft.plant.JSBSimAircraft.set_inputs` from the sensors.
 
         Parameters
         ----------
         y : array_like
             The sensors (:data:`fdikit.aircraft.plant.SENSORS`; the first ten are used).
+        setpoint : mapping, optional
+            State name → value (SI) replacing the trim value the state is held at — e.g. ``heading`` and
+            ``altitude`` moved along a flight plan (the gain stays the trim's).
 
         Returns
         -------
         dict
             Surface commands [rad], ``throttle_<i>``, and under ``"thrust"`` the thrust command [N].
         """
-        dx = np.asarray(y, dtype=float)[:10] - self.x0
+        x_ref = self.x0
+        if setpoint:
+            from fdikit.aircraft.plant import STATES
+
+            x_ref = self.x0.copy()
+            for name, value in setpoint.items():
+                x_ref[STATES.index(name)] = value
+        dx = np.asarray(y, dtype=float)[:10] - x_ref
         dx[8] = (dx[8] + np.pi) % (2 * np.pi) - np.pi
         du = -self.K @ dx
         out = {name: self.u0[name] + d for name, d in zip(self.inputs, du, strict=True)}

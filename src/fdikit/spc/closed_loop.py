@@ -118,24 +118,30 @@ class ClosedLoopSPC:
             raise DataError("call initialize(u, y) first.")
         return self._pred
 
-    def initialize(self, u, y) -> None:
+    def initialize(self, u, y, *, past=None) -> None:
         """Batch-initialise the predictor (the thesis's ``j = 1000`` columns, §6.5) and the past window.
 
         Also the re-initialisation on a configuration switch (§6.4): pass data of the new input
-        configuration (its number of inputs may differ); the QP solver is set up anew.
+        configuration (its number of inputs may differ; the QP solver sets itself up anew for the new size).
 
         Parameters
         ----------
         u : array_like, shape (N, m)
         y : array_like, shape (N, l)
+        past : tuple of array_like, optional
+            ``(u, y)`` of the plant the controller is about to run on, at least ``p + 1`` rows each
+            (the last ``p + 1`` are kept): the window the first steps start from. Default: the end of
+            the initialisation data — right only when they *are* the plant's recent past. When the data
+            come from a model (the thesis's open-loop simulation), pass the plant's own recent samples
+            (at a trim, repeated trim values): the first update would otherwise pair the model's window
+            with the plant's output, a large false innovation that can wreck the ill-conditioned fit.
 
         Raises
         ------
         DataError
-            Too few samples (``N ≥ p + p·(m+l)``) or mismatched lengths.
+            Too few samples (``N ≥ p + p·(m+l)``), mismatched lengths, or a ``past`` of the wrong shape.
         """
         from fdikit.spc.givens import RecursiveVarx
-        from fdikit.spc.law import QpSolver
 
         u = np.asarray(u, dtype=float)
         y = np.asarray(y, dtype=float)
@@ -143,12 +149,29 @@ class ClosedLoopSPC:
             raise DataError(f"u and y must be (N, m) and (N, l) with one row per sample; got {u.shape}, {y.shape}.")
         rec = RecursiveVarx(self.p, u.shape[1], y.shape[1], forgetting=self.forgetting)
         rec.initialize(u, y)
-        if self._rec is not None and self._rec.m != rec.m:
-            self.solver = QpSolver(self.solver.max_iter, self.solver.eps, self.solver.warm_start)
         self._rec = rec
         self._pred = rec.predictor
+        if past is not None:
+            u, y = (np.asarray(a, dtype=float) for a in past)
+            if (u.ndim != 2 or y.ndim != 2 or u.shape[0] != y.shape[0] or u.shape[0] < self.p + 1
+                    or u.shape[1] != rec.m or y.shape[1] != rec.l):
+                raise DataError(f"past must be (u, y) with at least p + 1 = {self.p + 1} rows of {rec.m} inputs "
+                                f"and {rec.l} outputs; got {u.shape}, {y.shape}.")
         self._u = deque(u[-(self.p + 1):], maxlen=self.p + 1)
         self._y = deque(y[-(self.p + 1):], maxlen=self.p + 1)
+
+    @property
+    def factor(self):
+        """The recursive RQ factor (:class:`fdikit.spc.givens.RecursiveVarx`: ``R11``, ``R21``, ``samples``).
+
+        Raises
+        ------
+        DataError
+            Before :meth:`initialize`.
+        """
+        if self._rec is None:
+            raise DataError("call initialize(u, y) first.")
+        return self._rec
 
     @property
     def m(self) -> int:

@@ -92,6 +92,10 @@ class LipSetup:
         Share of the window the same signature must hold.
     measured : tuple of str
         The states the IMM measures.
+    start : AircraftSnapshot
+        The aircraft at the nominal trim, where every flight starts.
+    imm : IMMFilter
+        The IMM of model set II plus the nominal model (:meth:`IMMFilter.online` for a flight).
     settings : dict
         The arguments (for reports and resumable runs).
 
@@ -117,8 +121,8 @@ class LipSetup:
     share: float = 1.0
     measured: tuple = ()
     settings: dict = field(default_factory=dict)
-    _snap: object = None
-    _imm: object = None
+    start: object = None
+    imm: object = None
 
 
 @dataclass(frozen=True)
@@ -220,7 +224,7 @@ def _fly(setup, seconds: float, seed: int, fault=None, record_states: bool = Fal
     from fdikit.aircraft.actuators import ActuatorBank
 
     ac = setup.aircraft
-    ac.restore(setup._snap)
+    ac.restore(setup.start)
     ac.set_turbulence(setup.turbulence, seed=seed)
     ac.inject([] if fault is None else [fault])
     healthy = ActuatorBank(ac.actuators.limits)
@@ -343,9 +347,9 @@ def lip_setup(*, noise: str = "thesis_cov", turbulence: int = 3, q_inflation: fl
                      Q=np.eye(10), R=R, noise_std=noise_std, transition=_transition(len(models), to_fault),
                      turbulence=turbulence, confirm=confirm, share=share, measured=tuple(measured),
                      settings=settings)
-    setup._snap = ac.snapshot()
+    setup.start = ac.snapshot()
     setup.Q = q_inflation * identify_process_noise(setup, calibration_seconds, calibration_seed)
-    setup._imm = _imm(models, setup.Q, R, setup.transition, nominal.linearization.x0, measured, ac.dt)
+    setup.imm = _imm(models, setup.Q, R, setup.transition, nominal.linearization.x0, measured, ac.dt)
     return setup
 
 
@@ -414,7 +418,7 @@ def fly_lip(setup: LipSetup, surface: str | None = None, lock: float | None = No
         fault = LockInPlace(surface, position=float(np.radians(lock)), onset=t_fault)
     duration = validate.positive("duration", duration)
     idx = [SENSORS.index(s) for s in setup.measured]
-    stepper = setup._imm.online()
+    stepper = setup.imm.online()
     t, mu, pos, alt = [], [], [], []
     for tk, y, u, _ in _fly(setup, duration, seed, fault):
         mu.append(stepper.step(u, y[idx]).mu)
