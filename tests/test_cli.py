@@ -174,9 +174,52 @@ def test_ftc_command_writes_the_msd_figures_and_table(tmp_path, monkeypatch):
             "pe": {k: {"y": y, "u": u, "rcond": np.full(n, 1e-3), "rmse": 0.1} for k in ("with", "without")}}
     monkeypatch.setattr(spc_msd, "run_msd_spc", lambda **kw: fake)
     out = tmp_path / "ftc"
-    res = runner.invoke(app, ["ftc", "--out", str(out), "--quick"])
+    res = runner.invoke(app, ["ftc", "--out", str(out), "--quick", "--no-b747"])
     assert res.exit_code == 0, res.output
     assert {p.name for p in out.iterdir()} == {"msd_ftc_outputs.png", "msd_ftc_inputs.png", "msd_ftc_rcond.png",
                                               "msd_ftc_rmse.csv", "msd_ftc_rmse.md"}
     assert "| spc | 1.5 | 0.05 |" in res.output
     assert (out / "msd_ftc_rmse.csv").read_text().splitlines()[1] == "spc,1.5,0.05"
+
+
+def _fake_flight(scenario, controller, n=400):
+    from fdikit.studies.hallouzi2008.b747_ftc import FtcRun
+
+    t = np.arange(n) * 0.1
+    y = np.tile([0.0, -2.0, 0.0, 92.6, -2.0, 0.0, 980.0], (n, 1))
+    ref = np.tile([0.0, -2.0, 92.6, 0.0, 0.0, 975.0], (n, 1))
+    spc = controller == "spc"
+    return FtcRun(t=t, y=y, reference=ref, surfaces=np.zeros((n, 4)), throttles=np.full((n, 4), 0.5),
+                  mu=np.full((n, 8), 0.125) if spc else np.zeros((n, 0)), configuration=np.array(["nominal"] * n),
+                  declared=("rudder", "rudder_lip_+25", 22.5) if spc and scenario == "rudder" else None, lost=None,
+                  qp={"solved": n} if spc else {}, step_seconds=np.full(n, 1e-3) if spc else np.zeros(0),
+                  rcond=np.full(40, 1e-5) if spc else np.zeros(0), scenario=scenario, controller=controller)
+
+
+def test_ftc_command_flies_the_b747_and_resumes(tmp_path, monkeypatch):
+    # The flights take minutes (docs/methods/ftc.md); here each is a small fake of the same structure, so the
+    # files, the printed table and the resumption are checked.
+    import fdikit.studies.hallouzi2008.b747_ftc as b747_ftc
+    from fdikit.studies.hallouzi2008.b747_ftc_report import FLIGHTS
+
+    calls = []
+
+    def fly(setup, scenario, *, controller, reconfigure, duration, seed):
+        calls.append((scenario, controller, reconfigure, duration, seed))
+        return _fake_flight(scenario, controller)
+
+    monkeypatch.setattr(b747_ftc, "ftc_setup", lambda **kw: object())
+    monkeypatch.setattr(b747_ftc, "fly_ftc", fly)
+    out = tmp_path / "ftc"
+    res = runner.invoke(app, ["ftc", "--out", str(out), "--quick", "--no-msd", "--seed", "3"])
+    assert res.exit_code == 0, res.output
+    assert len(calls) == len(FLIGHTS) and {c[3:] for c in calls} == {(120.0, 3)}
+    names = {p.name for p in (out / "b747").iterdir()}
+    assert {"ftc_b747.md", "ftc_b747.csv", "report.html", "rudder_responses.png", "rudder_modes.png",
+            "bijlmer_surfaces.png", "rcond.png"} <= names
+    assert "rudder (rudder_lip_+25) at 22.5 s (22 s)" in res.output and "max |h−h_ref| [m]" in res.output
+    assert "rudder (rudder_lip_+25) at 22.5 s (22 s)" in (out / "b747" / "ftc_b747.md").read_text()
+    res = runner.invoke(app, ["ftc", "--out", str(out), "--quick", "--no-msd", "--seed", "3"])
+    assert res.exit_code == 0 and len(calls) == len(FLIGHTS)          # every flight reused
+    res = runner.invoke(app, ["ftc", "--out", str(out), "--no-msd", "--no-b747"])
+    assert res.exit_code != 0 and "leave nothing to run" in res.output

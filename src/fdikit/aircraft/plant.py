@@ -367,13 +367,17 @@ class JSBSimAircraft:
                 raise DataError(f"JSBSim stopped at t = {self.time:.2f} s (crash or terminate).")
 
     # ---------------------------------------------------------------- set-up
-    def set_mass(self, mass: float) -> None:
+    def set_mass(self, mass: float, *, in_flight: bool = False) -> None:
         """Set the total mass [kg] with a payload at the empty-weight CG (fuel kept; drained if too heavy).
 
         Parameters
         ----------
         mass : float
             Total mass [kg].
+        in_flight : bool, optional
+            Change the payload only, without re-initialising JSBSim (which would reset the state to the
+            initial conditions): the new mass acts from the next step (a part lost in flight). The fuel
+            is not touched, so the mass cannot go below the structure plus the fuel.
 
         Raises
         ------
@@ -389,6 +393,12 @@ class JSBSimAircraft:
         extra = mass / LBM - dry - fuel.sum()
         if mass / LBM < dry:
             raise ParameterError(f"mass = {mass:.0f} kg is below the {self.name}'s empty weight {dry * LBM:.0f} kg.")
+        if in_flight:
+            if extra < 0:
+                raise ParameterError(f"mass = {mass:.0f} kg needs fuel drained, which in_flight=True does not do; "
+                                     f"the least is {(dry + fuel.sum()) * LBM:.0f} kg.")
+            f[slot] = extra
+            return
         if extra < 0:
             for t, c in zip(tanks, fuel, strict=True):
                 f[t] = c * (1 + extra / fuel.sum())

@@ -41,12 +41,15 @@ import numpy as np
 
 from fdikit import validate
 
-__all__ = ["SCENARIOS", "WEIGHTS", "FORGETTING", "T_INJECT", "FtcSetup", "FtcRun", "ftc_setup", "fly_ftc", "scenario_fault"]
+__all__ = ["SCENARIOS", "BIJLMER", "WEIGHTS", "ALTITUDE_GAINS", "FORGETTING", "T_INJECT", "FtcSetup", "FtcRun", "ftc_setup", "fly_ftc", "scenario_fault"]
 
 #: The §6.5 scenarios.
-SCENARIOS = ("nominal", "elevator", "rudder")
+SCENARIOS = ("nominal", "elevator", "rudder", "bijlmer")
 #: Fault injection time [s] (§6.5.2–§6.5.3).
 T_INJECT = 18.0
+#: The §6.5.4 "Bijlmerramp": its flight condition (mass as the other flights: the thesis gives none), the
+#: fault time [s] and the mass lost with engines 3 and 4 and their pylons [kg].
+BIJLMER = {"altitude": 980.0, "airspeed": 133.8, "flaps": 1.0, "onset": 10.0, "mass_lost": 10_028.0}
 _SPC_DT = 0.1
 #: λ of the recursive update (the thesis: 0.995; see the module docstring).
 FORGETTING = 0.999
@@ -58,11 +61,17 @@ _AIRSPEED_RAISE = 10.0
 WEIGHTS = {
     "nominal": dict(output=[10.0, 10.0, 0.0, 1.0, 0.0, 10.0, 0.0], input=[0.1, 0.1, 0.1, 0.01],
                     rate=[1.0, 1.0, 1.0, 0.1]),
-    "elevator": dict(output=[10.0, 10.0, 0.0, 1.0, 0.0, 10.0, 0.0], input=[0.1, 0.01, 0.1, 0.01],
+    "elevator": dict(output=[10.0, 30.0, 0.0, 1.0, 0.0, 10.0, 0.0], input=[0.1, 0.01, 0.1, 0.01],
                      rate=[1.0, 0.1, 1.0, 0.1]),
     "rudder": dict(output=[10.0, 10.0, 0.0, 1.0, 0.0, 10.0, 0.0], input=[0.1, 0.1, 0.01, 0.01],
                    rate=[1.0, 1.0, 0.1, 0.1]),
+    "unanticipated": dict(output=[10.0, 10.0, 0.0, 1.0, 0.0, 10.0, 0.0], input=[0.1, 0.1, 0.01, 0.1, 0.01, 0.01],
+                          rate=[1.0, 1.0, 0.1, 1.0, 0.1, 0.1]),
 }
+#: Altitude-loop gains ``(k_p, k_i, k_d)`` per configuration: with the 0.5 °/s stabilizer the pitch loop is slow,
+#: and the default gains of :func:`fdikit.ftc.outer.outer_loops` drive a growing phugoid (±15° pitch).
+ALTITUDE_GAINS = {"nominal": (-0.05, -0.005, -0.3), "rudder": (-0.05, -0.005, -0.3), "elevator": (-0.01, -0.0005, -0.2),
+                  "unanticipated": (-0.05, -0.005, -0.3)}
 _DRIVEN = ("aileron", "elevator", "stabilizer", "rudder")   # undriven ones are held at the trim
 _MODEL_GROUP = {"rudder": "rudder", "elevator": "elevator"}
 
@@ -93,6 +102,10 @@ class FtcSetup:
     origins : dict
         ``(configuration, model name)`` → trim and open-loop data (nominal and the model-set-II faults).
     settings : dict
+    start : AircraftSnapshot
+        The aircraft at the nominal trim.
+    bijlmer : dict
+        ``start``, ``origin`` (the 6-input configuration) and ``autopilot`` at the §6.5.4 condition.
 
     Examples
     --------
@@ -108,6 +121,7 @@ class FtcSetup:
     origins: dict
     settings: dict = field(default_factory=dict)
     start: object = None
+    bijlmer: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -182,16 +196,17 @@ class FtcRun:
                 "beta_rms": rms(y[:, 5]), "airspeed_rms": rms(y[:, 3] - r[:, 2])}
 
 
-def scenario_fault(scenario: str):
-    """The §6.5 fault of a scenario: elevator LIP at 1.9° or rudder runaway to 25° at 50°/s, both at 18 s.
+def scenario_fault(scenario: str) -> list:
+    """The §6.5 faults of a scenario: elevator LIP at 1.9° or rudder runaway to 25° at 50°/s (both at 18 s), or
+    engines 3 and 4 lost at 10 s (the Bijlmerramp; its mass loss is applied by :func:`fly_ftc`).
 
     Parameters
     ----------
-    scenario : {"nominal", "elevator", "rudder"}
+    scenario : {"nominal", "elevator", "rudder", "bijlmer"}
 
     Returns
     -------
-    Fault or None
+    list of Fault
 
     Raises
     ------
@@ -200,21 +215,23 @@ def scenario_fault(scenario: str):
 
     Examples
     --------
-    >>> type(scenario_fault("rudder")).__name__, scenario_fault("nominal")
-    ('Runaway', None)
+    >>> [type(f).__name__ for f in scenario_fault("rudder")], scenario_fault("nominal")
+    (['Runaway'], [])
 
     References
     ----------
-    Hallouzi 2008, §6.5.2–§6.5.3.
+    Hallouzi 2008, §6.5.2–§6.5.4.
     """
-    from fdikit.actuator_faults import LockInPlace, Runaway
+    from fdikit.actuator_faults import EngineFailure, LockInPlace, Runaway
 
     validate.choice("scenario", scenario, list(SCENARIOS))
     if scenario == "elevator":
-        return LockInPlace("elevator", position=float(np.radians(1.9)), onset=T_INJECT)
+        return [LockInPlace("elevator", position=float(np.radians(1.9)), onset=T_INJECT)]
     if scenario == "rudder":
-        return Runaway("rudder", position=float(np.radians(25.0)), rate=float(np.radians(50.0)), onset=T_INJECT)
-    return None
+        return [Runaway("rudder", position=float(np.radians(25.0)), rate=float(np.radians(50.0)), onset=T_INJECT)]
+    if scenario == "bijlmer":
+        return [EngineFailure(f"throttle_{i}", onset=BIJLMER["onset"]) for i in (3, 4)]
+    return []
 
 
 def _origin(ac, trim, config, rng) -> _Origin:
@@ -253,6 +270,7 @@ def ftc_setup(*, turbulence: int = 3, calibration_seconds: float = 300.0, seed: 
     ----------
     Hallouzi 2008, §6.4–§6.5.
     """
+    from fdikit.aircraft import HALLOUZI_POINT, FlightCondition, linearize_aircraft, lqr_autopilot, trim_aircraft
     from fdikit.ftc.configurations import input_configuration
     from fdikit.studies.hallouzi2008.aircraft_models import local_model
     from fdikit.studies.hallouzi2008.b747_lip import lip_setup
@@ -269,8 +287,14 @@ def ftc_setup(*, turbulence: int = 3, calibration_seconds: float = 300.0, seed: 
             fault_trim = local_model(ac, m.fault, m.size).linearization.trim
             origins[(m.fault, m.name)] = _origin(ac, fault_trim, input_configuration(_MODEL_GROUP[m.fault]), rng)
     ac.restore(lip.start)
+    cond = FlightCondition(BIJLMER["altitude"], BIJLMER["airspeed"], flaps=float(np.radians(BIJLMER["flaps"])),
+                           mass=HALLOUZI_POINT.mass)
+    b_trim = trim_aircraft(ac, cond)
+    bijlmer = {"origin": _origin(ac, b_trim, input_configuration("unanticipated"), rng),
+               "autopilot": lqr_autopilot(linearize_aircraft(ac, b_trim)), "start": ac.snapshot()}
+    ac.restore(lip.start)
     setup = FtcSetup(lip, trim, origins, dict(turbulence=turbulence, calibration_seconds=calibration_seconds,
-                                              seed=seed))
+                                              seed=seed), bijlmer=bijlmer)
     setup.start = lip.start
     return setup
 
@@ -316,7 +340,7 @@ def fly_ftc(setup: FtcSetup, scenario: str = "nominal", *, controller: str = "sp
     Parameters
     ----------
     setup : FtcSetup
-    scenario : {"nominal", "elevator", "rudder"}
+    scenario : {"nominal", "elevator", "rudder", "bijlmer"}
     controller : {"spc", "autopilot"}
     reconfigure : bool, optional
         Switch the SPC configuration on isolation (default True; False keeps the nominal one).
@@ -329,7 +353,8 @@ def fly_ftc(setup: FtcSetup, scenario: str = "nominal", *, controller: str = "sp
         descent here, see the module docstring).
     adapt : {"after_switch", "always", "never"}, optional
         When the predictor is updated: only after a reconfiguration (default; the nominal predictor stays
-        the identified one — see the module docstring), always (the thesis), or never.
+        the identified one — see the module docstring), always (the thesis), or never. The Bijlmerramp
+        always adapts (no FDI: adaptation is how the SPC learns the fault).
     progress : callable, optional
         Called with the simulated time every 10 s.
 
@@ -358,17 +383,20 @@ def fly_ftc(setup: FtcSetup, scenario: str = "nominal", *, controller: str = "sp
     from fdikit.ftc.references import nominal_plan
     from fdikit.multimodel.isolation import table_4_7_logic
 
-    fault = scenario_fault(scenario)
+    faults = scenario_fault(scenario)
     validate.choice("controller", controller, ["spc", "autopilot"])
     duration = validate.positive("duration", duration)
     lip, ac = setup.lip, setup.lip.aircraft
-    ac.restore(setup.start)
+    bijlmer = scenario == "bijlmer"   # unanticipated: the 6-input configuration, no FDI, always adapting
+    ac.restore(setup.bijlmer["start"] if bijlmer else setup.start)
     ac.set_turbulence(lip.turbulence, seed=seed)
-    ac.inject([] if fault is None else [fault])
+    ac.inject(faults)
+    autopilot = setup.bijlmer["autopilot"] if bijlmer else lip.autopilot
+    mass_after = ac.mass - BIJLMER["mass_lost"] if bijlmer else None
     healthy = ActuatorBank(ac.actuators.limits)
     healthy.restore(ac.actuators.snapshot())
     rng = np.random.default_rng(seed)
-    plan = nominal_plan(heading=0.0, new_heading=-120.0)
+    plan = nominal_plan(heading=0.0, new_heading=-120.0, airspeed=BIJLMER["airspeed"] if bijlmer else 92.6)
     idx = [SENSORS.index(s) for s in lip.measured]
     spc_idx = [SENSORS.index(s) for s in ("roll", "pitch", "heading", "true_airspeed", "alpha", "beta", "altitude")]
     units = np.array([np.degrees(1.0)] * 3 + [1.0] + [np.degrees(1.0)] * 2 + [1.0])
@@ -377,12 +405,12 @@ def fly_ftc(setup: FtcSetup, scenario: str = "nominal", *, controller: str = "sp
     n = max(1, int(round(lip.confirm / ac.dt)))
     persistence = _Persistence(max(1, int(np.ceil(lip.share * n))), n)
     every = int(round(_SPC_DT / ac.dt))
-    origin = origin0 = setup.origins[("nominal", "nominal")]
-    loops = outer_loops(_SPC_DT, pitch_trim=float(origin.y0[1]))
+    origin = origin0 = setup.bijlmer["origin"] if bijlmer else setup.origins[("nominal", "nominal")]
+    loops = outer_loops(_SPC_DT, pitch_trim=float(origin.y0[1]), altitude_gains=ALTITUDE_GAINS[origin.config.name])
     spc = None
     if controller == "spc":
         spc = _spc(origin, forgetting=validate.in_range("forgetting", forgetting, 0.0, 1.0, closed="right"))
-        spc.adapt = validate.choice("adapt", adapt, ["after_switch", "always", "never"]) == "always"
+        spc.adapt = validate.choice("adapt", adapt, ["after_switch", "always", "never"]) == "always" or bijlmer
         spc.initialize(origin.u, origin.y, past=(np.zeros((_P + 1, origin.config.m)), np.zeros((_P + 1, 7))))
     rec = {k: [] for k in ("t", "y", "r", "s", "thr", "mu", "cfg", "sec")}
     rcond, declared, lost = [], None, None
@@ -392,14 +420,17 @@ def fly_ftc(setup: FtcSetup, scenario: str = "nominal", *, controller: str = "sp
     hist_pos, hist_thr, hist_y = deque(maxlen=_P + 2), deque(maxlen=_P + 2), deque(maxlen=_P + 2)
     for k in range(int(round(duration / ac.dt))):
         t = ac.time
+        if mass_after is not None and t >= BIJLMER["onset"]:
+            ac.set_mass(mass_after, in_flight=True)
+            mass_after = None
         y = ac.measure(lip.noise_std, rng)
         if controller == "autopilot":
-            c = lip.autopilot.commands(y, {"heading": plan.heading(t), "altitude": plan.altitude(t),
+            c = autopilot.commands(y, {"heading": plan.heading(t), "altitude": plan.altitude(t),
                                            "true_airspeed": plan.airspeed_at(t)})
             ac.set_inputs(aileron=c["aileron"], elevator=c["elevator"], rudder=c["rudder"],
                           **dict.fromkeys(throttles, c["throttle"]))
         pos = healthy.update(ac.surface_commands(), t, ac.dt)
-        if controller == "spc":
+        if controller == "spc" and not bijlmer:
             u_imm = np.array([pos["aileron"], pos["elevator"], pos["stabilizer"], pos["rudder"],
                               ac.thrust().sum(), 1.0])
             mu = stepper.step(u_imm, y[idx]).mu
@@ -414,6 +445,8 @@ def fly_ftc(setup: FtcSetup, scenario: str = "nominal", *, controller: str = "sp
                     if label == "elevator":
                         plan = plan.with_airspeed(t, plan.airspeed + _AIRSPEED_RAISE)
                     spc = _spc(origin, spc)
+                    gains = ALTITUDE_GAINS[origin.config.name]
+                    loops.altitude.kp, loops.altitude.ki, loops.altitude.kd = gains   # integrator kept: bumpless
                     spc.adapt = adapt != "never"
                     past_u = np.array([origin.config.vector(p_, th, origin.positions, origin.throttles)
                                        for p_, th in zip(hist_pos, hist_thr, strict=True)])
