@@ -261,3 +261,17 @@ def test_limits_given_for_some_surfaces_keep_the_others():
     assert ac.actuators.limits["rudder"] == B747_LIMITS["rudder"]
     # with ±15° ailerons (Ch. 4's lumped range) a 25° rudder cannot be trimmed straight; with ±20° it can
     assert not trim_aircraft(ac, HALLOUZI_POINT, {"rudder": np.radians(25)}, require=False).converged
+
+
+def test_mass_lost_in_flight_keeps_the_state():
+    ac = JSBSimAircraft("B747", dt=0.01)
+    trim_aircraft(ac, HALLOUZI_POINT)
+    ac.step(10)
+    x = ac.state()
+    m = ac.mass
+    ac.set_mass(m - 10_028.0, in_flight=True)
+    assert np.array_equal(ac.state(), x)               # no re-initialisation
+    ac.step()
+    assert ac.mass == pytest.approx(m - 10_028.0, abs=1.0)    # less one step of fuel burn (≈ 0.05 kg)
+    with pytest.raises(ParameterError, match="in flight"):
+        ac.set_mass(ac.mass - 5_000.0, in_flight=True)     # 3 t of payload left: fuel would have to go

@@ -375,9 +375,7 @@ class JSBSimAircraft:
         mass : float
             Total mass [kg].
         in_flight : bool, optional
-            Change the payload only, without re-initialising JSBSim (which would reset the state to the
-            initial conditions): the new mass acts from the next step (a part lost in flight). The fuel
-            is not touched, so the mass cannot go below the structure plus the fuel.
+            Only change the payload, from the next step (no re-initialisation, which resets the state).
 
         Raises
         ------
@@ -393,10 +391,9 @@ class JSBSimAircraft:
         extra = mass / LBM - dry - fuel.sum()
         if mass / LBM < dry:
             raise ParameterError(f"mass = {mass:.0f} kg is below the {self.name}'s empty weight {dry * LBM:.0f} kg.")
+        if in_flight and extra < 0:
+            raise ParameterError(f"in flight the mass stays ≥ {(dry + fuel.sum()) * LBM:.0f} kg; got {mass:.0f}.")
         if in_flight:
-            if extra < 0:
-                raise ParameterError(f"mass = {mass:.0f} kg needs fuel drained, which in_flight=True does not do; "
-                                     f"the least is {(dry + fuel.sum()) * LBM:.0f} kg.")
             f[slot] = extra
             return
         if extra < 0:

@@ -1,12 +1,15 @@
 """Fault-tolerant control: outer loops, input configurations, reconfiguration and multi-rate execution.
 
 Hallouzi 2008, §6.2–6.6: outer PID loops (altitude → pitch, heading → roll, airspeed) around an inner
-closed-loop SPC (:class:`fdikit.spc.ClosedLoopSPC`), run in rate groups.  The input configurations of
-Table 6.1 and their switching by multiple-model isolation on the B747 are not implemented yet.
+closed-loop SPC (:class:`fdikit.spc.ClosedLoopSPC`), run in rate groups, with the Table 6.1 input
+configurations of the B747 the multiple-model isolation switches between (the flights themselves are in
+:mod:`fdikit.studies.hallouzi2008.b747_ftc`).
 
 * :mod:`fdikit.ftc.pid` — PID loops with anti-windup.
 * :mod:`fdikit.ftc.references` — Reference generators for the §6.5 manoeuvres (turn, descent).
 * :mod:`fdikit.ftc.multirate` — A rate-group scheduler with per-call timings.
+* :mod:`fdikit.ftc.outer` — The altitude → pitch and heading → roll loops around the inner SPC.
+* :mod:`fdikit.ftc.configurations` — Table 6.1 on JSBSim's B747: inputs, limits, linear models, start-up data.
 """
 
 import lazy_loader as lazy
@@ -17,5 +20,8 @@ __getattr__, __dir__, __all__ = lazy.attach(
         "pid": ["PID"],
         "references": ["FlightPlan", "nominal_plan"],
         "multirate": ["RateGroup", "MultiRate"],
+        "outer": ["OuterLoops", "outer_loops"],
+        "configurations": ["InputConfiguration", "input_configuration", "configuration_model",
+                           "identification_data"],
     },
 )

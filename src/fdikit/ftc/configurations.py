@@ -216,7 +216,7 @@ def input_configuration(name: str) -> InputConfiguration:
 
 
 def configuration_model(aircraft, trim, configuration: InputConfiguration, dt: float):
-    """Discrete linear model ``x⁺ = A x + B u``, ``y = C x`` of the aircraft at ``trim`` with the configuration's inputs.
+    """Discrete model ``x⁺ = A x + B u``, ``y = C x`` of the aircraft at ``trim`` with the configuration's inputs.
 
     Parameters
     ----------

@@ -1,4 +1,4 @@
-"""Fault-tolerant flight of JSBSim's B747: outer PIDs, closed-loop SPC and IMM-driven reconfiguration (Hallouzi 2008, §6.5).
+"""Fault-tolerant flight of JSBSim's B747: outer PIDs, closed-loop SPC, IMM-driven reconfiguration (Hallouzi §6.5).
 
 One flight: the B747 of :func:`fdikit.studies.hallouzi2008.b747_lip.lip_setup` (980 m, 92.6 m/s, flaps 20°,
 263 t; Dryden turbulence, Table 6.2 sensor noise ``"thesis_std"``) flies the §6.5.1 plan
@@ -41,7 +41,8 @@ import numpy as np
 
 from fdikit import validate
 
-__all__ = ["SCENARIOS", "BIJLMER", "WEIGHTS", "ALTITUDE_GAINS", "FORGETTING", "T_INJECT", "FtcSetup", "FtcRun", "ftc_setup", "fly_ftc", "scenario_fault"]
+__all__ = ["SCENARIOS", "BIJLMER", "WEIGHTS", "ALTITUDE_GAINS", "FORGETTING", "T_INJECT", "FtcSetup", "FtcRun",
+           "ftc_setup", "fly_ftc", "scenario_fault"]
 
 #: The §6.5 scenarios.
 SCENARIOS = ("nominal", "elevator", "rudder", "bijlmer")
@@ -152,6 +153,16 @@ class FtcRun:
     rcond : ndarray
         Reciprocal condition number of ``R11`` once per second.
     scenario, controller : str
+
+    Examples
+    --------
+    >>> run = fly_ftc(ftc_setup(calibration_seconds=30.0), "nominal", duration=20.0)  # doctest: +SKIP
+    >>> run.errors()["altitude_max"] < 20.0  # doctest: +SKIP
+    True
+
+    References
+    ----------
+    Hallouzi 2008, §6.5.
     """
 
     t: np.ndarray
@@ -235,8 +246,8 @@ def scenario_fault(scenario: str) -> list:
 
 
 def _origin(ac, trim, config, rng) -> _Origin:
-    from fdikit.ftc.configurations import SPC_OUTPUTS, configuration_model, identification_data
     from fdikit.aircraft.plant import STATES
+    from fdikit.ftc.configurations import SPC_OUTPUTS, configuration_model, identification_data
 
     A, B, C = configuration_model(ac, trim, config, _SPC_DT)
     std = [2.0 if n.startswith("engines") else 1.0 for n in config.inputs]
@@ -334,7 +345,7 @@ def _spc(origin, previous=None, forgetting=0.999):
 
 def fly_ftc(setup: FtcSetup, scenario: str = "nominal", *, controller: str = "spc", reconfigure: bool = True,
             duration: float = 300.0, seed: int = 0, forgetting: float = FORGETTING, adapt: str = "after_switch",
-            progress=None) -> FtcRun:
+            isolation: tuple | None = None, progress=None) -> FtcRun:
     """Fly the §6.5 plan with a fault scenario, by the FTC (SPC + IMM switching) or by the LQR autopilot.
 
     Parameters
@@ -355,6 +366,10 @@ def fly_ftc(setup: FtcSetup, scenario: str = "nominal", *, controller: str = "sp
         When the predictor is updated: only after a reconfiguration (default; the nominal predictor stays
         the identified one — see the module docstring), always (the thesis), or never. The Bijlmerramp
         always adapts (no FDI: adaptation is how the SPC learns the fault).
+    isolation : tuple of (str, float), optional
+        ``(model name, time)``: switch to that fault model's configuration at that time instead of running the
+        IMM (a known fault — to study the reconfiguration apart from the isolation); e.g.
+        ``("rudder_lip_+25", 22.0)``, the thesis's isolation time.
     progress : callable, optional
         Called with the simulated time every 10 s.
 
@@ -365,7 +380,7 @@ def fly_ftc(setup: FtcSetup, scenario: str = "nominal", *, controller: str = "sp
     Raises
     ------
     ParameterError
-        For an unknown scenario or controller.
+        For an unknown scenario, controller or isolation model.
 
     Examples
     --------
@@ -385,6 +400,8 @@ def fly_ftc(setup: FtcSetup, scenario: str = "nominal", *, controller: str = "sp
 
     faults = scenario_fault(scenario)
     validate.choice("controller", controller, ["spc", "autopilot"])
+    if isolation is not None:
+        validate.choice("isolation model", isolation[0], [k[1] for k in setup.origins if k[0] != "nominal"])
     duration = validate.positive("duration", duration)
     lip, ac = setup.lip, setup.lip.aircraft
     bijlmer = scenario == "bijlmer"   # unanticipated: the 6-input configuration, no FDI, always adapting
@@ -430,19 +447,24 @@ def fly_ftc(setup: FtcSetup, scenario: str = "nominal", *, controller: str = "sp
             ac.set_inputs(aileron=c["aileron"], elevator=c["elevator"], rudder=c["rudder"],
                           **dict.fromkeys(throttles, c["throttle"]))
         pos = healthy.update(ac.surface_commands(), t, ac.dt)
-        if controller == "spc" and not bijlmer:
-            u_imm = np.array([pos["aileron"], pos["elevator"], pos["stabilizer"], pos["rudder"],
-                              ac.thrust().sum(), 1.0])
-            mu = stepper.step(u_imm, y[idx]).mu
-            raw = str(logic.isolate(mu[None])[0]) if _trusted(t, plan, y, origin0) else "none"
-            label = persistence.step(raw)
-            if label is not None and declared is None and len(hist_y) == _P + 2:
-                member = max((i for i, m in enumerate(lip.models) if m.fault == label), key=lambda i: mu[i])
-                declared = (label, lip.models[member].name, t)
-                key = (label, lip.models[member].name)
+        if controller == "spc" and not bijlmer:   # the IMM runs on; only its first declaration acts
+            key = None
+            if isolation is None:
+                u_imm = np.array([pos["aileron"], pos["elevator"], pos["stabilizer"], pos["rudder"],
+                                  ac.thrust().sum(), 1.0])
+                mu = stepper.step(u_imm, y[idx]).mu
+                raw = str(logic.isolate(mu[None])[0]) if _trusted(t, plan, y, origin0) else "none"
+                label = persistence.step(raw)
+                if label is not None and declared is None and len(hist_y) == _P + 2:
+                    member = max((i for i, m in enumerate(lip.models) if m.fault == label), key=lambda i: mu[i])
+                    key = (label, lip.models[member].name)
+            elif declared is None and t >= isolation[1] and len(hist_y) == _P + 2:
+                key = next(k_ for k_ in setup.origins if k_[1] == isolation[0])
+            if key is not None:
+                declared = (*key, t)
                 if reconfigure and key in setup.origins:
                     origin = setup.origins[key]
-                    if label == "elevator":
+                    if key[0] == "elevator":
                         plan = plan.with_airspeed(t, plan.airspeed + _AIRSPEED_RAISE)
                     spc = _spc(origin, spc)
                     gains = ALTITUDE_GAINS[origin.config.name]

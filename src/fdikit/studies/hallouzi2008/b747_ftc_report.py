@@ -19,7 +19,6 @@ from __future__ import annotations
 import base64
 import html
 import io
-from pathlib import Path
 
 import numpy as np
 
@@ -57,6 +56,10 @@ def flight_summary(run, start: float) -> dict:
     --------
     >>> flight_summary.__name__
     'flight_summary'
+
+    References
+    ----------
+    Hallouzi 2008, §6.5.
     """
     from dataclasses import replace
 
