@@ -200,6 +200,7 @@ def test_ftc_command_flies_the_b747_and_resumes(tmp_path, monkeypatch):
     # The flights take minutes (docs/methods/ftc.md); here each is a small fake of the same structure, so the
     # files, the printed table and the resumption are checked.
     import fdikit.studies.hallouzi2008.b747_ftc as b747_ftc
+    import fdikit.studies.hallouzi2008.b747_ftc_flight as b747_ftc_flight
     from fdikit.studies.hallouzi2008.b747_ftc_report import FLIGHTS
 
     calls = []
@@ -209,7 +210,7 @@ def test_ftc_command_flies_the_b747_and_resumes(tmp_path, monkeypatch):
         return _fake_flight(scenario, controller)
 
     monkeypatch.setattr(b747_ftc, "ftc_setup", lambda **kw: object())
-    monkeypatch.setattr(b747_ftc, "fly_ftc", fly)
+    monkeypatch.setattr(b747_ftc_flight, "fly_ftc", fly)
     out = tmp_path / "ftc"
     res = runner.invoke(app, ["ftc", "--out", str(out), "--quick", "--no-msd", "--seed", "3"])
     assert res.exit_code == 0, res.output

@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from fdikit.errors import ParameterError
-from fdikit.studies.hallouzi2008.b747_ftc import T_INJECT, fly_ftc, ftc_setup, scenario_fault
+from fdikit.studies.hallouzi2008.b747_ftc import T_INJECT, ftc_setup, scenario_fault
+from fdikit.studies.hallouzi2008.b747_ftc_flight import fly_ftc
 
 
 @pytest.fixture(scope="module")

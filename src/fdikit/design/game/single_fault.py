@@ -257,10 +257,20 @@ def single_fault_game_filter(
         try:
             P = scipy.linalg.solve_continuous_are(A.T, C.T, W, np.linalg.inv(S))
         except (np.linalg.LinAlgError, ValueError) as exc:
-            raise DesignError(
-                f"the single-fault game Riccati equation for {name!r} has no stabilizing solution ({exc}); "
-                "check that (C, A) is detectable"
-            ) from exc
+            # scipy's symmetry test of the stable subspace can refuse a badly scaled equation under one BLAS
+            # kernel and accept it under another (the PATH game bank on the car: V ~ 1e-12, ‖H‖ ≈ 8e10, the
+            # spectrum 1.8 from the imaginary axis — 2e-11 of ‖H‖, yet 1e5 times the eps·‖H‖ a backward-stable
+            # eigensolver can misplace an eigenvalue by).  Retry with the Hamiltonian-Schur solver, its axis test
+            # at 1000·eps of the scaled norm and its own residual check (≤ 1e-8) guarding the result.
+            solver = "hamiltonian"
+            try:
+                P = solve_game_are(A.T, -C.T @ S @ C, W, axis_tol=1e3 * np.finfo(float).eps,
+                                   what=f"the single-fault game Riccati equation for {name!r}").X
+            except DesignError:
+                raise DesignError(
+                    f"the single-fault game Riccati equation for {name!r} has no stabilizing solution ({exc}); "
+                    "check that (C, A) is detectable"
+                ) from exc
     else:
         solver = "hamiltonian"
         P = solve_game_are(A.T, -C.T @ S @ C, W, what=f"the single-fault game Riccati equation for {name!r}").X

@@ -24,6 +24,10 @@ methods, Table 3.1 and the model-set comparison (Table 3.3), and the report comm
   persistency-of-excitation experiment (Hallouzi 2008, §5.4).
 * :mod:`fdikit.studies.hallouzi2008.report` — One command for the multiple-model reproductions of Hallouzi 2008
   (§2.4, §3.3.1, §3.6).
+* :mod:`fdikit.studies.hallouzi2008.b747_ftc` — The §6.5 fault-tolerant flights of the JSBSim B747: set-up,
+  scenarios, results (Hallouzi 2008, §6.4–§6.5).
+* :mod:`fdikit.studies.hallouzi2008.b747_ftc_flight` — One FTC flight in the §6.6 rate groups (IMM, SPC, plant).
+* :mod:`fdikit.studies.hallouzi2008.b747_ftc_report` — Files of the B747 part of ``fdikit ftc``.
 """
 
 import lazy_loader as lazy
@@ -67,6 +71,9 @@ __getattr__, __dir__, __all__ = lazy.attach(
             "Example31Result", "PAIRS", "example_3_1", "example_3_1_models",
         ],
         "spc_msd": ["LIMITS", "PE_SETTINGS", "run_msd_spc", "write_msd_ftc"],
+        "b747_ftc": ["SCENARIOS", "BIJLMER", "SPC_SETTINGS", "FtcSetup", "FtcRun", "ftc_setup", "scenario_fault"],
+        "b747_ftc_flight": ["fly_ftc"],
+        "b747_ftc_report": ["FLIGHTS", "THESIS_ISOLATION", "write_b747_ftc", "flight_summary"],
         "report": [
             "PARTS", "check_multiple_model_arguments", "multiple_model_report", "plot_b747", "plot_msd",
         ],

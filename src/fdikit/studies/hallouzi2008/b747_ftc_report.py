@@ -37,6 +37,7 @@ FLIGHTS = (
 THESIS_ISOLATION = {"elevator": 28.0, "rudder": 22.0}
 _PHASES = (("hold", 0.0, 75.0), ("turn", 75.0, 150.0), ("descent", 150.0, np.inf))
 _ARRAYS = ("t", "y", "reference", "surfaces", "throttles", "mu", "rcond", "step_seconds")
+_GROUPS = ("fdi", "spc", "plant")
 
 
 def flight_summary(run, start: float) -> dict:
@@ -64,7 +65,8 @@ def flight_summary(run, start: float) -> dict:
     from dataclasses import replace
 
     out = {"declared": list(run.declared) if run.declared else None, "lost": run.lost, "qp": run.qp,
-           "step_ms_median": float(np.median(run.step_seconds) * 1e3) if run.step_seconds.size else None}
+           "qp_ms_median": float(np.median(run.step_seconds) * 1e3) if run.step_seconds.size else None,
+           "timings": run.timings}
     for name, a, b in _PHASES:
         k = (run.t >= max(a, start)) & (run.t < b)
         if k.any():
@@ -150,6 +152,16 @@ def _table(summaries: dict) -> tuple[str, str]:
             md.append("| " + " | ".join(row) + " |")
             csv.append(",".join(c.replace(",", ";") for c in row))
             iso = lost = surf = ""
+    md += ["", "Real-time budget (§6.6): call times of the rate groups [ms], median / p99 (worst share of the period).",
+           "", "| flight | FDI, 100 Hz | SPC, 10 Hz | plant, 100 Hz | QP solve, median |", "|---|---|---|---|---|"]
+    for key, s in summaries.items():
+        cells = []
+        for g in _GROUPS:
+            t = (s.get("timings") or {}).get(g)
+            cells.append("—" if not t or not t.get("calls") else
+                         f"{1e3 * t['median']:.2f} / {1e3 * t['p99']:.2f} ({100 * t['budget_used']:.0f} %)")
+        qp = s.get("qp_ms_median")
+        md.append(f"| {key} | " + " | ".join(cells) + f" | {'—' if qp is None else f'{qp:.2f}'} |")
     return "\n".join(md) + "\n", "\n".join(csv) + "\n"
 
 
@@ -195,7 +207,8 @@ def write_b747_ftc(out_dir, *, quick: bool = False, seed: int = 1, fresh: bool =
     import matplotlib.pyplot as plt
 
     from fdikit.resume import RunStore
-    from fdikit.studies.hallouzi2008.b747_ftc import BIJLMER, T_INJECT, fly_ftc, ftc_setup
+    from fdikit.studies.hallouzi2008.b747_ftc import BIJLMER, T_INJECT, ftc_setup
+    from fdikit.studies.hallouzi2008.b747_ftc_flight import fly_ftc
 
     duration = 120.0 if quick else 300.0
     store = RunStore(out_dir, "ftc-b747", {"quick": quick, "seed": seed}, fresh=fresh)
@@ -239,13 +252,15 @@ def write_b747_ftc(out_dir, *, quick: bool = False, seed: int = 1, fresh: bool =
     md, csv = _table(summaries)
     images = "".join(f'<figure><img src="data:image/png;base64,{base64.b64encode(v).decode()}" width="820">'
                      f"<figcaption>{html.escape(k)}</figcaption></figure>" for k, v in files.items())
+    main = md.split("\n\n")[0].splitlines()
     rows = "".join("<tr>" + "".join(f"<td>{html.escape(c.strip())}</td>" for c in line.strip("|").split("|"))
-                   + "</tr>" for line in md.splitlines()[2:])
+                   + "</tr>" for line in main[2:])
     heads = "".join(f"<th>{html.escape(c.strip())}</th>" for c in md.splitlines()[0].strip("|").split("|"))
     page = ("<!doctype html><html><head><meta charset='utf-8'><title>fdikit: B747 fault-tolerant flights</title>"
             "<style>td,th{border:1px solid #ccc;padding:2px 6px;font-size:12px}</style></head><body>"
             f"<h1>Hallouzi 2008 §6.5 on JSBSim's B747</h1><p>{duration:.0f}-s flights, seed {seed}, Dryden "
             "turbulence, Table 6.2 sensor noise; see docs/methods/ftc.md.</p>"
-            f"<table><tr>{heads}</tr>{rows}</table>{images}</body></html>")
+            f"<table><tr>{heads}</tr>{rows}</table><pre>{html.escape(md.split(chr(10) * 2, 1)[1])}</pre>"
+            f"{images}</body></html>")
     store.publish({**files, "ftc_b747.csv": csv, "ftc_b747.md": md, "report.html": page})
     return summaries
