@@ -34,7 +34,7 @@ def test_elevator_lock_is_isolated_and_the_stabilizer_takes_over(setup):
     # The stabilizer moved (the SPC's pitch input now); the fixed autopilot cannot counter the lock's moment.
     assert np.ptp(ftc.surfaces[ftc.t > t_iso, 2]) > 0.5
     e, e_ap = window(ftc, 40.0), window(ap, 40.0)
-    assert e["pitch_rms"] < 8.0 < e_ap["pitch_rms"]               # 17 seeds: 0.2–5.6°; autopilot 10–11°
+    assert e["pitch_rms"] < 8.0 < e_ap["pitch_rms"]               # 17 seeds: 0.2–5.8°; autopilot 10–11°
     assert ftc.errors()["beta_rms"] < 3.0
     assert ftc.qp.get("solved", 0) >= 0.9 * sum(ftc.qp.values())
 

@@ -85,7 +85,7 @@ WEIGHTS = {
 #: and the default gains of :func:`fdikit.ftc.outer.outer_loops` drive a growing phugoid (±15° pitch).
 ALTITUDE_GAINS = {"nominal": (-0.05, -0.005, -0.3), "rudder": (-0.05, -0.005, -0.3), "elevator": (-0.01, -0.0005, -0.2),
                   "unanticipated": (-0.05, -0.005, -0.3)}
-_MODEL_GROUP = {"rudder": "rudder", "elevator": "elevator"}
+_RECONFIGURED = ("rudder", "elevator")   # the fault groups of model set II with a Table 6.1 configuration
 
 
 @dataclass
@@ -162,7 +162,7 @@ class FtcRun:
     step_seconds : ndarray
         Time of each SPC step [s].
     rcond : ndarray
-        Reciprocal condition number of ``R11`` once per second.
+        Reciprocal condition number of ``R11`` once per second (1-norm, LAPACK ``trcon`` estimate).
     scenario, controller : str
     timings : dict
         Per rate group (``fdi``, ``spc``, ``plant``) the :meth:`fdikit.ftc.multirate.RateGroup.timing`.
@@ -311,9 +311,9 @@ def ftc_setup(*, turbulence: int = 3, calibration_seconds: float = 300.0, seed: 
     trim = lip.nominal.linearization.trim
     origins = {("nominal", "nominal"): _origin(ac, trim, input_configuration("nominal"), rng)}
     for m in lip.models:
-        if m.fault in _MODEL_GROUP:
+        if m.fault in _RECONFIGURED:
             fault_trim = local_model(ac, m.fault, m.size).linearization.trim
-            origins[(m.fault, m.name)] = _origin(ac, fault_trim, input_configuration(_MODEL_GROUP[m.fault]), rng)
+            origins[(m.fault, m.name)] = _origin(ac, fault_trim, input_configuration(m.fault), rng)
     ac.restore(lip.start)
     cond = FlightCondition(BIJLMER["altitude"], BIJLMER["airspeed"], flaps=float(np.radians(BIJLMER["flaps"])),
                            mass=HALLOUZI_POINT.mass)
