@@ -81,7 +81,8 @@ class LQRAutopilot:
         Returns
         -------
         dict
-            Surface commands [rad], ``throttle_<i>``, and under ``"thrust"`` the thrust command [N].
+            Surface commands [rad], under ``"thrust"`` the thrust command [N] and under ``"throttle"`` the
+            throttle of every engine.
         """
         x_ref = self.x0
         if setpoint:
@@ -96,6 +97,27 @@ class LQRAutopilot:
         out = {name: self.u0[name] + d for name, d in zip(self.inputs, du, strict=True)}
         out["throttle"] = self.u0["throttle"] + (out["thrust"] - self.u0["thrust"]) / self.thrust_slope
         return out
+
+    def apply(self, aircraft, y, setpoint: Mapping | None = None) -> dict:
+        """Set the aircraft's surface and throttle commands from the sensors (:meth:`commands`).
+
+        Parameters
+        ----------
+        aircraft : JSBSimAircraft
+        y : array_like
+            Its sensors.
+        setpoint : mapping, optional
+            As for :meth:`commands`.
+
+        Returns
+        -------
+        dict
+            The commands (:meth:`commands`).
+        """
+        c = self.commands(y, setpoint)
+        aircraft.set_inputs(**{n: c[n] for n in self.inputs if n != "thrust"},
+                            **{f"throttle_{i + 1}": c["throttle"] for i in range(aircraft.engines)})
+        return c
 
 
 def lqr_autopilot(linearization, state_max: Mapping | None = None, input_max: Mapping | None = None,

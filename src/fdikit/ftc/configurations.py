@@ -55,7 +55,7 @@ SPC_OUTPUTS = (("roll", 180 / np.pi), ("pitch", 180 / np.pi), ("heading", 180 / 
 TABLE_6_2_NOISE = np.array([1.73e-4, 1.73e-4, 1.73e-4, 0.1, 1.73e-3, 1.73e-3, 0.1])
 #: Throttle rate limit [%/s] (not given by the thesis; see the module docstring).
 ENGINE_RATE = 10.0
-_ENGINES = {"engines": (1, 2, 3, 4), "engines_left": (1, 2), "engines_right": (3, 4)}
+_ENGINES = {"engines": [0, 1, 2, 3], "engines_left": [0, 1], "engines_right": [2, 3]}   # 0-based indices
 _SURFACES = ("aileron", "elevator", "stabilizer", "rudder")
 #: Table 6.1 on JSBSim's B747 (no spoilers): configuration → its SPC inputs.
 TABLE_6_1 = {
@@ -123,7 +123,7 @@ class InputConfiguration:
         out = {}
         for name, v in zip(self.inputs, u, strict=True):
             if name in _ENGINES:
-                thr[[e - 1 for e in _ENGINES[name]]] += v / 100.0
+                thr[_ENGINES[name]] += v / 100.0
             else:
                 out[name] = float(positions[name] + np.radians(v))
         out.update({f"throttle_{i + 1}": float(t) for i, t in enumerate(thr)})
@@ -144,7 +144,7 @@ class InputConfiguration:
         ndarray, shape (m,)
         """
         thr = np.asarray(throttles, dtype=float) - np.asarray(reference_throttles, dtype=float)
-        return np.array([100.0 * thr[[e - 1 for e in _ENGINES[n]]].mean() if n in _ENGINES
+        return np.array([100.0 * thr[_ENGINES[n]].mean() if n in _ENGINES
                          else np.degrees(positions[n] - reference_positions[n]) for n in self.inputs])
 
     def limits(self, positions, throttles, dt: float, surface_limits=None):
@@ -173,7 +173,7 @@ class InputConfiguration:
         lo, hi, rate = [], [], []
         for n in self.inputs:
             if n in _ENGINES:
-                t = float(np.mean([throttles[e - 1] for e in _ENGINES[n]]))
+                t = float(np.mean(np.asarray(throttles, dtype=float)[_ENGINES[n]]))
                 lo.append(-100.0 * t)
                 hi.append(100.0 * (1.0 - t))
                 rate.append(ENGINE_RATE * dt)
@@ -271,7 +271,7 @@ def configuration_model(aircraft, trim, configuration: InputConfiguration, dt: f
     def f(name: str, d: float) -> np.ndarray:
         pos, thr = dict(trim.positions), np.full(aircraft.engines, float(trim.throttle))
         if name in _ENGINES:
-            thr[[e - 1 for e in _ENGINES[name]]] += d / 100.0
+            thr[_ENGINES[name]] += d / 100.0
         else:
             pos[name] += np.radians(d)
         out = aircraft.derivatives(x0, pos, thr)

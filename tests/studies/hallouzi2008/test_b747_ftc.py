@@ -5,8 +5,6 @@ comparison bound lies between the ranges measured over seeds 11–27 for the rec
 fixed autopilot (docs/methods/ftc.md), not at one flight's value.
 """
 
-import dataclasses
-
 import numpy as np
 import pytest
 
@@ -20,11 +18,6 @@ def setup():
     return ftc_setup(calibration_seconds=60.0)
 
 
-def window(run, start):
-    k = run.t >= start
-    return dataclasses.replace(run, t=run.t[k], y=run.y[k], reference=run.reference[k]).errors()
-
-
 def test_elevator_lock_is_isolated_and_the_stabilizer_takes_over(setup):
     ftc = fly_ftc(setup, "elevator", duration=50.0, seed=1)
     ap = fly_ftc(setup, "elevator", controller="autopilot", duration=50.0, seed=1)
@@ -33,7 +26,7 @@ def test_elevator_lock_is_isolated_and_the_stabilizer_takes_over(setup):
     assert ftc.configuration[-1] == "elevator" and ftc.lost is None
     # The stabilizer moved (the SPC's pitch input now); the fixed autopilot cannot counter the lock's moment.
     assert np.ptp(ftc.surfaces[ftc.t > t_iso, 2]) > 0.5
-    e, e_ap = window(ftc, 40.0), window(ap, 40.0)
+    e, e_ap = ftc.errors(40.0), ap.errors(40.0)
     assert e["pitch_rms"] < 8.0 < e_ap["pitch_rms"]               # 17 seeds: 0.2–5.8°; autopilot 10–11°
     assert ftc.errors()["beta_rms"] < 3.0
     assert ftc.qp.get("solved", 0) >= 0.9 * sum(ftc.qp.values())
@@ -48,7 +41,7 @@ def test_rudder_runaway_reconfigured_keeps_the_heading(setup):
     left, right = ftc.throttles[-100:, 0].mean(), ftc.throttles[-100:, 2].mean()
     # +25° rudder yaws the nose left (JSBSim: ∂ṙ/∂δr < 0); the left engines push it back to the right
     assert left - right > 0.3
-    e, e_ap = window(ftc, 40.0), window(ap, 40.0)
+    e, e_ap = ftc.errors(40.0), ap.errors(40.0)
     assert e["heading_max"] < 30.0 < e_ap["heading_max"]          # 11 correct isolations: 7–22°; autopilot 44–66°
     assert ftc.lost is None
 
@@ -64,7 +57,7 @@ def test_rudder_runaway_is_declared_by_the_imm(setup):
 def test_bijlmerramp_flown_without_fdi(setup):
     run = fly_ftc(setup, "bijlmer", duration=35.0, seed=1)
     assert run.declared is None and set(run.configuration) == {"unanticipated"} and run.lost is None
-    e = window(run, 25.0)                                          # thesis: control regained after ≈ 15 s
+    e = run.errors(25.0)                                            # thesis: control regained after ≈ 15 s
     assert e["altitude_max"] < 60.0 and e["beta_rms"] < 3.0 and np.abs(run.y[run.t >= 25.0, 0]).max() < 15.0
 
 

@@ -59,7 +59,8 @@ __getattr__, __dir__, __all__ = lazy.attach(
             "model_set_i_logic", "noise_covariances", "run_table_4_6", "scenario_intervals", "simulate_table_4_6",
             "table_4_6_isolation",
         ],
-        "b747_lip": ["NOISE_PRESETS", "T_FAULT", "LipRun", "LipSetup", "false_alarm_rate", "fly_lip", "lip_setup"],
+        "b747_lip": ["NOISE_PRESETS", "T_FAULT", "LipRun", "LipSetup", "false_alarm_rate", "fly_lip", "imm_input",
+                     "lip_setup"],
         "table_4_8": [
             "FDIKIT_TABLE_4_8", "SWEEP_RANGES", "THESIS_TABLE_4_8", "LipRow", "Table48", "lock_positions", "table_4_8",
         ],

@@ -195,13 +195,13 @@ class FtcRun:
     controller: str
     timings: dict = field(default_factory=dict)
 
-    def errors(self, start: float = 0.0) -> dict:
-        """Tracking errors from ``start`` on: max ``|h − h_ref|``, max ``|ψ − ψ_ref|``, RMS ``θ, φ, β`` errors.
+    def errors(self, start: float = 0.0, end: float = np.inf) -> dict:
+        """Tracking errors over ``start ≤ t < end``: max ``|h − h_ref|``, max ``|ψ − ψ_ref|``, RMS ``θ, φ, β`` errors.
 
         Parameters
         ----------
-        start : float, optional
-            [s].
+        start, end : float, optional
+            [s] (default the whole flight).
 
         Returns
         -------
@@ -209,7 +209,7 @@ class FtcRun:
             ``altitude_max`` [m], ``heading_max`` [deg], ``pitch_rms``, ``roll_rms``, ``beta_rms`` [deg],
             ``airspeed_rms`` [m/s].
         """
-        k = self.t >= start
+        k = (self.t >= start) & (self.t < end)
         y, r = self.y[k], self.reference[k]
         dpsi = (y[:, 2] - r[:, 4] + 180.0) % 360.0 - 180.0
 

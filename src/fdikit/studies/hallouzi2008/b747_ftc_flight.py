@@ -34,6 +34,7 @@ from fdikit.studies.hallouzi2008.b747_ftc import (
     FtcRun,
     scenario_fault,
 )
+from fdikit.studies.hallouzi2008.b747_lip import imm_input
 
 __all__ = ["fly_ftc"]
 
@@ -131,18 +132,14 @@ class _Flight:
         y = self.y = ac.measure(self.lip.noise_std, self.rng)
         if self.controller == "autopilot":
             plan = self.plan
-            c = self.autopilot.commands(y, {"heading": plan.heading(t), "altitude": plan.altitude(t),
-                                            "true_airspeed": plan.airspeed_at(t)})
-            ac.set_inputs(aileron=c["aileron"], elevator=c["elevator"], rudder=c["rudder"],
-                          **dict.fromkeys(self.throttles, c["throttle"]))
+            self.autopilot.apply(ac, y, {"heading": plan.heading(t), "altitude": plan.altitude(t),
+                                         "true_airspeed": plan.airspeed_at(t)})
         pos = self.healthy.update(ac.surface_commands(), t, ac.dt)
         if self.controller != "spc" or self.bijlmer:
             return
         key, ready = None, self.declared is None and len(self.hist) == self.hist.maxlen
         if self.isolation is None:                     # the IMM runs on; only its first declaration acts
-            u_imm = np.array([pos["aileron"], pos["elevator"], pos["stabilizer"], pos["rudder"], ac.thrust().sum(),
-                              1.0])
-            self.mu = self.stepper.step(u_imm, y[self.imm_idx]).mu
+            self.mu = self.stepper.step(imm_input(ac, pos), y[self.imm_idx]).mu
             raw = str(self.logic.isolate(self.mu[None])[0]) if self._trusted(t, y) else "none"
             label = self.persistence.step(raw)
             if label is not None and ready:

@@ -62,15 +62,12 @@ def flight_summary(run, start: float) -> dict:
     ----------
     Hallouzi 2008, §6.5.
     """
-    from dataclasses import replace
-
     out = {"declared": list(run.declared) if run.declared else None, "lost": run.lost, "qp": run.qp,
            "qp_ms_median": float(np.median(run.step_seconds) * 1e3) if run.step_seconds.size else None,
            "timings": run.timings}
     for name, a, b in _PHASES:
-        k = (run.t >= max(a, start)) & (run.t < b)
-        if k.any():
-            out[name] = replace(run, t=run.t[k], y=run.y[k], reference=run.reference[k]).errors()
+        if np.any((run.t >= max(a, start)) & (run.t < b)):
+            out[name] = run.errors(max(a, start), b)
     out["surface_max"] = dict(zip(("aileron", "elevator", "stabilizer", "rudder"),
                                   np.max(np.abs(run.surfaces), axis=0).round(2).tolist(), strict=True))
     return out

@@ -50,7 +50,7 @@ import numpy as np
 from fdikit import validate
 from fdikit.studies.hallouzi2008.table_4_6 import R_S_THESIS
 
-__all__ = ["NOISE_PRESETS", "T_FAULT", "LipSetup", "LipRun", "lip_setup", "fly_lip", "false_alarm_rate"]
+__all__ = ["NOISE_PRESETS", "T_FAULT", "LipSetup", "LipRun", "lip_setup", "fly_lip", "false_alarm_rate", "imm_input"]
 
 #: Injection time [s] (§4.4.2).
 T_FAULT = 20.0
@@ -230,18 +230,41 @@ def _fly(setup, seconds: float, seed: int, fault=None, record_states: bool = Fal
     healthy = ActuatorBank(ac.actuators.limits)
     healthy.restore(ac.actuators.snapshot())
     rng = np.random.default_rng(seed)
-    ap = setup.autopilot
-    throttles = [f"throttle_{i + 1}" for i in range(ac.engines)]
     for _ in range(int(round(seconds / ac.dt))):
         t = ac.time
         y = ac.measure(setup.noise_std, rng)
-        c = ap.commands(y)
-        ac.set_inputs(aileron=c["aileron"], elevator=c["elevator"], rudder=c["rudder"],
-                      **dict.fromkeys(throttles, c["throttle"]))
-        pos = healthy.update(ac.surface_commands(), t, ac.dt)
-        u = np.array([pos["aileron"], pos["elevator"], pos["stabilizer"], pos["rudder"], ac.thrust().sum(), 1.0])
+        setup.autopilot.apply(ac, y)
+        u = imm_input(ac, healthy.update(ac.surface_commands(), t, ac.dt))
         yield t, y, u, (ac.state() if record_states else None)
         ac.step()
+
+
+def imm_input(aircraft, positions) -> np.ndarray:
+    """The input of the model-set-II models: the deflections ``aileron, elevator, stabilizer, rudder`` [rad],
+    the total thrust [N] and 1 (the trim offsets' column).
+
+    Parameters
+    ----------
+    aircraft : JSBSimAircraft
+        For the thrust.
+    positions : mapping
+        Surface deflections [rad], those of a fault-free actuator copy on the commands (see ``_fly``).
+
+    Returns
+    -------
+    ndarray, shape (6,)
+
+    Examples
+    --------
+    >>> imm_input.__name__
+    'imm_input'
+
+    References
+    ----------
+    Hallouzi 2008, §4.2, (4.1)–(4.2).
+    """
+    p = positions
+    return np.array([p["aileron"], p["elevator"], p["stabilizer"], p["rudder"], aircraft.thrust().sum(), 1.0])
 
 
 def identify_process_noise(setup, seconds: float, seed: int) -> np.ndarray:
