@@ -26,6 +26,15 @@ console = Console()
 err_console = Console(stderr=True)
 
 
+def _campaign_commands() -> None:
+    from fdikit.cli_campaign import campaign_app
+
+    app.add_typer(campaign_app, name="campaign")
+
+
+_campaign_commands()
+
+
 def _fail(exc: Exception) -> None:
     """Print ``error: <message>`` (unwrapped, no markup) on stderr and exit with code 2."""
     err_console.print("[red]error:[/red] ", end="")

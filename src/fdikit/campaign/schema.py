@@ -57,7 +57,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
 
-__all__ = ["SCHEMA", "COLUMNS", "empty_table", "table_from_rows"]
+__all__ = ["SCHEMA", "COLUMNS", "empty_table", "table_from_rows"]  # noqa: F822 - SCHEMA is built lazily (pyarrow)
 
 
 def _schema():
