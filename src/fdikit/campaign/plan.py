@@ -73,20 +73,23 @@ def _rng(spec: CampaignSpec, k: int):
     return np.random.default_rng(np.random.SeedSequence(spec.seed, spawn_key=(k,)))
 
 
-def _targets(spec: CampaignSpec, fam, plant) -> list[str]:
+def _targets(spec: CampaignSpec) -> dict[tuple[int, int], list[str]]:
+    """(plant index, fault family index) → the family's targets on that plant."""
     from fdikit.campaign.studies import get_study
 
-    known = get_study(spec.study).fault_names(plant, fam.kind)
-    return list(known) if fam.targets == "all" else list(fam.targets)
+    study = get_study(spec.study)
+    return {(i, j): list(study.fault_names(plant, fam.kind)) if fam.targets == "all" else list(fam.targets)
+            for i, plant in enumerate(spec.plants) for j, fam in enumerate(spec.faults)}
 
 
 def _cells(spec: CampaignSpec) -> list[tuple]:
-    """Grid cells ``(plant, fault, kind, size or None, onset or None)`` in plan order."""
+    """Grid cells ``(plant, fault, kind, size or None, onset or None, family)`` in plan order."""
+    targets = _targets(spec)
     cells = []
-    for plant in spec.plants:
+    for i, plant in enumerate(spec.plants):
         cells += [(plant.name, NO_FAULT, NO_FAULT, math.nan, math.nan)] * int(spec.healthy)
-        for fam in spec.faults:
-            for target in _targets(spec, fam, plant):
+        for j, fam in enumerate(spec.faults):
+            for target in targets[(i, j)]:
                 for size in fam.size.grid:
                     for onset in fam.onset.grid:
                         cells += [(plant.name, target, fam.kind, size, onset, fam)] * spec.sampling.grid.repeats
@@ -100,14 +103,15 @@ def _finish(spec: CampaignSpec, k: int, rng, plant, fault, kind, size, onset, fa
     return RunPlan(k, k // spec.chunk_size, plant, fault, kind, size, onset, int(rng.integers(2**63)))
 
 
-def _random_run(spec: CampaignSpec, k: int) -> RunPlan:
+def _random_run(spec: CampaignSpec, k: int, targets: dict) -> RunPlan:
     rng = _rng(spec, k)
-    plant = spec.plants[int(rng.integers(len(spec.plants)))]
+    i = int(rng.integers(len(spec.plants)))
+    plant = spec.plants[i]
     if not spec.faults or rng.random() < spec.healthy:
         return _finish(spec, k, rng, plant.name, NO_FAULT, NO_FAULT, math.nan, math.nan)
-    fam = spec.faults[int(rng.integers(len(spec.faults)))]
-    targets = _targets(spec, fam, plant)
-    target = targets[int(rng.integers(len(targets)))]
+    j = int(rng.integers(len(spec.faults)))
+    fam = spec.faults[j]
+    target = targets[(i, j)][int(rng.integers(len(targets[(i, j)])))]
     return _finish(spec, k, rng, plant.name, target, fam.kind, None, None, fam)
 
 
@@ -136,7 +140,8 @@ def plan_runs(spec: CampaignSpec) -> list[RunPlan]:
     (True, True)
     """
     if spec.sampling.random is not None:
-        return [_random_run(spec, k) for k in range(spec.sampling.random.runs)]
+        targets = _targets(spec)
+        return [_random_run(spec, k, targets) for k in range(spec.sampling.random.runs)]
     return [_finish(spec, k, _rng(spec, k), *cell) for k, cell in enumerate(_cells(spec))]
 
 
@@ -173,7 +178,7 @@ def plan_run(spec: CampaignSpec, run: int) -> RunPlan:
         n = spec.sampling.random.runs
         if not 0 <= run < n:
             raise ParameterError(f"run {run} is not in the campaign: it has {n} runs (0 to {n - 1})")
-        return _random_run(spec, run)
+        return _random_run(spec, run, _targets(spec))
     cells = _cells(spec)
     if not 0 <= run < len(cells):
         raise ParameterError(f"run {run} is not in the campaign: it has {len(cells)} runs (0 to {len(cells) - 1})")

@@ -60,16 +60,16 @@ class PathLinearStudy:
     Examples
     --------
     >>> PATH_LINEAR.fault_names(None, "bias")[:2]
-    ('air_mass_sensor', 'engine_speed_sensor')
+    ('throttle_actuator', 'brake_actuator')
     """
 
     name = "path-linear"
 
     def fault_names(self, plant, kind: str) -> tuple[str, ...]:
-        """The 15 fault names of §5.1.1 (any plant, any kind)."""
-        from fdikit.studies.path1996.bank import nominal_fault_sizes
+        """The 15 fault inputs of the App. D model, as §5.1.1 lists them (any plant, any kind)."""
+        from fdikit.studies.path1996.bank import path_fault_model
 
-        return tuple(nominal_fault_sizes())
+        return tuple(path_fault_model(14).faults)
 
     def check(self, spec) -> list[str]:
         """Problems with the spec's plant parameters, fault kinds and targets, designs and evaluators."""
