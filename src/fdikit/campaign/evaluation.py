@@ -168,12 +168,14 @@ def evaluate_runs(runs, traces, residuals: Mapping[str, np.ndarray], names: Mapp
     from fdikit.residuals import Residuals
 
     t = traces[0].t
-    onsets = np.array([np.nan if p.healthy else p.onset for p in runs])
+    # the onset as fdikit.metrics.score takes it: the time of the first faulty sample
+    onsets = np.array([t[np.argmax(tr.fault != "none")] if (tr.fault != "none").any() else np.nan for tr in traces])
     out: dict[tuple, list] = {}
     for (design, ev_name), ev in evaluators.items():
         r = residuals[design]
         stat = (threshold_batch if isinstance(ev, ThresholdEvaluator) else cusum_batch)(ev, r).statistic
-        delays, fas = crossings(stat, t, onsets, levels)
+        cross = crossings(stat, t, onsets, levels=levels)
+        delays, fas = cross.delay, cross.upcrossings
         for i, (plan, trace) in enumerate(zip(runs, traces)):
             res = Residuals(t, r[i], names[design], isolates[design])
             s = score(trace, ev.run(res))

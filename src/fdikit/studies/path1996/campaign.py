@@ -191,9 +191,9 @@ class PathLinearStudy:
             residuals, names, isolates = {}, {}, {}
             for design, (gen, _) in plant.designs.items():
                 residuals[design] = run_generator_batch(gen, traces)
-                names[design], isolates[design] = gen.residuals, gen.isolates
-            evaluators = {k: v for k, v in plant.evaluators.items()}
-            rows += evaluate_runs(mine, traces, residuals, names, isolates, evaluators, levels)
+                names[design] = gen.residuals
+                isolates[design] = gen.isolates or (None,) * len(gen.residuals)
+            rows += evaluate_runs(mine, traces, residuals, names, isolates, plant.evaluators, levels)
         order = {r.run: i for i, r in enumerate(runs)}
         return sorted(rows, key=lambda row: order[row["run"]])
 
