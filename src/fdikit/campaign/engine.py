@@ -81,6 +81,26 @@ def _setup(spec: CampaignSpec, fingerprint: str):
     return study, _SETUPS[fingerprint]
 
 
+class _numba_threads:  # noqa: N801 - a context manager used like threadpool_limits
+    """Limit numba's parallel kernels (:mod:`fdikit.batch`) to ``n`` threads: one worker, one core."""
+
+    def __init__(self, n: int) -> None:
+        self.n, self.old = n, None
+
+    def __enter__(self):
+        import numba
+
+        self.old = numba.get_num_threads()
+        numba.set_num_threads(self.n)
+        return self
+
+    def __exit__(self, *exc) -> bool:
+        import numba
+
+        numba.set_num_threads(self.old)
+        return False
+
+
 def compute_chunk(spec_json: str, chunk: int) -> bytes:
     """Compute one chunk of a campaign and return its Parquet bytes (what a worker runs).
 
@@ -104,7 +124,7 @@ def compute_chunk(spec_json: str, chunk: int) -> bytes:
 
     spec = CampaignSpec.model_validate_json(spec_json)
     fingerprint = spec_fingerprint(spec)
-    with threadpool_limits(1):
+    with threadpool_limits(1), _numba_threads(1):
         runs = chunks(_plan(spec, fingerprint))[chunk]
         study, setup = _setup(spec, fingerprint)
         rows = study.run_chunk(setup, spec, runs, sweep_levels(spec.sweep))

@@ -23,6 +23,11 @@ __all__ = ["Study", "STUDIES", "get_study", "check_spec", "shipped_specs"]
 #: Registered studies: name → ``"module:attribute"`` of the study object.
 STUDIES = {
     "path-linear": "fdikit.studies.path1996.campaign:PATH_LINEAR",
+    "path-nonlinear": "fdikit.studies.path1996.nonlinear_campaign:PATH_NONLINEAR",
+    "target-tracking": "fdikit.studies.hallouzi2008.tracking_campaign:TARGET_TRACKING",
+    "multiple-model": "fdikit.studies.hallouzi2008.multiple_model_campaign:MULTIPLE_MODEL",
+    "b747-lip": "fdikit.studies.hallouzi2008.b747_campaign:B747_LIP",
+    "b747-ftc": "fdikit.studies.hallouzi2008.ftc_campaign:B747_FTC",
 }
 
 
@@ -79,10 +84,10 @@ def get_study(name: str) -> Study:
     --------
     >>> get_study("path-linear").name
     'path-linear'
-    >>> get_study("nope")
+    >>> get_study("nope")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    fdikit.errors.ParameterError: study 'nope' is not registered (path-linear) and is not 'package.module:attribute'
+    fdikit.errors.ParameterError: study 'nope' is not registered (path-linear, ...) and is not 'package.module:attribute'
     """
     target = STUDIES.get(name, name)
     if ":" not in target:
