@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import argparse
 import base64
+import fcntl
 import json
 import os
 import select
@@ -37,6 +38,11 @@ import time
 from pathlib import Path
 
 INSTALL = "install it with `apt-get update && apt-get install -y chromium` (Debian package chromium)"
+
+
+#: Run in the child: fd argv[1] → 3, fd argv[2] → 4 (both inheritable), then exec argv[3:].
+_TRAMPOLINE = ("import os, sys; os.dup2(int(sys.argv[1]), 3); os.dup2(int(sys.argv[2]), 4); "
+               "os.execv(sys.argv[3], sys.argv[3:])")
 
 
 class BrowserError(RuntimeError):
@@ -141,6 +147,13 @@ def blank_fraction(png: bytes) -> float:
     return float(np.bincount(np.unique(codes, return_inverse=True)[1]).max() / codes.size)
 
 
+def _high_fd(fd: int) -> int:
+    """A copy of ``fd`` numbered 100 or more (close-on-exec); ``fd`` is closed."""
+    high = fcntl.fcntl(fd, fcntl.F_DUPFD_CLOEXEC, 100)
+    os.close(fd)
+    return high
+
+
 def check_page(page: str | Path, screenshot: str | Path | None = None, width: int = 1280, height: int = 2000,
                blank: float = 0.995, timeout: float = 60.0, chromium: str | None = None) -> list[str]:
     """Load ``page`` in headless Chromium; the list of problems (empty when the page passed).
@@ -153,14 +166,16 @@ def check_page(page: str | Path, screenshot: str | Path | None = None, width: in
     binary = find_chromium(chromium)
     to_chrome_r, to_chrome_w = os.pipe()
     from_chrome_r, from_chrome_w = os.pipe()
+    to_chrome_r, from_chrome_w = _high_fd(to_chrome_r), _high_fd(from_chrome_w)  # so dup2 to 3, 4 is safe
     with tempfile.TemporaryDirectory(prefix="browser-check-") as profile:
         args = [binary, "--headless", "--no-sandbox", "--disable-gpu", "--remote-debugging-pipe",
                 "--no-first-run", "--no-default-browser-check", "--disable-extensions",
                 f"--user-data-dir={profile}", f"--window-size={width},{height}", "about:blank"]
 
-        # The child reads commands on fd 3 and writes replies on fd 4: a shell moves the pipe ends there and
-        # execs Chromium (a preexec_fn cannot: subprocess closes fds after it runs).
-        wrapper = ["sh", "-c", f'exec "$0" "$@" 3<&{to_chrome_r} 4>&{from_chrome_w}', *args]
+        # The child reads commands on fd 3 and writes replies on fd 4: a tiny Python trampoline moves the pipe
+        # ends there and execs Chromium (a preexec_fn cannot: subprocess closes other fds after it runs; dash
+        # refuses fd numbers above 9 in redirections).
+        wrapper = [sys.executable, "-c", _TRAMPOLINE, str(to_chrome_r), str(from_chrome_w), *args]
         try:
             proc = subprocess.Popen(wrapper, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                                     stderr=subprocess.DEVNULL, pass_fds=(to_chrome_r, from_chrome_w))
@@ -180,7 +195,7 @@ def check_page(page: str | Path, screenshot: str | Path | None = None, width: in
             cdp.send("Page.navigate", {"url": page.as_uri()}, session=session)
             if not cdp.wait_for("Page.loadEventFired", timeout):
                 raise BrowserError(f"{page} did not finish loading within {timeout:g} s")
-            cdp.drain(0.5)  # errors raised just after the load event (timers, late scripts)
+            cdp.drain(0.3)  # errors raised just after the load event (timers, late scripts)
             shot = cdp.send("Page.captureScreenshot", {"format": "png"}, session=session)
             png = base64.b64decode(shot["data"])
             cdp.drain(0.1)

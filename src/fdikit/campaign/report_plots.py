@@ -317,6 +317,7 @@ def example_trace_figure(residuals, diagnosis, onset: float | None = None, title
     tau = np.asarray(tau, float) if tau is not None and np.size(tau) == q else None
     residuals.plot(ax=list(axes[:-1]), diagnosis=diagnosis if diagnosis.fired.shape[1] == q else None,
                    thresholds=tau, onset=onset, names=shown)
+    axes[-2].set_xlabel("")
     diagnosis.plot(ax=axes[-1])
     for ax in axes:
         for a in diagnosis.alarms:
