@@ -293,8 +293,9 @@ def isolate(
             for key in keys
         ])
         single = per.sum(axis=1) == 1
-        name = np.array(keys, dtype=object)[per.argmax(axis=1)]
-        vote = single & np.array([not str(x).startswith("?") for x in name])
+        which = per.argmax(axis=1)
+        name = np.array(keys, dtype=object)[which]
+        vote = single & ~np.array([key.startswith("?") for key in keys])[which]  # per key, not per sample
         unknown_vote = single & ~vote
         conflict |= unknown_vote | (vote & (candidate != "") & (candidate != name))
         candidate = np.where(vote & (candidate == ""), name, candidate)
