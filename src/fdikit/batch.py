@@ -35,12 +35,11 @@ __all__ = ["BatchDecision", "LevelCrossings", "crossings", "cusum_batch", "dlsim
 
 _METHODS = ("numba", "blas")
 _REBASE = 4096  # the CUSUM's rebase period, as in fdikit.decision.cusum (its run and step rebase alike)
-_CHUNK = 1 << 16  # elements per chunk of the window and CUSUM passes (stays in cache)
 _KERNEL: list = []
 
 
-def _lti_kernel():
-    """The compiled batch recursion (numba, parallel over runs; compiled once, cached on disk)."""
+def _kernels():
+    """The compiled kernels: LTI recursion, threshold window, CUSUM (numba, parallel over runs; cached on disk)."""
     if not _KERNEL:
         import numba
         prange = numba.prange
@@ -69,8 +68,60 @@ def _lti_kernel():
                         x[i] = out[i]
                 x_end[r] = x
 
-        _KERNEL.append(lti)
-    return _KERNEL[0]
+        @numba.njit(parallel=True, cache=True, nogil=True)
+        def threshold(r, c, tau, k, n, fired, stat, alarm):  # pragma: no cover - compiled
+            R, N, q = r.shape
+            for run in prange(R):
+                win, top, v = np.zeros((n, q)), np.empty((k, q)), np.empty(q)  # win: a = |r − c| / τ, last n
+                for t in range(N):
+                    for i in range(q):
+                        win[t % n, i] = abs(r[run, t, i] - c[i]) / tau[i]
+                    top[:] = 0.0  # the k largest of the window, by an insertion network (0 while fewer than k)
+                    for j in range(min(n, t + 1)):
+                        v[:] = win[j]
+                        for s in range(k):
+                            for i in range(q):
+                                hi = max(top[s, i], v[i])
+                                v[i] = min(top[s, i], v[i])
+                                top[s, i] = hi
+                    best = 0.0
+                    for i in range(q):
+                        fired[run, t, i] = top[k - 1, i] > 1.0
+                        best = max(best, top[k - 1, i])
+                    stat[run, t], alarm[run, t] = best, best > 1.0
+
+        @numba.njit(parallel=True, cache=True, nogil=True)
+        def cusum(r, mu, sd, nu, h, two, hold, fired, stat, alarm):  # pragma: no cover - compiled
+            R, N, q = r.shape
+            for run in prange(R):
+                sp, mp, sm, mm = np.zeros(q), np.zeros(q), np.zeros(q), np.zeros(q)
+                left = np.zeros(q, np.int64)
+                for t in range(N):
+                    rebase = (t + 1) % _REBASE == 0
+                    best, any_fired = 0.0, False
+                    for i in range(q):  # the evaluator's operations, in its order (S += x, M = min, g = S − M)
+                        s = (r[run, t, i] - mu[i]) / sd[i]
+                        sp[i] += s - nu[i]
+                        mp[i] = min(mp[i], sp[i])
+                        g = sp[i] - mp[i]
+                        if rebase:
+                            sp[i], mp[i] = g, 0.0
+                        if two:
+                            sm[i] += (-s) - nu[i]
+                            mm[i] = min(mm[i], sm[i])
+                            gm = sm[i] - mm[i]
+                            if rebase:
+                                sm[i], mm[i] = gm, 0.0
+                            g = max(g, gm)
+                        z = g / h[i]  # > 1 exactly when g > h (correctly rounded division)
+                        fired[run, t, i] = z > 1.0 or left[i] > 0
+                        any_fired = any_fired or fired[run, t, i]
+                        left[i] = hold if z > 1.0 else max(left[i] - 1, 0)
+                        best = max(best, z)
+                    stat[run, t], alarm[run, t] = best, any_fired
+
+        _KERNEL.extend([lti, threshold, cusum])
+    return _KERNEL
 
 
 def _runs_array(name: str, value, ndim: int, what: str) -> np.ndarray:
@@ -108,7 +159,7 @@ def _simulate(A, B, C, D, u, x0, offset, method) -> tuple[np.ndarray, np.ndarray
     if method == "numba":
         y, x_end = np.empty((R, N, p)), np.empty((R, n))
         Mt = np.ascontiguousarray(np.block([[A, B], [C, D]]).T)
-        _lti_kernel()(Mt, u, np.ascontiguousarray(offset, dtype=float), x0, y, x_end)
+        _kernels()[0](Mt, u, np.array(offset, dtype=float), x0, y, x_end)
     else:
         _finite_or_raise(u, offset, np.zeros((R, 0)))
         w = u.reshape(R * N, m) - offset if np.any(offset) else u.reshape(R * N, m)
@@ -268,18 +319,15 @@ def run_generator_batch(generator: ResidualGenerator, data, x0=None, *, method: 
     """
     if not isinstance(generator, ResidualGenerator):
         raise ParameterError(f"generator must be a fdikit.residuals.ResidualGenerator, got {type(generator).__name__}")
-    g = generator
+    g, nv = generator, len(generator.signals)
     if isinstance(data, Sequence) and not isinstance(data, str | bytes) and data and isinstance(data[0], Trace):
         g, v = _stack(generator, data)
-    else:
-        if g.dt is None:
-            raise ParameterError("the generator is continuous (dt=None): discretise it first with "
-                                 "generator.discretize(dt), or pass traces (their sample time is used)")
-        nv = len(g.signals)
-        v = _runs_array("data", data, 3, f"(runs, samples, {nv} signals {list(g.signals)})")
-        if v.shape[2] != nv:
-            raise DataError(f"data has {v.shape[2]} signals (last axis, shape {v.shape}); the generator reads {nv}: "
-                            f"{list(g.signals)} (controls then outputs)")
+    elif g.dt is None:
+        raise ParameterError("the generator is continuous (dt=None): discretise it first with "
+                             "generator.discretize(dt), or pass traces (their sample time is used)")
+    elif (v := _runs_array("data", data, 3, f"(runs, samples, {nv} signals {list(g.signals)})")).shape[2] != nv:
+        raise DataError(f"data has {v.shape[2]} signals (last axis, shape {v.shape}); the generator reads {nv}: "
+                        f"{list(g.signals)} (controls then outputs)")
     r, x_end = _simulate(g.A, g.B, g.C, g.D, v, x0, g.offset, method)
     return (r, x_end) if return_state else r
 
@@ -330,16 +378,11 @@ def _residuals(r, names, what: str) -> np.ndarray:
 
 def _per_residual(name: str, value, q: int, default: float) -> np.ndarray:
     if value is None:
-        return np.full(q, default)
+        return np.full(q, float(default))
     arr = np.atleast_1d(np.asarray(value, dtype=float))
     if arr.size not in (1, q):
         raise DataError(f"{arr.size} {name} values for {q} residuals")
     return np.array(np.broadcast_to(arr, (q,)))
-
-
-def _chunks(R: int, per_run: int):
-    step = max(1, _CHUNK // max(per_run, 1))
-    return [slice(a, min(R, a + step)) for a in range(0, R, step)]
 
 
 def threshold_batch(evaluator, r) -> BatchDecision:
@@ -390,25 +433,9 @@ def threshold_batch(evaluator, r) -> BatchDecision:
     R, N, q = r.shape
     tau, c = _per_residual("thresholds", evaluator.thresholds, q, 1.0), _per_residual("center", evaluator.center, q, 0)
     kp, n_p = evaluator.persistence
-    top = np.empty_like(r)
-    for sl in _chunks(R, N * q):
-        a = np.abs(r[sl] - c) / tau  # a_i > 1 exactly when |r_i − c_i| > τ_i (correctly rounded division)
-        top[sl] = a if n_p == 1 else _kth_largest(a, kp, n_p)
-    fired = top > 1.0
-    return BatchDecision(fired.any(axis=2), fired, top.max(axis=2, initial=0.0), evaluator.names)
-
-
-def _kth_largest(a: np.ndarray, k: int, n: int) -> np.ndarray:
-    """The k-th largest of the last ``n`` samples (axis 1) of ``a ≥ 0``, the missing ones taken as 0."""
-    top = [np.zeros_like(a) for _ in range(k)]  # top[0] >= top[1] >= ... (an insertion network)
-    for lag in range(n):
-        v = np.zeros_like(a)
-        v[:, lag:] = a[:, : a.shape[1] - lag]
-        for j in range(k):
-            hi = np.maximum(top[j], v)
-            np.minimum(top[j], v, out=v)
-            top[j] = hi
-    return top[k - 1]
+    fired, stat, alarm = np.empty((R, N, q), bool), np.empty((R, N)), np.empty((R, N), bool)
+    _kernels()[1](r, c, tau, kp, n_p, fired, stat, alarm)
+    return BatchDecision(alarm, fired, stat, evaluator.names)
 
 
 def cusum_batch(evaluator, r) -> BatchDecision:
@@ -463,36 +490,9 @@ def cusum_batch(evaluator, r) -> BatchDecision:
     R, N, q = r.shape
     nu, h = (_per_residual(nm, getattr(evaluator, nm), q, 1.0) for nm in ("drift", "threshold"))
     mu, sd = _per_residual("mean", evaluator.mean, q, 0.0), _per_residual("sigma", evaluator.sigma, q, 1.0)
-    g = np.empty_like(r)
-    for sl in _chunks(R, N * q):
-        s = (r[sl] - mu) / sd  # the evaluator's operations, in its order
-        gs = _page_batch(s - nu)
-        if evaluator.two_sided:
-            np.maximum(gs, _page_batch((-s) - nu), out=gs)
-        g[sl] = gs / h  # g_i / h_i > 1 exactly when g_i > h_i
-    fired = _held(g > 1.0, evaluator.hold) if evaluator.hold else g > 1.0
-    return BatchDecision(fired.any(axis=2), fired, g.max(axis=2, initial=0.0), evaluator.names)  # g ≥ 0
-
-
-def _page_batch(x: np.ndarray) -> np.ndarray:
-    """Non-resetting Page statistic along axis 1: ``g = S − min(0, min S)``, ``S ← g`` every 4096 samples."""
-    g = np.empty_like(x)
-    start = np.zeros(x.shape[:1] + x.shape[2:])
-    for a in range(0, x.shape[1], _REBASE):
-        seg = x[:, a : a + _REBASE]
-        S = np.add.accumulate(np.concatenate([start[:, None], seg], axis=1), axis=1)[:, 1:]
-        M = np.minimum.accumulate(np.concatenate([np.zeros_like(start)[:, None], S], axis=1), axis=1)[:, 1:]
-        g[:, a : a + _REBASE] = S - M
-        start = g[:, a + seg.shape[1] - 1]
-    return g
-
-
-def _held(e: np.ndarray, hold: int) -> np.ndarray:
-    """True where ``e`` was True at this sample or one of the ``hold`` before (axis 1)."""
-    c = np.cumsum(e, axis=1, dtype=np.int64)
-    out = c.copy()
-    out[:, hold + 1 :] -= c[:, : -(hold + 1)]
-    return out > 0
+    fired, stat, alarm = np.empty((R, N, q), bool), np.empty((R, N)), np.empty((R, N), bool)
+    _kernels()[2](r, mu, sd, nu, h, evaluator.two_sided, evaluator.hold, fired, stat, alarm)
+    return BatchDecision(alarm, fired, stat, evaluator.names)
 
 
 @dataclass(frozen=True)
