@@ -78,6 +78,24 @@ def test_bit_identical_across_workers_and_backends(reference, tmp_path, workers,
     assert _digests(tmp_path) == _digests(folder)
 
 
+def test_dask_cluster_by_address(reference, tmp_path):
+    """--scheduler ADDRESS: a cluster started elsewhere (here a LocalCluster of the test) computes the same bytes."""
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster:
+        messages = []
+        done = run_campaign(load_campaign(SPEC), tmp_path, scheduler=cluster.scheduler_address, say=messages.append)
+    assert done.backend == "dask" and done.workers == 2
+    assert any(m.startswith("Dask dashboard: http") for m in messages)
+    assert _digests(tmp_path) == _digests(reference[0])
+
+
+def test_unreachable_scheduler(tmp_path, monkeypatch):
+    monkeypatch.setattr("fdikit.campaign.engine.CONNECT_TIMEOUT", "1s")
+    with pytest.raises(ParameterError, match=r"scheduler \(--scheduler\): cannot connect to tcp://127.0.0.1:9"):
+        run_campaign(load_campaign(SPEC), tmp_path, scheduler="tcp://127.0.0.1:9")
+
+
 def test_rerun_resumes_and_other_spec_refused(reference, tmp_path):
     folder, _ = reference
     again = run_campaign(load_campaign(SPEC), folder, workers=1)

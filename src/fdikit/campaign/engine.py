@@ -23,10 +23,12 @@ from pathlib import Path
 from fdikit.campaign.spec import CampaignSpec
 from fdikit.errors import ParameterError
 
-__all__ = ["CampaignRun", "run_campaign", "compute_chunk", "replay", "BACKENDS"]
+__all__ = ["CampaignRun", "run_campaign", "compute_chunk", "replay", "BACKENDS", "CONNECT_TIMEOUT"]
 
 #: The execution backends.
 BACKENDS = ("local", "dask")
+#: How long to wait for a Dask scheduler given by address.
+CONNECT_TIMEOUT = "20s"
 
 # Per-process caches of the worker: the plan and the study setup of a spec (by fingerprint).  Module
 # state on purpose: a worker process computes many chunks of the same campaign and must set up once.
@@ -134,13 +136,20 @@ def compute_chunk(spec_json: str, chunk: int) -> bytes:
 def _local(spec_json: str, todo: list[int], workers: int, done: Callable, say: Callable) -> None:
     import multiprocessing
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+    from concurrent.futures.process import BrokenProcessPool
 
-    with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn")) as pool:
-        pending = {pool.submit(compute_chunk, spec_json, c): c for c in todo}
-        while pending:
-            finished, _ = wait(pending, return_when=FIRST_COMPLETED)
-            for fut in sorted(finished, key=pending.get):
-                done(pending.pop(fut), fut.result())
+    try:
+        with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+            pending = {pool.submit(compute_chunk, spec_json, c): c for c in todo}
+            while pending:
+                finished, _ = wait(pending, return_when=FIRST_COMPLETED)
+                for fut in sorted(finished, key=pending.get):
+                    done(pending.pop(fut), fut.result())
+    except BrokenProcessPool:
+        raise ParameterError("a campaign worker process died (killed, out of memory, or the calling script starts "
+                             "the campaign at import: guard it with `if __name__ == \"__main__\":` — worker "
+                             "processes import the main module); the chunks finished so far are kept, rerun to "
+                             "resume") from None
 
 
 def _dask(spec_json: str, todo: list[int], workers: int, scheduler: str | None, done: Callable,
@@ -155,7 +164,7 @@ def _dask(spec_json: str, todo: list[int], workers: int, scheduler: str | None, 
         client = Client(cluster)
     else:
         try:
-            client = Client(scheduler, timeout="20s")
+            client = Client(scheduler, timeout=CONNECT_TIMEOUT)
         except OSError as exc:
             raise ParameterError(f"scheduler (--scheduler): cannot connect to {scheduler} ({exc}); start one with "
                                  "`dask scheduler` and workers with `dask worker ADDRESS`") from None

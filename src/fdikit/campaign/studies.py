@@ -87,12 +87,12 @@ def get_study(name: str) -> Study:
     >>> get_study("nope")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    fdikit.errors.ParameterError: study 'nope' is not registered (path-linear, ...) and is not 'package.module:attribute'
+    fdikit.errors.ParameterError: study 'nope' is not registered (path-linear, ...) and is not 'package.module:...'
     """
     target = STUDIES.get(name, name)
     if ":" not in target:
         raise ParameterError(f"study {name!r} is not registered ({', '.join(STUDIES)}) and is not "
-                             "'package.module:attribute'")
+                             "'package.module:attribute' naming a study object")
     module, _, attr = target.partition(":")
     try:
         obj = getattr(importlib.import_module(module), attr)
