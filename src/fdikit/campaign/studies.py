@@ -87,7 +87,7 @@ def get_study(name: str) -> Study:
     >>> get_study("nope")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    fdikit.errors.ParameterError: study 'nope' is not registered (path-linear, ...) and is not 'package.module:...'
+    fdikit.errors.ParameterError: study 'nope' is not registered (path-linear, ...) ... naming a study object
     """
     target = STUDIES.get(name, name)
     if ":" not in target:
