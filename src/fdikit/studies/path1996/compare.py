@@ -20,7 +20,7 @@ from fdikit.compare import Comparison, compare_evaluators, score_run, scores_csv
 from fdikit.errors import ParameterError
 from fdikit.studies.path1996.bank import path_bank, path_fault_model, path_runs
 
-__all__ = ["path_evaluator_comparison", "check_comparison_arguments", "EVALUATORS"]
+__all__ = ["path_evaluator_comparison", "check_comparison_arguments", "fit_comparison_evaluator", "EVALUATORS"]
 
 #: The evaluators of the comparison: command-line key → table name (the table's row order).
 EVALUATORS = {
@@ -254,6 +254,76 @@ def _test_run(spec, noise_fraction: float, size: float = 1.0, duration: float = 
 
 def _fit(chosen: Sequence[str], seed: int, noise_fraction: float, progress: bool) -> dict:
     """Fit the chosen evaluators (keys of EVALUATORS) on the training runs; ``{table name: evaluator}``."""
+    bank = _bank()
+    healthy = path_runs(bank, runs_per_fault=0, healthy_runs=1, duration=600.0, seed=seed,
+                        noise_fraction=noise_fraction)[0][1].slice(start=10.0)
+    labelled = None
+    if any(k in chosen for k in ("mhsprt", "gaussian-ml", "bnn")):
+        labelled = path_runs(bank, runs_per_fault=1, healthy_runs=1, onset=_ONSET, seed=seed + 1,
+                             noise_fraction=noise_fraction, progress=progress)
+    return {EVALUATORS[k]: fit_comparison_evaluator(k, healthy, bank.groups, labelled, onset=_ONSET) for k in chosen}
+
+
+def fit_comparison_evaluator(key: str, healthy, groups: Sequence[str] | None, labelled=None, *, onset: float = _ONSET,
+                             false_alarms_per_hour: float = 1.0, mean_time_between_false_alarms: float = 3600.0,
+                             shift: float = 4.0, window: int = 50, alpha: float = 1e-6, beta: float = 1e-3,
+                             order: int = 5, regularization: float = 1e-6):
+    """One evaluator of the comparison, fitted as ``fdikit compare-evaluators`` fits it.
+
+    The fault-free statistics (thresholds, CUSUM, GLR, SPRT and their AR-whitened variants) come from
+    ``healthy``; the MHSSPRT (fault densities from the labelled runs after ``onset + 1`` s), the Gaussian ML
+    classifier and the Bayesian NN from ``labelled``.  The defaults are the comparison's.
+
+    Parameters
+    ----------
+    key : str
+        A key of :data:`EVALUATORS`.
+    healthy : Residuals
+        Fault-free residuals (start-up transient removed).
+    groups : sequence of str, optional
+        The filter of each residual (bank isolation logic).
+    labelled : sequence of (Trace, Residuals), optional
+        Labelled training runs, fault-free ones labelled ``'none'`` (needed by ``mhsprt``, ``gaussian-ml``,
+        ``bnn``); the MHSSPRT takes each faulty run's fault from its last sample.
+    onset : float, default 5.0
+        Fault onset of the labelled runs [s].
+    false_alarms_per_hour : float, default 1.0
+        Target rate of the threshold and GLR tests.
+    mean_time_between_false_alarms : float, default 3600.0
+        CUSUM target [s].
+    shift : float, default 4.0
+        Design shift of CUSUM and SPRT in fault-free standard deviations of each (whitened) residual.
+    window : int, default 50
+        GLR window [samples].
+    alpha, beta : float, default 1e-6, 1e-3
+        SPRT error probabilities.
+    order : int, default 5
+        AR order of the whitening.
+    regularization : float, default 1e-6
+        MHSSPRT density regularisation.
+
+    Returns
+    -------
+    object
+        The fitted evaluator (``run(residuals) -> Diagnosis``).
+
+    Raises
+    ------
+    ParameterError
+        For an unknown key, or a learned evaluator without ``labelled`` runs.
+
+    References
+    ----------
+    Douglas et al. 1996, Ch. 7 (MHSSPRT), §6.2.1 (Gaussian ML), Ch. 6 (Bayesian neural network).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fdikit.residuals import Residuals
+    >>> res = Residuals(np.arange(2000) * 0.01, np.random.default_rng(0).standard_normal((2000, 1)), ("r",), ("f",))
+    >>> type(fit_comparison_evaluator("glr", res, None)).__name__
+    'GlrEvaluator'
+    """
     import numpy as np
 
     from fdikit.decision import CusumEvaluator, GlrEvaluator, SprtEvaluator, ThresholdEvaluator, Whitened
@@ -261,46 +331,50 @@ def _fit(chosen: Sequence[str], seed: int, noise_fraction: float, progress: bool
     from fdikit.decision.learned.gaussian_ml import GaussianMlEvaluator
     from fdikit.decision.mhsprt import MhsprtEvaluator
 
-    bank = _bank()
-    onset = _ONSET
-    healthy = path_runs(bank, runs_per_fault=0, healthy_runs=1, duration=600.0, seed=seed,
-                        noise_fraction=noise_fraction)[0][1].slice(start=10.0)
-    g = bank.groups
-    # design shift of CUSUM and SPRT: 4 fault-free standard deviations per residual (the nominal faults move
-    # their own scaled residual by 1, far more than 4σ at this noise level)
-    shift = 4.0 * healthy.r.std(axis=0, ddof=1)
+    if key not in EVALUATORS:
+        raise ParameterError(f"unknown evaluator {key!r}; choose from: {', '.join(EVALUATORS)}")
+    if key in ("mhsprt", "gaussian-ml", "bnn") and labelled is None:
+        raise ParameterError(f"{key} is trained on labelled runs; pass labelled=[(trace, residuals), ...]")
+    g = groups
     # vector tests (GLR, SPRT) per fault within each filter: residual '<filter>:<fault>[k]' → '<filter>:<fault>'
     blocks = [name.split("[")[0] for name in healthy.names]
-    w_shift = None
-    if any(k in chosen for k in ("cusum-whitened", "sprt-whitened")):
-        # the same tests on AR(5)-prewhitened residuals (the bank's residuals are coloured; decision.whiten)
-        innov = Whitened(ThresholdEvaluator(), order=5).fit(healthy, false_alarm_prob=1e-3).whiten(healthy)
-        w_shift = 4.0 * np.nanstd(innov.r, axis=0, ddof=1)
-    labelled = None
-    if any(k in chosen for k in ("mhsprt", "gaussian-ml", "bnn")):
-        labelled = path_runs(bank, runs_per_fault=1, healthy_runs=1, onset=onset, seed=seed + 1,
-                             noise_fraction=noise_fraction, progress=progress)
-    fits = {
-        "threshold": lambda: ThresholdEvaluator(groups=g, persistence=(5, 10)).fit(healthy, false_alarms_per_hour=1),
-        "cusum": lambda: CusumEvaluator(groups=g).fit(healthy, mean_time_between_false_alarms=3600.0, shift=shift),
-        "glr": lambda: GlrEvaluator(window=50, blocks=blocks, groups=g).fit(healthy, false_alarms_per_hour=1),
-        "sprt": lambda: SprtEvaluator(shift=shift, alpha=1e-6, beta=1e-3, blocks=blocks, groups=g).fit(healthy),
-        "cusum-whitened": lambda: Whitened(CusumEvaluator(groups=g), 5).fit(
-            healthy, mean_time_between_false_alarms=3600.0, shift=w_shift),
-        "glr-whitened": lambda: Whitened(GlrEvaluator(window=50, blocks=blocks, groups=g), 5).fit(
-            healthy, false_alarms_per_hour=1),
-        "sprt-whitened": lambda: Whitened(
-            SprtEvaluator(shift=w_shift, alpha=1e-6, beta=1e-3, blocks=blocks, groups=g), 5).fit(healthy),
-        "mhsprt": lambda: MhsprtEvaluator().fit(_by_fault(healthy, labelled, onset), regularization=1e-6),
-        "gaussian-ml": lambda: GaussianMlEvaluator().fit([res for _, res in labelled],
-                                                         [trace.fault for trace, _ in labelled]),
-        "bnn": lambda: BnnEvaluator().fit([res for _, res in labelled], [trace.fault for trace, _ in labelled]),
-    }
-    return {EVALUATORS[k]: fits[k]() for k in chosen}
+    if key == "threshold":
+        return ThresholdEvaluator(groups=g, persistence=(5, 10)).fit(
+            healthy, false_alarms_per_hour=false_alarms_per_hour)
+    if key in ("cusum", "sprt"):
+        # design shift of CUSUM and SPRT: 4 fault-free standard deviations per residual (the nominal faults move
+        # their own scaled residual by 1, far more than 4σ at the report's noise level)
+        delta = shift * healthy.r.std(axis=0, ddof=1)
+        if key == "cusum":
+            return CusumEvaluator(groups=g).fit(
+                healthy, mean_time_between_false_alarms=mean_time_between_false_alarms, shift=delta)
+        return SprtEvaluator(shift=delta, alpha=alpha, beta=beta, blocks=blocks, groups=g).fit(healthy)
+    if key == "glr":
+        return GlrEvaluator(window=window, blocks=blocks, groups=g).fit(
+            healthy, false_alarms_per_hour=false_alarms_per_hour)
+    if key == "glr-whitened":
+        return Whitened(GlrEvaluator(window=window, blocks=blocks, groups=g), order).fit(
+            healthy, false_alarms_per_hour=false_alarms_per_hour)
+    if key in ("cusum-whitened", "sprt-whitened"):
+        # the same tests on AR-prewhitened residuals (the bank's residuals are coloured; decision.whiten)
+        innov = Whitened(ThresholdEvaluator(), order=order).fit(healthy, false_alarm_prob=1e-3).whiten(healthy)
+        w_shift = shift * np.nanstd(innov.r, axis=0, ddof=1)
+        if key == "cusum-whitened":
+            return Whitened(CusumEvaluator(groups=g), order).fit(
+                healthy, mean_time_between_false_alarms=mean_time_between_false_alarms, shift=w_shift)
+        return Whitened(SprtEvaluator(shift=w_shift, alpha=alpha, beta=beta, blocks=blocks, groups=g),
+                        order).fit(healthy)
+    if key == "mhsprt":
+        return MhsprtEvaluator().fit(_by_fault(healthy, labelled, onset), regularization=regularization)
+    runs, labels = [res for _, res in labelled], [trace.fault for trace, _ in labelled]
+    if key == "gaussian-ml":
+        return GaussianMlEvaluator().fit(runs, labels)
+    return BnnEvaluator().fit(runs, labels)
 
 
 def _by_fault(healthy, labelled, onset):
     by_fault = {"none": healthy}
-    for trace, res in labelled[1:]:
-        by_fault[str(trace.fault[-1])] = res.slice(start=onset + 1.0)
+    for trace, res in labelled:
+        if str(trace.fault[-1]) != "none":  # path_runs puts its one fault-free run first
+            by_fault[str(trace.fault[-1])] = res.slice(start=onset + 1.0)
     return by_fault
