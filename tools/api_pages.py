@@ -37,14 +37,15 @@ PAGES = [
     ("aircraft", "fdikit.aircraft", "Nonlinear aircraft through JSBSim"),
     ("spc", "fdikit.spc", "Subspace predictive control"),
     ("ftc", "fdikit.ftc", "Fault-tolerant control"),
+    ("campaign", "fdikit.campaign", "Campaigns: Monte Carlo over plants, faults, designs and evaluators"),
     ("studies-path1996", "fdikit.studies.path1996", "Study: Douglas et al. 1996 (PATH)"),
     ("studies-hallouzi2008", "fdikit.studies.hallouzi2008", "Study: Hallouzi 2008"),
     ("studies-vanderploeg2018", "fdikit.studies.vanderploeg2018", "Study: van der Ploeg 2018"),
     ("studies-varrier2014", "fdikit.studies.varrier2014", "Study: Varrier et al. 2014"),
 ]
 
-#: Modules without an API page: the command-line entry point (documented by ``fdikit --help``).
-SKIP = {"fdikit.cli"}
+#: Modules without an API page: the command line (documented by ``fdikit --help``).
+SKIP = {"fdikit.cli", "fdikit.cli_campaign"}
 
 
 def modules(package: str) -> list[str]:

@@ -54,6 +54,14 @@ class CampaignRun:
         Worker processes used.
     backend : str
         ``'local'`` or ``'dask'``.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> run = CampaignRun(Path("out"), runs=100, chunks=2, computed=1, reused=1, seconds=3.5, workers=2,
+    ...                   backend="local")
+    >>> run.computed + run.reused == run.chunks
+    True
     """
 
     folder: Path
@@ -117,6 +125,16 @@ def compute_chunk(spec_json: str, chunk: int) -> bytes:
     -------
     bytes
         :func:`fdikit.campaign.store.encode_chunk` of the chunk's rows.
+
+    Examples
+    --------
+    Computing a chunk in the calling process (what a worker does; the first chunk also sets the study up):
+
+    >>> import pyarrow as pa, pyarrow.parquet as pq  # doctest: +SKIP
+    >>> from fdikit.campaign.spec import load_campaign
+    >>> data = compute_chunk(load_campaign("path-linear").model_dump_json(), 0)  # doctest: +SKIP
+    >>> pq.read_table(pa.BufferReader(data)).num_rows  # doctest: +SKIP
+    40
     """
     from threadpoolctl import threadpool_limits
 
@@ -213,6 +231,15 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int | None = N
     ------
     ParameterError
         For a bad backend or worker count, an unreachable scheduler, or ``out`` holding another campaign.
+
+    Examples
+    --------
+    A script that starts worker processes guards its entry point (the workers import the main module):
+
+    >>> from fdikit.campaign.spec import load_campaign
+    >>> if __name__ == "__main__":  # doctest: +SKIP
+    ...     done = run_campaign(load_campaign("path-linear"), "out/campaign/path-linear", workers=2, progress=True)
+    ...     print(done.computed, done.reused, f"{done.seconds:.0f} s")
     """
     import os
 
@@ -280,6 +307,12 @@ def replay(folder: str | Path, run: int, design: str, evaluator: str):
     ------
     ParameterError
         For an unknown run, design or evaluator.
+
+    Examples
+    --------
+    >>> folder = "out/campaign/path-linear"
+    >>> trace, residuals, diagnosis = replay(folder, 17, "beard-jones", "threshold")  # doctest: +SKIP
+    >>> diagnosis.first_alarm()  # doctest: +SKIP
     """
     from fdikit.campaign.plan import plan_run
     from fdikit.campaign.spec import spec_fingerprint

@@ -95,6 +95,11 @@ def load_results(folder: str | Path, *, complete: bool = True):
     ------
     DataError
         When the folder holds no campaign, or (``complete``) chunks are missing.
+
+    Examples
+    --------
+    >>> manifest, table = load_results("out/campaign/path-linear")  # doctest: +SKIP
+    >>> table.groupby(["design", "evaluator"]).detected.mean()  # doctest: +SKIP
     """
     import pandas as pd
 
@@ -226,12 +231,49 @@ class CampaignStore:
 
 
 def chunk_file(chunk: int) -> str:
-    """File name of a chunk: ``chunk-NNNNNN.parquet``."""
+    """File name of a chunk.
+
+    Parameters
+    ----------
+    chunk : int
+
+    Returns
+    -------
+    str
+        ``chunk-NNNNNN.parquet``.
+
+    Examples
+    --------
+    >>> chunk_file(12)
+    'chunk-000012.parquet'
+    """
     return f"chunk-{chunk:06d}.parquet"
 
 
 def encode_chunk(rows: list[dict], fingerprint: str, chunk: int) -> bytes:
-    """Parquet bytes of a chunk's rows, with the fingerprint, chunk and row count in the file's metadata."""
+    """Parquet bytes of a chunk's rows, with the fingerprint, chunk and row count in the file's metadata.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Rows of :data:`fdikit.campaign.schema.SCHEMA`.
+    fingerprint : str
+        The spec's fingerprint.
+    chunk : int
+        The chunk index.
+
+    Returns
+    -------
+    bytes
+        A zstd-compressed Parquet file.
+
+    Examples
+    --------
+    >>> import json, pyarrow as pa, pyarrow.parquet as pq
+    >>> data = encode_chunk([], "ab" * 32, 3)
+    >>> json.loads(pq.read_metadata(pa.BufferReader(data)).metadata[b"fdikit.campaign"])["chunk"]
+    3
+    """
     import pyarrow as pa
     import pyarrow.parquet as pq
 

@@ -40,6 +40,11 @@ class Study(Protocol):
     process.  Rows have the columns of :data:`fdikit.campaign.schema.COLUMNS`
     (:func:`fdikit.campaign.rows.score_row` builds one from a :class:`~fdikit.metrics.Score`).
 
+    Attributes
+    ----------
+    name : str
+        The name specs use (``study:``).
+
     Examples
     --------
     >>> isinstance(get_study("path-linear"), Study)
