@@ -182,7 +182,7 @@ def lip_statistic(mu, confirm_samples: int, share: float) -> np.ndarray:
     --------
     >>> mu = np.array([[0.0, 1.0], [0.5, 0.5], [0.8, 0.2], [0.0, 1.0]])
     >>> lip_statistic(mu, 2, 1.0).round(6).tolist()
-    [0.0, 2.5, 2.5, 0.0]
+    [0.0, 0.0, 2.5, 0.0]
     """
     deficit = np.abs(1.0 - np.asarray(mu, dtype=float)[:, -1]) / T_F
     n = max(1, int(confirm_samples))
