@@ -169,6 +169,7 @@ def test_kill_and_resume_loses_and_duplicates_nothing(reference, tmp_path):
     assert f"{30 - len(kept)} computed, {len(kept)} resumed" in result.stdout
     final = _digests(out)
     assert len(final) == 30 and all(final[k] == v for k, v in kept.items())
+    assert not [p.name for p in (out / "runs").iterdir() if not p.name.startswith("chunk-")]  # no temporary file
     _, table = load_results(out)
     assert len(table) == 60 and not table.duplicated(["run", "design", "evaluator"]).any()
     assert table.groupby("run")["seed"].first().tolist() == [p.seed for p in plan_runs(load_campaign(spec_file))]

@@ -193,12 +193,14 @@ class CampaignStore:
         return (min(first + self.chunk_size, self.runs) - first) * self.rows_per_run
 
     def done_chunks(self) -> set[int]:
-        """The chunks whose files are complete and belong to this spec."""
+        """The chunks whose files are complete and belong to this spec (removing a killed run's temporary files)."""
         import pyarrow.parquet as pq
 
         done = set()
         if not self.data.is_dir():
             return done
+        for tmp in self.data.glob(".chunk-*.tmp"):
+            tmp.unlink(missing_ok=True)
         for path in self.data.glob("chunk-*.parquet"):
             try:
                 meta = json.loads(pq.read_metadata(path).metadata[_META])
