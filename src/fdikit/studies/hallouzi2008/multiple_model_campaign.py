@@ -86,6 +86,14 @@ def _kind(named, default=None) -> str:
     return named.kind or (named.name if default is None else default)
 
 
+def _faults_of(plant_kind: str, kind: str) -> tuple[str, ...]:
+    from fdikit.plants.b747 import B747_MODEL_NAMES
+
+    if FAULT_KINDS.get(kind) != plant_kind:
+        return ()
+    return tuple(B747_MODEL_NAMES[1:]) if plant_kind == "b747" else tuple(_MSD_FAULTS)
+
+
 def b747_window(fault: str) -> tuple[int, int, float, float]:
     """The samples ``[a, b]`` (inclusive) a B747 row is scored on, and the fault's Table 2.6 size and onset [s].
 
@@ -140,12 +148,7 @@ class MultipleModelStudy:
 
     def fault_names(self, plant, kind: str) -> tuple[str, ...]:
         """The faults of ``kind`` on ``plant``: Table 2.6's four on a B747, u1_actuator and x2_sensor on the MSD."""
-        from fdikit.plants.b747 import B747_MODEL_NAMES
-
-        pk = _kind(plant)
-        if FAULT_KINDS.get(kind) != pk:
-            return ()
-        return tuple(B747_MODEL_NAMES[1:]) if pk == "b747" else tuple(_MSD_FAULTS)
+        return _faults_of(_kind(plant), kind)
 
     def check(self, spec) -> list[str]:
         """Problems with the spec's plants, faults, designs and evaluators."""
@@ -174,7 +177,7 @@ class MultipleModelStudy:
                                 f"{', '.join(FAULT_KINDS)}")
                 continue
             pk = FAULT_KINDS[fam.kind]
-            names = self.fault_names(type("P", (), {"kind": pk, "name": pk})(), fam.kind)
+            names = _faults_of(pk, fam.kind)
             if fam.targets != "all":
                 bad = [t for t in fam.targets if t not in names]
                 if bad:
