@@ -15,7 +15,8 @@ use, cached on disk): the runs in parallel, one sequential recursion each, the i
 ``method="blas"`` is pure numpy (a GEMM for ``[B; D] u``, a time loop of ``(R × n) @ (n × n)`` products, a
 GEMM for ``C x``).  Lifting over blocks as :func:`fdikit.lti.dlsim_blocked` does was measured and is slower
 here: its Toeplitz products cost ``M·m·p`` flops per sample against ``(n + p)(n + m)``, and the per-sample
-Python loop it removes is gone already (``docs/PERFORMANCE.md``, batched execution).
+Python loop it removes is gone already (``docs/PERFORMANCE.md``, batched execution).  The threshold window and
+the CUSUM are compiled kernels as well, parallel over runs (the CUSUM in the evaluator's arithmetic, bit for bit).
 """
 
 from __future__ import annotations
