@@ -24,8 +24,15 @@ Design kinds: ``beard-jones`` (the four-filter bank, :func:`~fdikit.studies.path
 ``kalman`` (one steady-state Kalman filter, :func:`~fdikit.studies.path1996.kalman_bank.path_kalman_bank`,
 designed for the plant's noise), ``game`` (the game-theoretic bank,
 :func:`~fdikit.studies.path1996.game_bank.path_game_bank`, weights in ``params``: ``gamma``, ``M``, ``Q``).
-Evaluators: :mod:`fdikit.campaign.evaluation`.  Calibration runs are fault-free runs of the same plant from
-the seed ``SeedSequence(seed, spawn_key=(plant, 1))``, disjoint from every run's.
+Evaluators: every kind of :mod:`fdikit.campaign.evaluation` but ``mhsprt-whitened`` (fitted on runs with the
+fault from 2 s, the nonlinear study's); ``glr`` … ``bnn`` are those of ``fdikit compare-evaluators``
+(:mod:`fdikit.studies.path1996.compare`, Douglas et al. 1996, Ch. 6–7), fitted exactly as it fits them.
+Calibration runs are fault-free runs of the same plant from the seed ``SeedSequence(seed, spawn_key=(plant, 1))``,
+disjoint from every run's.  When an evaluator is trained (``mhsprt``, ``gaussian-ml``, ``bnn``), the labelled
+training runs are those of the comparison (``path_runs(..., runs_per_fault=1, healthy_runs=1)``): one fault-free
+run, then each of the 15 faults as a bias of 1 nominal size from 5 s, 20 s each, at the plant's noise, their
+seeds drawn as :func:`~fdikit.studies.path1996.bank.path_runs` draws them from
+``SeedSequence(seed, spawn_key=(plant, 2))`` (disjoint from the runs' and the calibration's).
 """
 
 from __future__ import annotations
@@ -35,7 +42,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["PathLinearStudy", "PATH_LINEAR", "DESIGN_KINDS", "FAULT_KINDS", "NOISE_PRESETS"]
+__all__ = ["PathLinearStudy", "PATH_LINEAR", "DESIGN_KINDS", "FAULT_KINDS", "NOISE_PRESETS", "EVALUATORS"]
 
 #: Design kind → its parameters and defaults.
 DESIGN_KINDS = {"beard-jones": {}, "kalman": {}, "game": {"gamma": 1e-6, "M": 0.01, "Q": 1e-6}}
@@ -44,6 +51,11 @@ FAULT_KINDS = ("bias", "drift")
 #: Named noise levels of the plant's ``noise`` parameter.
 NOISE_PRESETS = ("realistic", "report")
 _PLANT_PARAMS = ("noise", "dt")
+#: The evaluator kinds of :mod:`fdikit.campaign.evaluation` the study runs.
+EVALUATORS = ("threshold", "cusum", "glr", "sprt", "cusum-whitened", "glr-whitened", "sprt-whitened", "mhsprt",
+              "gaussian-ml", "bnn")
+#: The labelled training runs (``fdikit compare-evaluators``'s): onset [s], duration [s], size [nominal sizes].
+TRAINING = {"onset": 5.0, "duration": 20.0, "size": 1.0}
 
 
 @dataclass(frozen=True, eq=False)
@@ -110,7 +122,7 @@ class PathLinearStudy:
                 if p not in DESIGN_KINDS[kind]:
                     problems.append(f"designs.{k}.params.{p}: unknown parameter; {kind} takes: "
                                     f"{', '.join(DESIGN_KINDS[kind]) or 'none'}")
-        return problems + check_evaluators(spec.evaluators)
+        return problems + check_evaluators(spec.evaluators, EVALUATORS, self.name)
 
     # ------------------------------------------------------------------ set-up (once per worker)
     @staticmethod
@@ -126,7 +138,8 @@ class PathLinearStudy:
 
     def setup(self, spec) -> dict:
         """Per plant: the discrete model, the noise, every design's generator and the calibrated evaluators."""
-        from fdikit.campaign.evaluation import calibration_seconds, fit_evaluator
+        from fdikit.campaign.evaluation import calibration_seconds, fit_evaluator, needs_training
+        from fdikit.campaign.plan import RunPlan
         from fdikit.simulate import simulate
         from fdikit.studies.path1996.bank import nominal_fault_sizes, path_bank, path_fault_model
         from fdikit.studies.path1996.game_bank import path_game_bank
@@ -154,29 +167,29 @@ class PathLinearStudy:
             seed = np.random.SeedSequence(spec.seed, spawn_key=(k, 1))
             healthy = simulate(model, duration=calibration_seconds(spec.evaluators), measurement_noise_std=noise,
                                rng=np.random.default_rng(seed))
+            training = []
+            if needs_training(spec.evaluators):
+                labels = ["none", *self.fault_names(plant, "bias")]
+                seeds = np.random.default_rng(np.random.SeedSequence(spec.seed, spawn_key=(k, 2))).integers(
+                    2**31, size=len(labels))
+                training = [_simulate(model, noise, nominal, TRAINING["duration"],
+                                      RunPlan(-1, -1, plant.name, f, "none" if f == "none" else "bias",
+                                              TRAINING["size"], TRAINING["onset"], int(s)))
+                            for f, s in zip(labels, seeds)]
             evaluators = {}
             for d in spec.designs:
                 gen, groups = designs[d.name]
                 res = gen.run(healthy)
+                labelled = [(tr, gen.run(tr)) for tr in training]
                 for e in spec.evaluators:
-                    evaluators[(d.name, e.name)] = fit_evaluator(e, res, groups)
+                    evaluators[(d.name, e.name)] = fit_evaluator(e, res, groups, labelled, TRAINING["onset"])
             plants[plant.name] = _Plant(model, noise, designs, evaluators)
         return {"plants": plants, "nominal": nominal}
 
     # ------------------------------------------------------------------ runs
     def _trace(self, setup, spec, run):
-        from fdikit.faults import Bias, Drift, FaultScenario
-        from fdikit.simulate import simulate
-
         plant = setup["plants"][run.plant]
-        faults = []
-        if not run.healthy:
-            signal, loc = run.fault.rsplit("_", 1)
-            size = run.size * setup["nominal"][run.fault]
-            cls = Bias if run.kind == "bias" else Drift
-            faults = [cls(signal, size, onset=run.onset, location=loc)]
-        return simulate(plant.model, FaultScenario(faults), duration=spec.duration,
-                        measurement_noise_std=plant.noise, rng=run.seed)
+        return _simulate(plant.model, plant.noise, setup["nominal"], spec.duration, run)
 
     def run_chunk(self, setup, spec, runs: Sequence, levels: Sequence[float]) -> list[dict]:
         """Rows of the runs: simulate each, every design's residuals in one batch per plant, every evaluator."""
@@ -203,6 +216,20 @@ class PathLinearStudy:
         trace = self._trace(setup, spec, run)
         residuals = plant.designs[design][0].run(trace)
         return trace, residuals, plant.evaluators[(design, evaluator)].run(residuals)
+
+
+def _simulate(model, noise, nominal, duration: float, run):
+    """One run as :func:`~fdikit.studies.path1996.bank.path_runs` simulates it (a bias or drift of ``run.size``
+    nominal sizes from ``run.onset``, white sensor noise, the run's seed)."""
+    from fdikit.faults import Bias, Drift, FaultScenario
+    from fdikit.simulate import simulate
+
+    faults = []
+    if not run.healthy:
+        signal, loc = run.fault.rsplit("_", 1)
+        cls = Bias if run.kind == "bias" else Drift
+        faults = [cls(signal, run.size * nominal[run.fault], onset=run.onset, location=loc)]
+    return simulate(model, FaultScenario(faults), duration=duration, measurement_noise_std=noise, rng=run.seed)
 
 
 #: The registered study object.
