@@ -31,3 +31,15 @@ def test_readme_example_on_a_builtin_plant():
     assert len(code.strip().splitlines()) <= 15
     s = _result(code)
     assert s.detected and s.label == "yaw_rate_sensor" and s.false_alarms == 0
+
+
+def test_readme_campaign_spec_is_valid():
+    import yaml
+
+    from fdikit.campaign.plan import plan_runs
+    from fdikit.campaign.spec import load_campaign
+
+    (block,) = re.findall(r"```yaml\n(.*?)```", (ROOT / "README.md").read_text(), re.S)
+    spec = load_campaign(yaml.safe_load(block))
+    plan = plan_runs(spec)
+    assert spec.name == "quick" and len(plan) == 300 and {p.fault for p in plan} >= {"none", "yaw_rate_sensor"}
