@@ -103,7 +103,8 @@ def test_ftc_rows_are_the_study_flights():
 
 def test_check_rejects_bad_names():
     lip = get_study("b747-lip")
-    problems = lip.check(_spec(LIP, plants=[{"name": "b747", "params": {"noise": "datasheet", "gust": 1}}],
+    problems = lip.check(_spec(LIP, plants=[{"name": "b747", "params": {"noise": "datasheet", "gust": 1}},
+                                            {"name": "f16", "kind": "f16"}],
                                faults=[{"kind": "lock", "targets": ["elevator", "flap_actuator"]},
                                        {"kind": "runaway", "targets": ["rudder_actuator"], "size": {"values": [40.0]}}],
                                designs=[{"name": "x", "kind": "model-set-iii"}],
@@ -113,7 +114,8 @@ def test_check_rejects_bad_names():
                    "faults.0.targets: unknown fault 'elevator' (the fault name is elevator_actuator)",
                    "faults.0.targets: unknown fault 'flap_actuator'", "faults.1.kind: unknown fault kind 'runaway'",
                    "faults.1.size: lock position 40.0 deg of rudder_actuator is outside",
-                   "designs.0.kind: unknown design 'model-set-iii'", "evaluators.0.params.share: must be in (0.5, 1]"):
+                   "plants.1.kind: unknown plant 'f16'", "designs.0.kind: unknown design 'model-set-iii'",
+                   "evaluators.0.params.share: must be in (0.5, 1]"):
         assert needle in text, needle
     ftc = get_study("b747-ftc")
     bad_lock = {"kind": "lock", "targets": ["elevator_actuator"], "size": {"values": [3.0]}, "onset": {"values": [18]}}
