@@ -314,6 +314,25 @@ def evaluate_runs(runs, traces, residuals: Mapping[str, np.ndarray], names: Mapp
     -------
     list of dict
         Rows of :data:`fdikit.campaign.schema.SCHEMA` (sweep columns as the module docstring says).
+
+    Examples
+    --------
+    One faulty run (a step of 5 in a unit-variance residual at 5 s) and a fixed threshold of 3:
+
+    >>> import numpy as np
+    >>> from fdikit.campaign.plan import RunPlan
+    >>> from fdikit.decision import ThresholdEvaluator
+    >>> from fdikit.trace import Trace
+    >>> t = np.arange(1000) * 0.01
+    >>> r = np.random.default_rng(0).standard_normal((1, 1000, 1)); r[0, 500:, 0] += 5.0
+    >>> trace = Trace(t, np.zeros((1000, 0)), np.zeros((1000, 1)), (), ("y",),
+    ...               fault=np.where(t >= 5.0, "y_sensor", "none"))
+    >>> plan = RunPlan(0, 0, "p", "y_sensor", "bias", 5.0, 5.0, 1)
+    >>> ev = ThresholdEvaluator(thresholds=3.0, isolates=("y_sensor",))
+    >>> (row,) = evaluate_runs([plan], [trace], {"d": r}, {"d": ("r",)}, {"d": ("y_sensor",)},
+    ...                        {("d", "threshold"): ev}, levels=[1.0, 2.0])
+    >>> row["detected"], row["isolated"], row["sweep_delay"][0] == row["detection_delay"]
+    (True, 'y_sensor', True)
     """
     from fdikit.batch import crossings
     from fdikit.campaign.rows import score_row

@@ -117,6 +117,10 @@ def flight_seed(seed: int) -> int:
     -------
     int
 
+    References
+    ----------
+    Hallouzi 2008, §4.4 (the Table 4.8 lock-in-place sweep), Table 4.7 (the isolation logic).
+
     Examples
     --------
     >>> flight_seed(2**31 + 5)
@@ -139,6 +143,10 @@ def lip_diagnosis(run):
         ``fired`` per fault group (``elevator_actuator``, ``aileron_actuator``, ``rudder_actuator``),
         ``isolated`` the declared fault name (``unknown`` kept), the mode probabilities as
         ``probabilities``.
+
+    References
+    ----------
+    Hallouzi 2008, §4.4 (the Table 4.8 lock-in-place sweep), Table 4.7 (the isolation logic).
 
     Examples
     --------
@@ -178,6 +186,10 @@ def lip_statistic(mu, confirm_samples: int, share: float) -> np.ndarray:
     (N,) ndarray
         0 while the window holds fewer than ``⌈share·n⌉`` samples.
 
+    References
+    ----------
+    Hallouzi 2008, §4.4 (the Table 4.8 lock-in-place sweep), Table 4.7 (the isolation logic).
+
     Examples
     --------
     >>> mu = np.array([[0.0, 1.0], [0.5, 0.5], [0.8, 0.2], [0.0, 1.0]])
@@ -205,6 +217,10 @@ def lip_metrics(run, onset: float) -> dict:
     Returns
     -------
     dict of str to float
+
+    References
+    ----------
+    Hallouzi 2008, §4.4 (the Table 4.8 lock-in-place sweep), Table 4.7 (the isolation logic).
 
     Examples
     --------
@@ -236,6 +252,10 @@ def _params(named, table) -> dict:
 
 class B747LipStudy:
     """The ``b747-lip`` campaign study (module docstring).
+
+    References
+    ----------
+    Hallouzi 2008, §4.4 (the Table 4.8 lock-in-place sweep), Table 4.7 (the isolation logic).
 
     Examples
     --------

@@ -88,6 +88,10 @@ def ftc_diagnosis(run):
     Diagnosis
         One column ``imm``; ``isolated`` is ``<group>_actuator`` from the declaration on.
 
+    References
+    ----------
+    Hallouzi 2008, §6.5 (the fault-tolerant flights), Table 6.1 (the input configurations).
+
     Examples
     --------
     >>> from fdikit.studies.hallouzi2008.b747_ftc import FtcRun
@@ -124,6 +128,10 @@ def ftc_metrics(run, onset: float) -> dict:
     Returns
     -------
     dict of str to float
+
+    References
+    ----------
+    Hallouzi 2008, §6.5 (the fault-tolerant flights), Table 6.1 (the input configurations).
 
     Examples
     --------
@@ -162,6 +170,10 @@ def ftc_metrics(run, onset: float) -> dict:
 
 class B747FtcStudy:
     """The ``b747-ftc`` campaign study (module docstring).
+
+    References
+    ----------
+    Hallouzi 2008, §6.5 (the fault-tolerant flights), Table 6.1 (the input configurations).
 
     Examples
     --------

@@ -107,6 +107,11 @@ def b747_window(fault: str) -> tuple[int, int, float, float]:
     tuple
         ``(a, b, size, onset)``; for ``'none'`` the first nominal interval and NaN size / onset.
 
+    Raises
+    ------
+    ParameterError
+        When ``fault`` is not a fault of Table 2.6.
+
     References
     ----------
     Hallouzi 2008, §2.4.1, Table 2.6.
@@ -134,6 +139,10 @@ def b747_window(fault: str) -> tuple[int, int, float, float]:
 
 class MultipleModelStudy:
     """The ``multiple-model`` campaign study (module docstring).
+
+    References
+    ----------
+    Hallouzi 2008, §2.4.1 (Table 2.6), §3.6.2 (the MSD model sets), Example 3.1.
 
     Examples
     --------

@@ -73,6 +73,11 @@ def run_metrics(result) -> dict[str, float]:
     dict of str to float
         ``<quantity>_rmse_<interval>``, ``<quantity>_mse_<interval>``, ``chatter``, ``mu_left_mean``.
 
+    Raises
+    ------
+    ParameterError
+        When the result is not of one run and one filter.
+
     References
     ----------
     Hallouzi 2008, §2.4.2, (2.64).
@@ -109,6 +114,10 @@ def run_metrics(result) -> dict[str, float]:
 
 class TargetTrackingStudy:
     """The ``target-tracking`` campaign study (module docstring).
+
+    References
+    ----------
+    Hallouzi 2008, §2.4.2 (the maneuvering-target benchmark).
 
     Examples
     --------

@@ -69,6 +69,10 @@ class _Plant:
 class PathLinearStudy:
     """The ``path-linear`` campaign study (module docstring).
 
+    References
+    ----------
+    Douglas et al. 1996, Ch. 4 (the bank), §5.1.1 (the faults and their nominal sizes).
+
     Examples
     --------
     >>> PATH_LINEAR.fault_names(None, "bias")[:2]

@@ -65,6 +65,10 @@ def _road(plant) -> str:
 class PathNonlinearStudy:
     """The ``path-nonlinear`` campaign study (module docstring).
 
+    References
+    ----------
+    Douglas et al. 1996, Ch. 5 (the evaluation on the nonlinear car), §5.1.1.
+
     Examples
     --------
     >>> PATH_NONLINEAR.fault_names(None, "bias")[:2]
