@@ -194,3 +194,37 @@ def test_missing_folder_parts(tmp_path):
     (tmp_path / "campaign.json").write_text("{not json")
     with pytest.raises(DataError, match="cannot read"):
         write_report(tmp_path)
+
+
+def test_study_figures_section(tmp_path):
+    rows = synthetic_rows(runs=8)
+    for k, row in enumerate(rows):
+        row["metrics"] = json.dumps({"rmse <m>": float(k), "kept": float(k % 2)})
+    page = write_report(write_campaign(tmp_path / "c", rows)).read_text(encoding="utf-8")
+    assert "<h2>Study figures</h2>" in page and "rmse &lt;m&gt;" in page
+    assert "This study stores no figures" not in page
+
+
+def test_metric_summary_against_a_loop():
+    import pandas as pd
+
+    from fdikit.campaign.stats import metric_summary
+
+    rng = np.random.default_rng(4)
+    rows = synthetic_rows(runs=12)
+    for row in rows:
+        row["metrics"] = json.dumps({"e": float(rng.normal()), **({"nan": math.nan} if row["run"] % 3 else {})})
+    table = pd.DataFrame(rows)
+    got = metric_summary(table)
+    for r in got.itertuples(index=False):
+        sel = table[(table.design == r.design) & (table.evaluator == r.evaluator) & (table.fault == r.fault)]
+        vals = [json.loads(m)[r.metric] for m in sel.metrics if r.metric in json.loads(m)]
+        finite = [v for v in vals if math.isfinite(v)]
+        assert r.runs == len(finite)
+        if finite:
+            assert r.mean == pytest.approx(sum(finite) / len(finite), rel=1e-12)
+            assert (r.min, r.max) == (min(finite), max(finite))
+        else:
+            assert math.isnan(r.mean)
+    with pytest.raises(DataError, match="is not a JSON object of numbers"):
+        metric_summary(pd.DataFrame({"design": ["a"], "evaluator": ["e"], "fault": ["none"], "metrics": ["[1"]}))

@@ -243,6 +243,23 @@ def _per_fault(st) -> str:
     return "".join(out) or "<p>No faulty runs.</p>"
 
 
+def _study_figures(table) -> str:
+    from fdikit.campaign.stats import metric_summary
+
+    figures = metric_summary(table)
+    if figures.empty:
+        return "<p>This study stores no figures of its own.</p>"
+    out = []
+    for (design, evaluator), g in figures.groupby(["design", "evaluator"], sort=True):
+        rows = [[r.fault, r.metric, r.runs, _num(r.mean), _num(r.median), _num(r.p10), _num(r.p90), _num(r.min),
+                 _num(r.max)] for r in g.itertuples(index=False)]
+        out.append(f"<details><summary><code>{_e(design)}</code> / <code>{_e(evaluator)}</code> "
+                   f"({len(rows)} figures)</summary>" + _table(
+                       ["fault", "figure", "runs", "mean", "median", "p10", "p90", "min", "max"], rows, left=2)
+                   + "</details>")
+    return "".join(out)
+
+
 def _false_alarms(st) -> str:
     rows = [[r.design, r.evaluator, r.fault_free_runs, r.runs_with_false_alarm,
              _pct(r.false_alarm_run_fraction, r.false_alarm_run_low, r.false_alarm_run_high), r.false_alarms,
@@ -397,6 +414,9 @@ def write_report(folder: str | os.PathLike, out: str | os.PathLike | None = None
             "smallest resolvable rate.</p>", fig_trade,
             f"<details><summary>trade-off table ({len(st.tradeoff)} rows)</summary>{_tradeoff(st)}</details>",
             "<h2>Per fault</h2>", _per_fault(st),
+            "<h2>Study figures</h2>",
+            "<p class=\"note\">The study's own per-run figures (the <code>metrics</code> column: RMSEs, flight "
+            "errors, isolation times), over the runs of each fault.</p>", _study_figures(table),
             "<h2>False alarms</h2>", _false_alarms(st),
             "<h2>Confusion matrices</h2>",
             "<p class=\"note\">Rows: true fault; columns: the isolated fault, <code>missed</code>, or "

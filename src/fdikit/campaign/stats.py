@@ -37,7 +37,7 @@ import numpy as np
 from fdikit import validate
 from fdikit.errors import DataError, ParameterError
 
-__all__ = ["CampaignStatistics", "campaign_statistics", "clopper_pearson", "REQUIRED_COLUMNS"]
+__all__ = ["CampaignStatistics", "campaign_statistics", "clopper_pearson", "metric_summary", "REQUIRED_COLUMNS"]
 
 #: The columns :func:`campaign_statistics` reads.
 REQUIRED_COLUMNS = ("fault", "design", "evaluator", "detected", "missed", "detection_delay", "isolated",
@@ -418,4 +418,61 @@ def campaign_statistics(table, levels: Sequence[float], confidence: float = 0.95
     tradeoff = pd.DataFrame(trade_rows, columns=[*_KEY, *_TRADEOFF])
     confusion = pd.DataFrame(conf_rows, columns=[*_KEY, "true", "diagnosed", "count"])
     return CampaignStatistics(tuple(float(x) for x in lv), c, detection, overall, false_alarms, confusion, tradeoff)
+
+
+def metric_summary(table):
+    """The study-specific figures (the ``metrics`` JSON column) per design × evaluator × fault × metric.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        Rows of :data:`fdikit.campaign.schema.SCHEMA` (at least ``design``, ``evaluator``, ``fault`` and
+        ``metrics``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``design``, ``evaluator``, ``fault``, ``metric``, ``runs`` (rows with a finite value), ``mean``,
+        ``median``, ``p10``, ``p90``, ``min``, ``max``; empty when no row has a figure.
+
+    Raises
+    ------
+    DataError
+        When a column is missing or a ``metrics`` entry is not a JSON object of numbers.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> t = pd.DataFrame({"design": ["a", "a"], "evaluator": ["e", "e"], "fault": ["none", "none"],
+    ...                   "metrics": ['{"rmse": 1.0}', '{"rmse": 3.0}']})
+    >>> metric_summary(t)[["metric", "runs", "mean", "max"]].to_dict("records")
+    [{'metric': 'rmse', 'runs': 2, 'mean': 2.0, 'max': 3.0}]
+    """
+    import json
+
+    import pandas as pd
+
+    cols = ["design", "evaluator", "fault", "metrics"]
+    missing = [c for c in cols if c not in table.columns]
+    if missing:
+        raise DataError(f"the results table lacks the columns {missing}; read it with "
+                        "fdikit.campaign.store.load_results")
+    values: dict[tuple, list[float]] = {}
+    for design, evaluator, fault, text in table[cols].itertuples(index=False):
+        try:
+            figures = json.loads(text or "{}")
+            items = [(str(k), float(v)) for k, v in figures.items()]
+        except (ValueError, TypeError, AttributeError):
+            raise DataError(f"metrics entry {text!r} is not a JSON object of numbers") from None
+        for key, v in items:
+            values.setdefault((design, evaluator, fault, key), []).append(v)
+    rows = []
+    for key, vals in sorted(values.items()):
+        v = np.asarray(vals)
+        v = v[np.isfinite(v)]
+        stats = ([float(f(v)) for f in (np.mean, np.median)] + [float(x) for x in np.percentile(v, [10, 90])]
+                 + [float(v.min()), float(v.max())]) if v.size else [np.nan] * 6
+        rows.append([*key, int(v.size), *stats])
+    return pd.DataFrame(rows, columns=["design", "evaluator", "fault", "metric", "runs", "mean", "median", "p10",
+                                       "p90", "min", "max"])
 
