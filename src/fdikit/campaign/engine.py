@@ -15,6 +15,7 @@ address is given.  The Dask dashboard address is printed.
 
 from __future__ import annotations
 
+import hashlib
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -189,7 +190,10 @@ def _dask(spec_json: str, todo: list[int], workers: int, scheduler: str | None, 
     try:
         n = len(client.scheduler_info().get("workers", {})) or workers
         say(f"Dask dashboard: {client.dashboard_link}  ({n} workers)")
-        futures = {client.submit(compute_chunk, spec_json, c, pure=False, key=f"chunk-{c}"): c for c in todo}
+        # task keys carry the spec's fingerprint: two campaigns on one scheduler never share a task
+        tag = hashlib.sha256(spec_json.encode()).hexdigest()[:16]
+        futures = {client.submit(compute_chunk, spec_json, c, pure=False, key=f"fdikit-{tag}-chunk-{c}"): c
+                   for c in todo}
         for fut in as_completed(list(futures)):
             done(futures[fut], fut.result())
         return n
