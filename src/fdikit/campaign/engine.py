@@ -139,14 +139,14 @@ def compute_chunk(spec_json: str, chunk: int) -> bytes:
     """
     from threadpoolctl import threadpool_limits
 
-    from fdikit.campaign.plan import chunks
     from fdikit.campaign.spec import spec_fingerprint, sweep_levels
     from fdikit.campaign.store import encode_chunk
 
     spec = CampaignSpec.model_validate_json(spec_json)
     fingerprint = spec_fingerprint(spec)
     with threadpool_limits(1), _numba_threads(1):
-        runs = chunks(_plan(spec, fingerprint))[chunk]
+        size = spec.chunk_size
+        runs = _plan(spec, fingerprint)[chunk * size:(chunk + 1) * size]  # run k is in chunk k // chunk_size
         study, setup = _setup(spec, fingerprint)
         rows = study.run_chunk(setup, spec, runs, sweep_levels(spec.sweep))
     return encode_chunk(rows, fingerprint, chunk)
