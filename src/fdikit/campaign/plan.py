@@ -11,13 +11,12 @@ worker computed it and whatever else ran.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from dataclasses import dataclass
 
 from fdikit.campaign.spec import CampaignSpec
 from fdikit.errors import ParameterError
 
-__all__ = ["RunPlan", "plan_runs", "plan_run", "chunks", "NO_FAULT"]
+__all__ = ["RunPlan", "plan_runs", "plan_run", "NO_FAULT"]
 
 #: Fault label, kind and target of a fault-free run.
 NO_FAULT = "none"
@@ -184,25 +183,3 @@ def plan_run(spec: CampaignSpec, run: int) -> RunPlan:
         raise ParameterError(f"run {run} is not in the campaign: it has {len(cells)} runs (0 to {len(cells) - 1})")
     return _finish(spec, run, _rng(spec, run), *cells[run])
 
-
-def chunks(plan: Sequence[RunPlan]) -> dict[int, list[RunPlan]]:
-    """The runs grouped by chunk, in chunk order.
-
-    Parameters
-    ----------
-    plan : sequence of RunPlan
-
-    Returns
-    -------
-    dict of int to list of RunPlan
-
-    Examples
-    --------
-    >>> p = [RunPlan(k, k // 2, "a", "none", "none", 0.0, 0.0, k) for k in range(3)]
-    >>> {c: [r.run for r in runs] for c, runs in chunks(p).items()}
-    {0: [0, 1], 1: [2]}
-    """
-    out: dict[int, list[RunPlan]] = {}
-    for p in plan:
-        out.setdefault(p.chunk, []).append(p)
-    return out
