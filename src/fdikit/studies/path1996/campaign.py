@@ -152,6 +152,7 @@ class PathLinearStudy:
         nominal = nominal_fault_sizes()
         models = (path_fault_model(12), path_fault_model(14))
         plants = {}
+        beard_jones = None
         for k, plant in enumerate(spec.plants):
             dt = float(plant.params.get("dt", 0.01))
             model = models[1].discretize(dt)
@@ -160,8 +161,8 @@ class PathLinearStudy:
             designs = {}
             for d in spec.designs:
                 kind = d.kind or d.name
-                if kind == "beard-jones":
-                    bank = path_bank()
+                if kind == "beard-jones":  # noise-independent: designed once for every plant
+                    bank = beard_jones = beard_jones or path_bank()
                 elif kind == "kalman":
                     bank = path_kalman_bank(models[1], std, dt=dt)
                 else:
