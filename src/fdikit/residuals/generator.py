@@ -6,7 +6,7 @@ controls ``u`` and the measurements ``y`` named in its ``controls`` and ``output
     z' = A z + B [u; y]        (z[k+1] in discrete time)
     r  = C z + D [u; y]
 
-``run(trace)`` processes a whole :class:`~fdikit.trace.Trace` at once (a blocked,
+``run(trace)`` processes a whole :class:`~fdikit.trace.Trace` at once (a compiled,
 vectorised recursion between gaps); ``online()`` returns a :class:`ResidualStepper` whose
 ``step(u, y)`` gives the same residuals one sample at a time.  Both follow one gap rule
 for invalid (NaN/inf) samples: the filter is propagated with the model and the inputs
@@ -28,7 +28,6 @@ import numpy as np
 from fdikit import validate
 from fdikit.errors import DataError, ModelError, ParameterError
 from fdikit.gaps import GapRule, Recovery, gap_options
-from fdikit.lti import dlsim_blocked
 from fdikit.model import GROUPS, FaultModel
 from fdikit.operating_point import OperatingPoint
 from fdikit.residuals.series import Residuals
@@ -217,10 +216,10 @@ class ResidualGenerator:
         :mod:`fdikit.gaps` (model prediction of the missing measurements, last value of a missing
         control).  The samples after a gap are *recovering* (finite residuals, ``valid`` False,
         ``recovering`` True) until the gap transient has decayed below ``recovery_tol`` noise
-        standard deviations.  Stretches of valid samples are processed by the blocked recursion of
-        :func:`fdikit.lti.dlsim_blocked`; only the invalid samples and the recovery bookkeeping are
+        standard deviations.  Stretches of valid samples are processed by the compiled recursion of
+        :func:`fdikit.runtime.lti_batch.lsim`; only the invalid samples and the recovery bookkeeping are
         stepped one by one (by superposition: the response to the usable inputs and the response to
-        the gap rule's state corrections are each one blocked solve over the whole trace).
+        the gap rule's state corrections are each one compiled pass over the whole trace).
 
         Parameters
         ----------
@@ -250,7 +249,9 @@ class ResidualGenerator:
             Residuals at the trace's times, with ``valid`` / ``recovering`` flags and the trace's
             metadata under ``meta["trace"]``.
         """
-        v = self.inputs_from(trace)
+        from fdikit.runtime.lti_batch import lsim, lsim_columns
+
+        self.check_trace(trace)
         if len(trace) > 1:
             g = self._for_dt(self.check_uniform(trace))
         elif self.dt is None:
@@ -258,20 +259,25 @@ class ResidualGenerator:
         else:
             g = self
         x0 = _state0(g, x0)
-        ok_ch = np.isfinite(v)
-        ok = ok_ch.all(axis=1)
         meta = {"trace": dict(trace.meta)}
-        if ok.all():
-            r, _, _ = dlsim_blocked(g.A, g.B, g.C, g.D, v, x0)
+        # clean data (the usual case): one compiled pass reading the trace's columns in place
+        r, _, _, bad = lsim_columns(g.A, g.B, g.C, g.D, trace.u, [trace.controls.index(c) for c in self.controls],
+                                    trace.y, [trace.outputs.index(c) for c in self.outputs], self.offset,
+                                    trace.valid, x0)
+        if bad == len(trace):
             gap_options(g, residual_cov, recovery_tol)  # the options are checked alike on clean data
             return Residuals(trace.t, r, self.residuals, self.isolates, meta=meta)
+        del r
+        v = self.inputs_from(trace)
+        ok_ch = np.isfinite(v)
+        ok = ok_ch.all(axis=1)
         rule = GapRule(g, residual_cov, recovery_tol)
         N, n = v.shape[0], g.n
         # Superposition: x = X0 + c, X0 the response to the usable inputs (bad entries 0) from rest, c the
         # response to x0 and to the state corrections E the gap rule applies on invalid samples.  Only the
-        # invalid samples (and the recovery bookkeeping) are stepped; both responses are one blocked solve.
+        # invalid samples (and the recovery bookkeeping) are stepped; both responses are one compiled pass.
         v0 = np.where(ok_ch, v, 0.0)
-        r0, X0, _ = dlsim_blocked(g.A, g.B, g.C, g.D, v0)
+        r0, X0, _ = lsim(g.A, g.B, g.C, g.D, v0, states=True)
         E = np.zeros((N, n))
         valid = np.zeros(N, bool)
         recovering = np.zeros(N, bool)
@@ -296,7 +302,7 @@ class ResidualGenerator:
                 rec.invalid_sample(ok_ch[k])
             kc, prev = b, b
         self._flags(rec, valid, recovering, prev, N)
-        rc, _, _ = dlsim_blocked(g.A, np.eye(n), g.C, np.zeros((len(self.residuals), n)), E, x0)
+        rc, _, _ = lsim(g.A, np.eye(n), g.C, np.zeros((len(self.residuals), n)), E, x0)
         r = r0 + rc
         r[~ok] = np.nan
         return Residuals(trace.t, r, self.residuals, self.isolates, valid, meta=meta, recovering=recovering)

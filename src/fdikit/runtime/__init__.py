@@ -7,7 +7,7 @@ the results; this package computes the same numbers (to 1e-12 relative) at the s
 * :mod:`fdikit.runtime.evaluators` — compiled evaluator steps (threshold, CUSUM, GLR, MHSSPRT).
 * :mod:`fdikit.runtime.estimators` — compiled Kalman filter and IMM cycle.
 * :mod:`fdikit.runtime.monitor` — a fused monitor: a detector's generator and evaluator in one step.
-* :mod:`fdikit.runtime.lsim` — the batch LTI response: only the needed flops, bounded memory.
+* :mod:`fdikit.runtime.lti_batch` — the batch LTI response: only the needed flops, bounded memory.
 * :mod:`fdikit.runtime.c_export` — a designed detector as portable C99 for a target computer.
 """
 
@@ -20,7 +20,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
         "evaluators": ["CompiledEvaluator", "compile_evaluator"],
         "estimators": ["CompiledKalman", "CompiledIMM", "compile_kalman", "compile_imm"],
         "monitor": ["Monitor", "compile_detector"],
-        "lsim": ["lsim"],
+        "lti_batch": ["lsim"],
         "c_export": ["CExport", "export_c"],
     },
 )
