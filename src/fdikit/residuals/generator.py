@@ -450,6 +450,8 @@ class ResidualStepper:
         Flags of the last sample stepped.
     invalid : int
         Number of invalid samples since creation or :meth:`reset`.
+    last_inputs : numpy.ndarray
+        The last valid value of every input ``[u − u0; y − y0]`` (what the gap rule holds through a dropout).
 
     Raises
     ------
@@ -480,7 +482,7 @@ class ResidualStepper:
         self.invalid = 0
         self.last_valid = True
         self.last_recovering = False
-        self._last = np.zeros(self._AB.shape[1] - self.generator.n)
+        self.last_inputs = np.zeros(self._AB.shape[1] - self.generator.n)
         self._rec = Recovery(self._rule)
 
     def _vector(self, values, names: tuple[str, ...], what: str) -> np.ndarray:
@@ -533,14 +535,14 @@ class ResidualStepper:
             self.invalid += 1
             self.last_valid = False
             self.last_recovering = False
-            self.x = self._rule.propagate(self.x, v, ok_ch, self._last)
-            self._last[ok_ch] = v[ok_ch]
+            self.x = self._rule.propagate(self.x, v, ok_ch, self.last_inputs)
+            self.last_inputs[ok_ch] = v[ok_ch]
             self._rec.invalid_sample(ok_ch)
             return np.full(len(g.residuals), np.nan)
         xv = np.concatenate([self.x, v])
         r = self._CD @ xv
         self.x = self._AB @ xv
-        self._last = v.copy()
+        self.last_inputs = v.copy()
         self.last_valid = self._rec.valid_sample() if self._rec.active else True
         self.last_recovering = not self.last_valid
         return r

@@ -196,7 +196,8 @@ def lsim_columns(A, B, C, D, U, iu, Y, iy, offset, valid, x0, *, states: bool = 
     out = np.empty((N, np.shape(C)[0]))
     X = np.empty((N if states else 0, n))
     x = np.array(x0, dtype=float).reshape(n)
-    bad = _kernel(_c(A.T), diagonal_blocks(A), _c(np.transpose(B)), _c(np.vstack([np.transpose(C), np.transpose(D)])), U,
+    CDT = _c(np.vstack([np.transpose(C), np.transpose(D)]))
+    bad = _kernel(_c(A.T), diagonal_blocks(A), _c(np.transpose(B)), CDT, U,
                   np.asarray(iu, dtype=np.int64).reshape(-1), Y, np.asarray(iy, dtype=np.int64).reshape(-1),
                   _c(offset).reshape(-1), np.ascontiguousarray(valid, dtype=np.bool_), x, out, X, int(chunk))
     return out, (X if states else None), x, int(bad)
