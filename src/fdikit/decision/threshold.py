@@ -32,11 +32,13 @@ from scipy.stats import norm
 from fdikit.decision.calibration import calibration_report, calibration_runs
 from fdikit.decision.common import checked_residuals, held, isolate_cached, isolate_fired, k_of_n, step_vector
 from fdikit.decision.signature import as_signature_table
-from fdikit.diagnosis import Diagnosis, StepDecision
+from fdikit.diagnosis import Alarm, Diagnosis, StepDecision
 from fdikit.errors import DataError, ParameterError
 from fdikit.residuals import Residuals
 
 __all__ = ["ThresholdEvaluator", "alpha_from_rate"]
+
+_COMPILED_RUN = 1 << 16  # residual entries from which run() uses the compiled pass (numba loaded on first use)
 
 
 def alpha_from_rate(false_alarms_per_hour: float, dt: float) -> float:
@@ -235,19 +237,52 @@ class ThresholdEvaluator:
 
     # ------------------------------------------------------------------ batch
     def run(self, residuals: Residuals) -> Diagnosis:
-        """Decisions for a whole residual series; identical to stepping through it."""
+        """Decisions for a whole residual series; identical to stepping through it.
+
+        A series of 65,536 residual entries or more is evaluated in one compiled pass
+        (:func:`fdikit.runtime.evaluator_kernels.threshold_batch`, numba loaded on first use) with the same
+        results; shorter ones by numpy.
+        """
         residuals = checked_residuals(residuals, self.names, "the threshold evaluator")
         q = len(residuals.names)
         tau, c, iso = self._ready(q, residuals)
         r = residuals.r
-        valid = residuals.valid & np.all(np.isfinite(r), axis=1)
         k, n = self.persistence
+        meta = {"evaluator": "threshold", "thresholds": tau.tolist(), "persistence": list(self.persistence)}
+        if r.size >= _COMPILED_RUN:
+            return self._run_compiled(residuals, tau, c, iso, meta)
+        valid = residuals.valid & np.all(np.isfinite(r), axis=1)
         fired = held(k_of_n(np.abs(r[valid] - c) > tau, k, n), valid, False)
         isolated = isolate_fired(fired, iso, self.groups, self.signatures, residuals.names)
-        return Diagnosis(
-            residuals.t, fired.any(axis=1), fired, residuals.names, isolated, valid=valid,
-            meta={"evaluator": "threshold", "thresholds": tau.tolist(), "persistence": list(self.persistence)},
-        )
+        return Diagnosis(residuals.t, fired.any(axis=1), fired, residuals.names, isolated, valid=valid, meta=meta)
+
+    def _run_compiled(self, residuals: Residuals, tau, c, iso, meta: dict) -> Diagnosis:
+        """:meth:`run` for a long series: the same decisions from one compiled pass
+        (:func:`fdikit.runtime.evaluator_kernels.threshold_batch`), the isolation once per distinct fired pattern."""
+        from fdikit.runtime.evaluator_kernels import threshold_batch
+
+        r = np.ascontiguousarray(residuals.r, dtype=float)
+        N, q = r.shape
+        fired, alarm = np.empty((N, q), bool), np.empty(N, bool)
+        valid, starts = np.empty(N, bool), np.empty(N, np.int64)
+        k, n = self.persistence
+        m = threshold_batch(r, np.array(residuals.valid, dtype=bool), np.array(c, dtype=float),
+                            np.array(tau, dtype=float), k, n, fired, alarm, valid, starts)  # writable copies: one type
+        starts = starts[:m]  # the fired pattern is constant from each start to the next
+        rows = fired[starts]
+        packed = np.ascontiguousarray(np.packbits(rows, axis=1))
+        keys = packed.view(np.dtype((np.void, packed.shape[1]))).ravel()
+        _, first, inv = np.unique(keys, return_index=True, return_inverse=True)
+        patterns = rows[first]
+        labels = isolate_fired(patterns, iso, self.groups, self.signatures, residuals.names)
+        inv = np.asarray(inv).ravel()
+        isolated = np.repeat(labels[inv], np.diff(np.append(starts, N)))
+        rises = np.flatnonzero(alarm[starts] & ~np.concatenate([[False], alarm[starts[:-1]]]))
+        fired_names = [tuple(nm for nm, f in zip(residuals.names, p) if f) for p in patterns.tolist()]
+        alarms = tuple(Alarm(time, int(i), lab, fired_names[u]) for time, i, lab, u in zip(
+            residuals.t[starts[rises]].tolist(), starts[rises].tolist(), labels[inv[rises]].tolist(),
+            inv[rises].tolist()))
+        return Diagnosis(residuals.t, alarm, fired, residuals.names, isolated, alarms=alarms, valid=valid, meta=meta)
 
     # ------------------------------------------------------------------ online
     def reset(self) -> None:
