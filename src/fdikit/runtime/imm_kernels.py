@@ -114,7 +114,7 @@ def _logsumexp(b, o, size):  # pragma: no cover - compiled
     return mx + math.log(s)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")  # one call site: compiled with its caller
 def _update(b, y, u, M, n, p):  # pragma: no cover - compiled
     """Step 2, measurement update of every mode into ``xf, Pf, z, S``; ``lp`` ← the log-likelihoods (2.12)."""
     m = u.shape[0]

@@ -145,7 +145,7 @@ def _gain(b, oP, oS, oKT, oPf, n, p):  # pragma: no cover - compiled
     return True
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")  # one call site: compiled with its caller
 def _settle(b, n, p):  # pragma: no cover - compiled
     """The reference's steady-state cache from the settled ``P``: gain, ``L⁻¹``, ``P(k|k)``, ``S``, constant."""
     oL, oLi, oSs = int(b[_L]), int(b[_LIT]), int(b[_SS])
@@ -163,33 +163,55 @@ def _settle(b, n, p):  # pragma: no cover - compiled
     return True
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")  # one call site: compiled with its caller
 def _steady_step(b, y, u, n, p):  # pragma: no cover - compiled
-    """``KalmanFilter._steady_step``: the constant-gain update and the prediction."""
-    ox, oxf, oe, oKs, oLi = int(b[_X]), int(b[_XF]), int(b[_E]), int(b[_KST]), int(b[_LIT])
+    """``KalmanFilter._steady_step``: the constant-gain update and the prediction (one fused pass, local views)."""
+    m = u.shape[0]
     if b[H_FRESH] == 0.0:  # first steady sample: the outputs take the cached P(k|k), S, gain (as the reference)
         copy(b, int(b[_PFS]), int(b[_PF]), n * n)
         copy(b, int(b[_SS]), int(b[_S]), p * p)
-        copy(b, oKs, int(b[_KT]), p * n)
+        copy(b, int(b[_KST]), int(b[_KT]), p * n)
         b[H_FRESH] = 1.0
-    residual(b, y, u, int(b[_CT]), ox, int(b[_D]), oe, p, n)
-    copy(b, ox, oxf, n)
-    gemv_t(b, oKs, oe, oxf, n, p)           # x + K e
-    affine(b, u, int(b[_AT]), oxf, int(b[_B]), ox, n)
-    ow = int(b[_WP])
-    fill(b, ow, p, 0.0)
-    for j in range(p):  # w = L⁻¹ e, by columns of L⁻¹
-        a = b[oe + j]
-        oj = oLi + j * p
+    ox, oxf, oe, ow, oK, oL = int(b[_X]), int(b[_XF]), int(b[_E]), int(b[_WP]), int(b[_KST]), int(b[_LIT])
+    oCt, oDt, oAt, oBt = int(b[_CT]), int(b[_D]), int(b[_AT]), int(b[_B])
+    x, xf, e, w = b[ox:ox + n], b[oxf:oxf + n], b[oe:oe + p], b[ow:ow + p]
+    Ct, Dt, KT, LiT = b[oCt:oCt + n * p], b[oDt:oDt + m * p], b[oK:oK + p * n], b[oL:oL + p * p]
+    At, Bt = b[oAt:oAt + n * n], b[oBt:oBt + m * n]
+    for i in range(p):                       # e = y − C x − D u
+        e[i] = y[i]
+        w[i] = 0.0
+    for j in range(n):
+        a = x[j]
+        xf[j] = a
+        for i in range(p):
+            e[i] -= a * Ct[j * p + i]
+    for j in range(m):
+        a = u[j]
+        for i in range(p):
+            e[i] -= a * Dt[j * p + i]
+    for j in range(p):                       # x̂(k|k) = x + K e;  w = L⁻¹ e
+        a = e[j]
+        for i in range(n):
+            xf[i] += a * KT[j * n + i]
         for i in range(j, p):
-            b[ow + i] += a * b[oj + i]
+            w[i] += a * LiT[j * p + i]
+    for i in range(n):                       # x̂(k+1|k) = A x̂(k|k) + B u
+        x[i] = 0.0
+    for j in range(n):
+        a = xf[j]
+        for i in range(n):
+            x[i] += a * At[j * n + i]
+    for j in range(m):
+        a = u[j]
+        for i in range(n):
+            x[i] += a * Bt[j * n + i]
     q = 0.0
     for i in range(p):
-        q += b[ow + i] * b[ow + i]
+        q += w[i] * w[i]
     b[H_LL] = b[H_CONST] - 0.5 * q
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")  # one call site: compiled with its caller
 def _covariance_step(b, y, u, n, p, valid):  # pragma: no cover - compiled
     """``KalmanFilter.step`` (covariance form): recursion, settling test and switch; status 0 or 2."""
     ox, oP, oxf, oPf, oe, oS = int(b[_X]), int(b[_P]), int(b[_XF]), int(b[_PF]), int(b[_E]), int(b[_S])
@@ -233,7 +255,7 @@ def _covariance_step(b, y, u, n, p, valid):  # pragma: no cover - compiled
 
 
 # ---------------------------------------------------------------------------------------- square-root form
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")  # one call site: compiled with its caller
 def _sqrt_step(b, y, u, n, p, valid):  # pragma: no cover - compiled
     """``KalmanFilter.step`` (square-root form): ``srkf_update`` + ``srkf_predict``; status 0 or 2."""
     ox, oSx, oxf, oe, oS = int(b[_X]), int(b[_SX]), int(b[_XF]), int(b[_E]), int(b[_S])
@@ -305,7 +327,7 @@ def _checks(u, y, buf):  # pragma: no cover - compiled
     return 0 if bad == 0 else 3
 
 
-checks = numba.njit(cache=True, nogil=True)(_checks)
+checks = numba.njit(cache=True, nogil=True, inline="always")(_checks)
 
 
 def kalman_step(u, y, buf) -> int:  # pragma: no cover - compiled
