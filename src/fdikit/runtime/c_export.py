@@ -1,30 +1,63 @@
-"""A designed detector as portable C99 for a target computer: one header, one source, no allocation.
+"""A designed detector as portable C99 for a target computer (an ECU, a flight computer): :func:`export_c`.
 
-:func:`export_c` writes ``<name>.h`` and ``<name>.c`` for a :class:`fdikit.detector.Detector` whose evaluator is a
-:class:`fdikit.decision.ThresholdEvaluator` (thresholds, centre, k-of-n persistence, the single-fault and bank
-isolation logic of Douglas et al. 1996 §1 — ``isolates`` and ``groups``; a signature table is not exported).
-The generated code holds the discretised filter ``[A B; C D]`` as a compressed sparse row table (structural zeros,
-e.g. the off-diagonal blocks of a stacked bank, are skipped), the operating point, the thresholds and the
-name tables as ``static const`` data with exact hexadecimal floating-point literals, and all mutable data in
-a caller-owned ``<name>_state`` struct::
+What is exported: the online step of a :class:`~fdikit.detector.Detector` — its residual generator (continuous
+ones ZOH-discretised at ``dt``, as ``Detector.online(dt=)`` does), the operating point, the warm-up, the gap rule of
+:mod:`fdikit.gaps` with its recovery flags, and a :class:`~fdikit.decision.ThresholdEvaluator` (thresholds, centres,
+k-of-n persistence) or :class:`~fdikit.decision.CusumEvaluator` (drift, threshold, mean, sigma, one or two sides,
+restart, hold, the rebase every 4096 samples), with the isolation of the fault from the fired residuals (the
+single-fault / bank logic of :func:`fdikit.diagnosis.isolate` with ``isolates`` and ``groups``, or a signature
+table, exact or partial).  Other evaluators are refused (:class:`~fdikit.errors.ParameterError` naming the
+supported ones).  One header ``<name>.h`` and one source ``<name>.c``: C99 with ``<math.h>``, ``<stdint.h>``,
+``<stdbool.h>`` and ``<string.h>`` only, no dynamic allocation, no mutable global (everything in
+``<name>_state``), matrices as ``static const`` arrays of their nonzero entries (compressed rows, so a stacked
+bank's block-diagonal ``A`` costs only its blocks).  ``<name>_step(state, u, y, out)`` takes the ABSOLUTE signals
+in the detector's ``controls`` / ``outputs`` order (listed in the header with their log columns, units and
+operating-point values) and returns the status; ``out`` holds the evaluator's residuals, the per-residual
+decisions, the alarm, the isolated fault (an index of ``<name>_fault_names``, ``-1`` for none, an index for
+``'unknown'``), whether the decision used the sample, and the generator's ``valid`` / ``recovering`` flags.
 
-    <name>_state s;  <name>_output out;
-    <name>_init(&s);
-    int status = <name>_step(&s, u, y, valid, &out);   // absolute u[NU], y[NY]; 0 valid, 1 invalid, 2 recovering
+Why hand-written: no library turns these steps into dependency-free embedded C; code generators for LTI filters
+(e.g. MATLAB Coder) know neither fdikit's gap rule nor its evaluators.
 
-``out`` holds the residuals the evaluator reads (in the detector's ``residual_names`` order), the fired pattern,
-the alarm, the fault index into ``<name>_fault_names`` (-1 none, ``<NAME>_NF`` unknown) and the flags.
+Equality with Python (``Detector.online().step``), precision ``"double"``:
 
-Bad samples.  A sample flagged ``valid = 0`` or with a NaN/inf value is treated as a dropout of **every** signal:
-the filter is propagated by the reference gap rule (:mod:`fdikit.gaps`) for the pattern "all signals missing"
-(``z+ = T z + G v_last``, the matrices taken from :class:`fdikit.gaps.GapRule` when exporting), the residuals
-are NaN and the decision holds; the recovery bookkeeping (the transient covariance ``P`` propagated through
-the gap and decayed on the samples after it, the hold count of held inputs) is the reference's, in C.  This
-equals Python exactly for samples flagged invalid as a whole (``valid=False``).  A *partial* dropout (some
-values NaN) differs: Python propagates with the remaining channels, the C code drops the whole sample.
+* valid samples: the same residuals to rounding (the sums run in another order: ~1e-15 relative to the terms),
+  identical ``fired`` / ``alarm`` / ``fault`` / ``valid`` flags unless a statistic lands within that rounding of
+  its threshold;
+* a bad sample (a NaN/inf in a signal, or every signal NaN for a sample the source flags invalid, which is what
+  ``step(..., valid=False)`` does): NaN residuals, ``sample_valid`` false, the decision held, the filter propagated
+  by the gap rule of :mod:`fdikit.gaps` (missing outputs fed the least-squares values that zero each filter
+  part's residuals, a missing control or a direction the feedthrough does not see held at its last valid value)
+  and the recovery covariance ``P+ = T P Tᵀ + Q`` updated.  The rule is linear per pattern of missing signals, so
+  the export precomputes, per pattern, ``z+ = F [z; v; last]`` and ``(T, Q)`` from the reference's own
+  :meth:`fdikit.gaps.GapRule.pattern` — for the patterns listed in ``CExport.gap_patterns``: by default every
+  pattern when the detector reads at most 5 signals, else all signals missing, all outputs missing, all controls
+  missing and each single signal missing; ``gap_patterns=`` replaces the defaults (all signals missing is always
+  listed; ``gap_patterns=[]`` keeps only it, the smallest code).  On these patterns the C code equals Python to
+  rounding.  Each pattern costs up to ``n (n + 2 (m + p)) + 2 n²`` constants (``CExport.const_bytes`` reports the
+  total).  **A pattern not listed** (two of many sensors out at once) is propagated with the
+  all-signals-missing map (its finite values are only stored as the last valid ones) and the step returns
+  ``<NAME>_STATUS_UNLISTED_GAP`` (1): the filter state then differs from Python's until the gap transient has
+  decayed, and the recovery may end at another sample;
+* recovering samples (finite, after a gap): as Python — residuals computed, ``sample_valid`` false,
+  ``recovering`` true, the decision held — until every residual's transient standard deviation
+  ``sqrt((C P Cᵀ)_ii)`` is at most ``recovery_tol`` times its noise standard deviation (``P`` propagated
+  ``A P Aᵀ``, stored per block of coupled states) and, for parts fed held values, at least ``settle`` samples.
 
-Why hand-written: no library turns a state-space filter bank and its decision logic into dependency-free C;
-python-control and scipy stop at the matrices.
+Precision ``"single"``: matrices, state, residuals and the CUSUM in ``float`` (the operating point is subtracted in
+double, thresholds and centres compared in double).  ``CExport.error_gain`` is a first-order bound ``K`` (in the
+unit roundoffs 2⁻²⁴ and 2⁻⁵³) on ``max_i |r_C,i − r_Python,i|`` per unit of the largest input deviation
+``max_k ||v_k||∞`` (``v = [u − u0; y − y0]``) over the valid samples since reset, without gaps: from the rounding
+of the matrices and of every sum (``γ_m``), propagated through ``Σ_j |C A^j|`` and ``Σ_j |A^j B|`` (computed until
+``||A^j||∞ < 1e-10``, with a rigorous tail; ``inf`` when the filter does not forget within 20000 samples).  Decisions
+may differ where a statistic is within that error of its threshold.  For ``"double"`` the same formula gives the C
+code's distance to Python.
+
+References
+----------
+Douglas et al. 1996, Ch. 1 (a threshold per residual; the fault announced from the pattern of fired residuals, the
+bank logic) and §4.2 (the bank of detection filters); Page 1954 and Basseville & Nikiforov 1993, §2.2 (the
+CUSUM).  The gap rule is :mod:`fdikit.gaps` (no source document).
 
 Examples
 --------
@@ -33,339 +66,449 @@ Examples
 >>> from fdikit.detector import Detector
 >>> from fdikit.residuals import ResidualGenerator
 >>> g = ResidualGenerator([[0.4]], [[1.0, 0.5]], [[-1.0]], [[0.0, 1.0]], ("u",), ("y",), ("r",), dt=1.0)
->>> out = export_c(Detector(g, ThresholdEvaluator(thresholds=[0.5], isolates=("y_sensor",))), tempfile.mkdtemp())
->>> out.header.name, out.source.name, out.faults
-('fdikit_monitor.h', 'fdikit_monitor.c', ('y_sensor',))
+>>> ex = export_c(Detector(g, ThresholdEvaluator(thresholds=[0.5], isolates=("y_sensor",))), tempfile.mkdtemp())
+>>> ex.header.name, ex.source.name, ex.faults
+('fdikit_monitor.h', 'fdikit_monitor.c', ('y_sensor', 'unknown'))
 """
 
 from __future__ import annotations
 
+import itertools
 import os
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from fdikit.atomic import write_text
-from fdikit.decision import ThresholdEvaluator
-from fdikit.detector import Detector
-from fdikit.errors import ParameterError
-from fdikit.gaps import GapRule
+from fdikit.errors import DataError, ParameterError
 
-__all__ = ["CExport", "export_c"]
+__all__ = ["CExport", "SUPPORTED_EVALUATORS", "export_c"]
+
+#: The evaluators :func:`export_c` translates (exact types).
+SUPPORTED_EVALUATORS = ("ThresholdEvaluator", "CusumEvaluator")
+
+_KEYWORDS = frozenset("""auto break case char const continue default do double else enum extern float for goto if
+inline int long register restrict return short signed sizeof static struct switch typedef union unsigned void
+volatile while _Bool _Complex _Imaginary bool true false NULL main""".split())
+_AUTO_ALL = 5  # detectors reading at most this many signals get every missing-signal pattern
+_MAX_PATTERNS = 256
 
 
 @dataclass(frozen=True)
 class CExport:
-    """What :func:`export_c` wrote.
+    """What :func:`export_c` wrote: the two files and the tables the C step is indexed by.
 
     Attributes
     ----------
     header, source : pathlib.Path
         ``<name>.h`` and ``<name>.c``.
     name : str
-        The C prefix.
-    controls, outputs : tuple of str
-        The order of ``u`` and ``y`` in ``<name>_step``.
-    residuals : tuple of str
-        The order of ``out->r`` and ``out->fired``.
+        The C prefix of every exported symbol.
+    n_states, n_controls, n_outputs, n_residuals : int
+        Filter order, lengths of ``u`` and ``y``, and of ``out.r`` / ``out.fired``.
+    controls, outputs, residuals : tuple of str
+        The order of ``u``, ``y`` and of the residuals (the evaluator's).
     faults : tuple of str
-        ``<name>_fault_names``: the fault index of ``out->fault``.
-
-    Examples
-    --------
-    >>> CExport(Path("m.h"), Path("m.c"), "m", ("u",), ("y",), ("r",), ()).faults
-    ()
-    """
-
-    header: Path
-    source: Path
-    name: str
-    controls: tuple[str, ...]
-    outputs: tuple[str, ...]
-    residuals: tuple[str, ...]
-    faults: tuple[str, ...]
-
-
-def _num(x: float) -> str:
-    x = float(x)
-    if np.isnan(x):
-        return "NAN"
-    if np.isinf(x):
-        return "INFINITY" if x > 0 else "-INFINITY"
-    return x.hex()
-
-
-def _array(ctype: str, name: str, values, fmt=_num) -> str:
-    values = list(np.asarray(values).ravel())
-    body = ", ".join(fmt(v) for v in values) if values else ("0" if ctype != "const char *const" else '""')
-    return f"static const {ctype} {name}[{max(len(values), 1)}] = {{{body}}};\n"
-
-
-def _csr(M: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    rows, cols = np.nonzero(M)
-    ptr = np.searchsorted(rows, np.arange(M.shape[0] + 1))
-    return ptr, cols, M[rows, cols]
-
-
-def _string(s: str) -> str:
-    return '"' + s.replace("\\", "\\\\").replace('"', '\\"') + '"'
-
-
-def _gap_matrices(rule: GapRule, n: int, nv: int) -> tuple[np.ndarray, np.ndarray]:
-    """``T``, ``G`` of the all-missing pattern: ``propagate(z, ·, none valid, last) = T z + G last`` (linear)."""
-    none = np.zeros(nv, bool)
-    nan = np.full(nv, np.nan)
-    T = np.column_stack([rule.propagate(e, nan, none, np.zeros(nv)) for e in np.eye(n)]) if n else np.zeros((0, 0))
-    G = np.column_stack([rule.propagate(np.zeros(n), nan, none, e) for e in np.eye(nv)]) if nv else np.zeros((n, 0))
-    return T.reshape(n, n), G.reshape(n, nv)
-
-
-def export_c(detector: Detector, directory: str | os.PathLike, *, name: str = "fdikit_monitor",
-             dt: float | None = None) -> CExport:
-    """Write a detector as C99: ``<name>.h`` and ``<name>.c`` in ``directory`` (atomically).
-
-    Parameters
-    ----------
-    detector : Detector
-        A generator (discrete, or continuous with ``dt``) and a :class:`~fdikit.decision.ThresholdEvaluator`.
-    directory : path
-        Where to write (created if missing).
-    name : str, default "fdikit_monitor"
-        The C prefix of every symbol and the file names (a C identifier).
-    dt : float, optional
-        Sample time for a continuous generator (ZOH discretisation, as ``Detector.online(dt)``).
-
-    Returns
-    -------
-    CExport
-
-    Raises
-    ------
-    ParameterError
-        For another evaluator, a signature table, an unfitted evaluator or a name that is not a C identifier.
-    ModelError
-        For a continuous generator without ``dt``.
+        ``<name>_fault_names``: ``out.fault`` indexes it (``-1``: none); ``'unknown'`` is at ``unknown``.
+    unknown : int
+        The index of ``'unknown'``.
+    evaluator : str
+        ``'threshold'`` or ``'cusum'``.
+    dt : float
+        Sample time [s] of the exported (discrete) filter.
+    precision : str
+        ``'double'`` or ``'single'``.
+    gap_patterns : tuple of tuple of str
+        The missing-signal patterns the C code propagates exactly as Python (the first: every signal missing).
+    error_gain : float
+        First-order bound on ``max |r_C − r_Python|`` per unit of the largest input deviation so far (module
+        docstring).
+    const_bytes : int
+        Size of the ``static const`` data of the source (matrices, gap maps, tables) for the target's flash budget.
 
     Examples
     --------
     >>> import tempfile
     >>> from fdikit.decision import ThresholdEvaluator
+    >>> from fdikit.detector import Detector
     >>> from fdikit.residuals import ResidualGenerator
-    >>> g = ResidualGenerator([[0.5]], [[1.0]], [[1.0]], [[0.0]], (), ("y",), ("r",), dt=1.0)
-    >>> export_c(Detector(g, ThresholdEvaluator(thresholds=[1.0])), tempfile.mkdtemp(), name="m").residuals
-    ('r',)
+    >>> g = ResidualGenerator([[0.4]], [[1.0, 0.5]], [[-1.0]], [[0.0, 1.0]], ("u",), ("y",), ("r",), dt=1.0)
+    >>> ex = export_c(Detector(g, ThresholdEvaluator(thresholds=[0.5])), tempfile.mkdtemp(), name="m")
+    >>> ex.n_states, ex.n_controls, ex.n_outputs, ex.n_residuals, ex.gap_patterns
+    (1, 1, 1, 1, (('u', 'y'), ('u',), ('y',)))
     """
+
+    header: Path
+    source: Path
+    name: str
+    n_states: int
+    n_controls: int
+    n_outputs: int
+    n_residuals: int
+    controls: tuple[str, ...]
+    outputs: tuple[str, ...]
+    residuals: tuple[str, ...]
+    faults: tuple[str, ...]
+    unknown: int
+    evaluator: str
+    dt: float
+    precision: str
+    gap_patterns: tuple[tuple[str, ...], ...]
+    error_gain: float
+    const_bytes: int
+
+
+def export_c(detector, directory: str | os.PathLike, *, name: str = "fdikit_monitor", dt: float | None = None,
+             precision: str = "double", gap_patterns: Sequence[Sequence[str]] | None = None) -> CExport:
+    """Write ``<name>.h`` and ``<name>.c``: the detector's online step as C99 (module docstring).
+
+    Parameters
+    ----------
+    detector : Detector
+        A :class:`~fdikit.detector.Detector` with a ThresholdEvaluator or CusumEvaluator, set up (thresholds).
+    directory : str or PathLike
+        Folder of the two files (created when missing); each file is written atomically.
+    name : str, default "fdikit_monitor"
+        Prefix of the files and of every C symbol: a C identifier (letters, digits, ``_``; no leading digit or
+        ``_``; at most 40 characters; not a keyword).
+    dt : float, optional
+        Sample time [s]; needed for a continuous generator (ZOH), else it must be the generator's own.
+    precision : {"double", "single"}, default "double"
+        Arithmetic of the filter and the evaluator (``"single"``: ``float``; bound ``CExport.error_gain``).
+    gap_patterns : sequence of sequence of str, optional
+        The sets of signal names whose simultaneous dropout the C code propagates exactly as Python, replacing the
+        defaults of the module docstring (every signal missing is always included; ``[]`` keeps only it).
+
+    Returns
+    -------
+    CExport
+        The paths and the tables of the C step.
+
+    Raises
+    ------
+    ParameterError
+        For an unsupported or unset evaluator (the message names the supported ones), a bad ``name``,
+        ``precision`` or ``gap_patterns``, isolation tables that do not fit the residuals, or a detector that is
+        not a Detector.
+    ModelError
+        For a continuous generator without ``dt``.
+    DataError
+        For a ``dt`` other than a discrete generator's own, evaluator parameters of the wrong length, a signature
+        table the residuals do not map onto, or files that cannot be written.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from fdikit.decision import CusumEvaluator
+    >>> from fdikit.detector import Detector
+    >>> from fdikit.residuals import ResidualGenerator
+    >>> g = ResidualGenerator([[-2.0]], [[1.0, 2.0]], [[-1.0]], [[0.0, 1.0]], ("u",), ("y",), ("r",))
+    >>> ex = export_c(Detector(g, CusumEvaluator(drift=0.5, threshold=5.0)), tempfile.mkdtemp(), dt=0.01)
+    >>> ex.evaluator, ex.dt, ex.n_states
+    ('cusum', 0.01, 1)
+    """
+    from fdikit.atomic import atomic_path
+    from fdikit.detector import Detector
+    from fdikit.gaps import GapRule
+    from fdikit.runtime.c_render import render_header, render_source
+
     if not isinstance(detector, Detector):
         raise ParameterError(f"detector must be a fdikit.detector.Detector, got {type(detector).__name__}")
-    if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]{0,40}", name):
-        raise ParameterError(f"name must be a C identifier (letters, digits, _; at most 41 characters), got {name!r}")
-    ev = detector.evaluator
-    if type(ev) is not ThresholdEvaluator:
-        raise ParameterError(f"C export supports the ThresholdEvaluator only, got {type(ev).__name__}; export a "
-                             "detector with thresholds, or run the compiled Python monitor (fdikit.runtime.Monitor)")
-    if ev.signatures is not None:
-        raise ParameterError("C export does not support a fault-signature table (signatures=); use isolates/groups")
-    names = detector.residual_names
-    tau, c, iso = ev._ready(len(names))  # noqa: SLF001 - the evaluator's own resolution of its parameters
-    stepper = detector.generator.online(dt=dt, residual_cov=detector.residual_cov, recovery_tol=detector.recovery_tol)
-    g = stepper.generator
-    n, mu, p, q = g.n, len(g.controls), len(g.outputs), len(g.residuals)
-    nv = mu + p
-    sel = [g.residuals.index(r) for r in names]
-    groups = ev.groups if ev.groups is not None else ("",) * len(names)
-    faults = tuple(dict.fromkeys(f for f in iso if f is not None))
-    group_ids = list(dict.fromkeys(groups))
-    key = [faults.index(f) if f is not None else -1 - k for k, f in enumerate(iso)]  # untied: a key of its own
+    if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z][A-Za-z0-9_]{0,39}", name) or name in _KEYWORDS:
+        raise ParameterError(f"name must be a C identifier of at most 40 characters starting with a letter (letters, "
+                             f"digits, '_'; not a C keyword), got {name!r}")
+    if precision not in ("double", "single"):
+        raise ParameterError(f"precision must be 'double' or 'single', got {precision!r}")
+    g = detector.generator.online(dt=dt, residual_cov=detector.residual_cov,
+                                  recovery_tol=detector.recovery_tol).generator  # ZOH and checks as online()
+    nv = g.B.shape[1]
+    if nv == 0:
+        raise ParameterError("the detector's generator reads no signal; there is nothing to export")
     rule = GapRule(g, detector.residual_cov, detector.recovery_tol)
-    T, G = _gap_matrices(rule, n, nv)
-    _, _, _, _, Tp, Qp, held = rule.pattern(np.zeros(nv, bool))
-    k_of, n_of = ev.persistence
-    U = name.upper()
-    ptr, col, val = _csr(np.block([[g.A, g.B], [g.C, g.D]]))
-    gptr, gcol, gval = _csr(np.hstack([T, G]))
-    warm = detector.warmup_samples(g.dt)
-    h = f"""/* {name}.h — generated by fdikit {_version()} from the detector {detector.name!r}. C99, no allocation.
- * step(u, y): absolute signals; u = {list(g.controls)}, y = {list(g.outputs)}.
- * out->r, out->fired: residuals {list(names)}; out->fault: index into {name}_fault_names
- * ({list(faults)}), -1 none, {U}_NF unknown.  Sample time {g.dt} s. */
-#ifndef {U}_H
-#define {U}_H
-#include <stdint.h>
-#define {U}_N {n}
-#define {U}_NU {mu}
-#define {U}_NY {p}
-#define {U}_NR {len(names)}
-#define {U}_NF {len(faults)}
-#define {U}_DT {_num(g.dt)}
-typedef struct {{
-    double x[{max(n, 1)}], last[{max(nv, 1)}], P[{max(n * n, 1)}], tmp[{max(n * n, 1)}];
-    int P_active;
-    long hold, warm;
-    uint8_t win[{n_of * max(len(names), 1)}], fired[{max(len(names), 1)}];
-    int win_count, win_pos, have_fired;
-}} {name}_state;
-typedef struct {{
-    double r[{max(len(names), 1)}];
-    uint8_t fired[{max(len(names), 1)}];
-    int alarm, fault, valid, recovering;
-}} {name}_output;
-extern const char *const {name}_fault_names[{max(len(faults), 1)}];
-void {name}_init({name}_state *s);
-void {name}_reset({name}_state *s);
-int {name}_step({name}_state *s, const double *u, const double *y, int valid, {name}_output *out);
-#endif
-"""
-    src = f"""/* {name}.c — generated by fdikit; see {name}.h. */
-#include <math.h>
-#include <string.h>
-#include "{name}.h"
-#define N {n}
-#define NV {nv}
-#define NU {mu}
-#define NQ {q}
-#define NR {len(names)}
-#define NG {len(group_ids)}
-#define KOF {k_of}
-#define NOF {n_of}
-{_array("double", "OFF", g.offset)}{_array("int", "MPTR", ptr, str)}{_array("int", "MCOL", col, str)}\
-{_array("double", "MVAL", val)}{_array("int", "GPTR", gptr, str)}{_array("int", "GCOL", gcol, str)}\
-{_array("double", "GVAL", gval)}{_array("double", "TP", Tp)}{_array("double", "QP", Qp)}{_array("double", "AM", g.A)}\
-{_array("double", "CM", g.C)}{_array("double", "LIMIT", np.broadcast_to(rule.limit, (q,)))}\
-{_array("int", "SEL", sel, str)}{_array("double", "TAU", tau)}{_array("double", "CTR", c)}\
-{_array("int", "GROUP", [group_ids.index(x) for x in groups], str)}{_array("int", "KEY", key, str)}\
-static const int HELD = {int(bool(held))};
-static const long SETTLE = {int(rule.settle)};
-static const long WARM = {int(warm)};
-const char *const {name}_fault_names[{max(len(faults), 1)}] = {{{", ".join(map(_string, faults)) or '""'}}};
-
-void {name}_reset({name}_state *s) {{
-    memset(s, 0, sizeof *s);
-    s->warm = WARM;
-}}
-
-void {name}_init({name}_state *s) {{ {name}_reset(s); }}
-
-/* P <- X P X^T (+ Q): the transient covariance of the reference gap rule */
-static void congruence({name}_state *s, const double *X, const double *Q) {{
-    int i, j, k;
-    for (i = 0; i < N; ++i)
-        for (j = 0; j < N; ++j) {{
-            double acc = 0.0;
-            for (k = 0; k < N; ++k) acc += X[i * N + k] * s->P[k * N + j];
-            s->tmp[i * N + j] = acc;
-        }}
-    for (i = 0; i < N; ++i)
-        for (j = 0; j < N; ++j) {{
-            double acc = Q ? Q[i * N + j] : 0.0;
-            for (k = 0; k < N; ++k) acc += s->tmp[i * N + k] * X[j * N + k];
-            s->P[i * N + j] = acc;
-        }}
-}}
-
-static int recovered({name}_state *s) {{
-    int recovering = 0, i, j, k;
-    if (s->P_active) {{
-        int over = 0;
-        for (i = 0; i < NQ && !over; ++i) {{
-            double d = 0.0;
-            for (j = 0; j < N; ++j) {{
-                double row = 0.0;
-                for (k = 0; k < N; ++k) row += s->P[j * N + k] * CM[i * N + k];
-                d += CM[i * N + j] * row;
-            }}
-            over = d > LIMIT[i];
-        }}
-        if (over) {{ recovering = 1; congruence(s, AM, 0); }} else s->P_active = 0;
-    }}
-    if (s->hold != 0) {{ recovering = 1; if (s->hold > 0) s->hold -= 1; }}
-    return !recovering;
-}}
-
-static int isolate(const uint8_t *fired) {{
-    int any = 0, candidate = -1, conflict = 0, g, k;
-    for (k = 0; k < NR; ++k) any |= fired[k];
-    if (!any) return -1;
-    for (g = 0; g < NG; ++g) {{
-        int first = 0, have = 0, multi = 0;
-        for (k = 0; k < NR; ++k)
-            if (GROUP[k] == g && fired[k]) {{
-                if (!have) {{ first = KEY[k]; have = 1; }} else if (KEY[k] != first) multi = 1;
-            }}
-        if (!have || multi) continue;
-        if (first < 0) conflict = 1;
-        else if (candidate < 0) candidate = first;
-        else if (candidate != first) conflict = 1;
-    }}
-    return (candidate >= 0 && !conflict) ? candidate : {U}_NF;
-}}
-
-int {name}_step({name}_state *s, const double *u, const double *y, int valid, {name}_output *out) {{
-    double z[N + NV + 1], o[N + NQ + 1];
-    int ok = valid != 0, i, j, status, use;
-    for (j = 0; j < NU; ++j) {{ z[N + j] = u[j] - OFF[j]; ok = ok && isfinite(z[N + j]); }}
-    for (j = 0; j < NV - NU; ++j) {{ z[N + NU + j] = y[j] - OFF[NU + j]; ok = ok && isfinite(z[N + NU + j]); }}
-    if (!ok) {{  /* a dropout of every signal: the reference gap rule's propagation and recovery bookkeeping */
-        for (j = 0; j < N; ++j) z[j] = s->x[j];
-        for (j = 0; j < NV; ++j) z[N + j] = s->last[j];
-        for (i = 0; i < N; ++i) {{
-            double acc = 0.0;
-            for (j = GPTR[i]; j < GPTR[i + 1]; ++j) acc += GVAL[j] * z[GCOL[j]];
-            s->x[i] = acc;
-        }}
-        if (!s->P_active) {{ memset(s->P, 0, sizeof s->P); s->P_active = 1; }}
-        congruence(s, TP, QP);
-        if (HELD) s->hold = SETTLE;
-        for (i = 0; i < NR; ++i) out->r[i] = NAN;
-        status = 1;
-        use = 0;
-        out->recovering = 0;
-    }} else {{
-        for (j = 0; j < N; ++j) z[j] = s->x[j];
-        for (i = 0; i < N + NQ; ++i) {{
-            double acc = 0.0;
-            for (j = MPTR[i]; j < MPTR[i + 1]; ++j) acc += MVAL[j] * z[MCOL[j]];
-            o[i] = acc;
-        }}
-        for (j = 0; j < N; ++j) s->x[j] = o[j];
-        for (j = 0; j < NV; ++j) s->last[j] = z[N + j];
-        for (i = 0; i < NR; ++i) out->r[i] = o[N + SEL[i]];
-        use = (s->P_active || s->hold != 0) ? recovered(s) : 1;
-        status = use ? 0 : 2;
-        out->recovering = !use;
-    }}
-    out->valid = use;
-    if (s->warm > 0) {{ s->warm -= 1; use = 0; }}
-    for (i = 0; i < NR && use; ++i) use = isfinite(out->r[i]);
-    if (use) {{  /* k of the last n valid samples above the threshold */
-        uint8_t *w = s->win + s->win_pos * (NR > 0 ? NR : 1);
-        for (i = 0; i < NR; ++i) w[i] = fabs(out->r[i] - CTR[i]) > TAU[i];
-        s->win_pos = (s->win_pos + 1) % NOF;
-        if (s->win_count < NOF) s->win_count += 1;
-        for (i = 0; i < NR; ++i) {{
-            int count = 0;
-            for (j = 0; j < s->win_count; ++j) count += s->win[j * (NR > 0 ? NR : 1) + i];
-            s->fired[i] = count >= KOF;
-        }}
-        s->have_fired = 1;
-    }}
-    out->alarm = 0;
-    for (i = 0; i < NR; ++i) {{ out->fired[i] = s->have_fired ? s->fired[i] : 0; out->alarm |= out->fired[i]; }}
-    out->fault = isolate(out->fired);
-    out->valid = use;
-    return status;
-}}
-"""
+    fitted = getattr(detector.evaluator, "names", None)
+    idx = (list(range(len(g.residuals))) if fitted is None or tuple(fitted) == g.residuals
+           else [g.residuals.index(r) for r in fitted])  # as Detector selects the evaluator's residuals
+    ev, iso = _evaluator(detector.evaluator, len(idx))
+    patterns = _patterns(g, gap_patterns)
+    plan = _filter_plan(g, rule, idx, patterns, precision == "single")
+    signals = g.controls + g.outputs
+    faults = iso.pop("faults")
+    plan.update(
+        name=name, NAME=name.upper(), single=precision == "single", real="float" if precision == "single" else "double",
+        detector=detector.name, description=detector.description, version=detector.fdikit_version,
+        dt=float(g.dt), controls=g.controls, outputs=g.outputs, residuals=tuple(g.residuals[i] for i in idx),
+        res_faults=iso.pop("res_faults"), columns=detector.columns, units=detector.units,
+        offset=[float(x) for x in g.offset], evaluator=ev, isolation=iso, faults=faults,
+        unknown=faults.index("unknown"), warm=detector.warmup_samples(g.dt),
+        pattern_names=[tuple(s for s, b in zip(signals, bad) if b) for bad in patterns])
+    eps = 2.0**-24 if precision == "single" else 2.0**-53
+    gain = _error_gain(g, idx, eps) + _error_gain(g, idx, 2.0**-53)
     directory = Path(directory)
-    directory.mkdir(parents=True, exist_ok=True)
     header, source = directory / f"{name}.h", directory / f"{name}.c"
-    write_text(header, h)
-    write_text(source, src)
-    return CExport(header, source, name, g.controls, g.outputs, tuple(names), faults)
+    htext, ctext = render_header(plan), render_source(plan)
+    with atomic_path(header, suffix=".h") as th, atomic_path(source, suffix=".c") as tc:
+        th.write_text(htext, encoding="ascii")
+        tc.write_text(ctext, encoding="ascii")
+    return CExport(header, source, name, g.n, len(g.controls), len(g.outputs), len(idx), g.controls, g.outputs,
+                   plan["residuals"], tuple(faults), plan["unknown"], ev["kind"], float(g.dt), precision,
+                   tuple(plan["pattern_names"]), float(gain), _const_bytes(ctext, precision == "single"))
 
 
-def _version() -> str:
-    from fdikit import __version__
+# ---------------------------------------------------------------------------------------------------- evaluator
+def _widen(what: str, value, q: int, default: float) -> np.ndarray:
+    """One value per residual (a scalar broadcast), as the evaluators' ``_ready`` does; DataError otherwise."""
+    if value is None:
+        return np.full(q, float(default))
+    arr = np.atleast_1d(np.asarray(value, dtype=float)).ravel()
+    if arr.size not in (1, q):
+        raise DataError(f"{arr.size} {what} values for {q} residuals")
+    return np.array(np.broadcast_to(arr, (q,)), dtype=float)
 
-    return __version__
+
+def _evaluator(ev, q: int) -> tuple[dict, dict]:
+    """The evaluator's constants and its isolation tables; ParameterError for an evaluator that is not exported."""
+    from fdikit.decision import CusumEvaluator, ThresholdEvaluator
+
+    if type(ev) is ThresholdEvaluator:
+        if ev.thresholds is None:
+            raise ParameterError("the ThresholdEvaluator has no thresholds; pass thresholds= or call fit() before "
+                                 "exporting")
+        k, n = ev.persistence
+        spec = {"kind": "threshold", "tau": _widen("threshold", ev.thresholds, q, 1.0),
+                "center": _widen("center", ev.center, q, 0.0), "k": int(k), "n": int(n),
+                "title": f"ThresholdEvaluator ({k} of {n} samples)"}
+    elif type(ev) is CusumEvaluator:
+        if ev.drift is None or ev.threshold is None:
+            raise ParameterError("the CusumEvaluator has no drift/threshold; pass drift= and threshold= or call "
+                                 "fit(fault_free, arl0=..., shift=...) before exporting")
+        spec = {"kind": "cusum", "nu": _widen("drift", ev.drift, q, 0.5),
+                "h": _widen("threshold", ev.threshold, q, 1.0), "mu": _widen("mean", ev.mean, q, 0.0),
+                "sd": _widen("sigma", ev.sigma, q, 1.0),
+                "two_sided": bool(ev.two_sided), "reset": ev.restart == "reset", "hold": int(ev.hold),
+                "title": f"CusumEvaluator ({'two' if ev.two_sided else 'one'}-sided, restart {ev.restart!r}, "
+                         f"hold {int(ev.hold)})"}
+    else:
+        raise ParameterError(f"export_c translates the evaluators {list(SUPPORTED_EVALUATORS)}, not "
+                             f"{type(ev).__name__}; deploy it with Detector.online() or fdikit.runtime instead")
+    iso = tuple(ev.isolates) if ev.isolates else (None,) * q
+    if len(iso) != q:
+        raise ParameterError(f"the evaluator has {len(iso)} 'isolates' entries for {q} residuals")
+    return spec, _isolation(iso, ev.groups, ev.signatures, ev.names, q)
+
+
+def _isolation(iso: tuple, groups, table, names, q: int) -> dict:
+    """Tables of the isolation logic of :func:`fdikit.decision.common.isolate_fired`, as the evaluators' steps use
+    it."""
+    if table is not None:
+        rnames = tuple(names) if names is not None else tuple(f"r{i}" for i in range(q))
+        M = table.resolve(rnames, iso)
+        if len(table.groups) > 64:
+            raise ParameterError(f"the signature table has {len(table.groups)} residual groups; export_c handles at "
+                                 "most 64")
+        mask = [sum(1 << j for j in range(M.shape[1]) if M[i, j]) for i in range(q)]
+        sig = [sum(1 << j for j, on in enumerate(row) if on) for row in table.matrix]
+        faults = list(table.faults)
+        kind = {"kind": "signature", "res_mask": mask, "sig": sig, "partial": table.match == "partial"}
+    else:
+        groups = tuple(groups) if groups is not None else ("",) * q
+        if len(groups) != q:
+            raise ParameterError(f"the evaluator has {len(groups)} 'groups' entries for {q} residuals")
+        keys, res_key, grp_start = [], [0] * q, [0]
+        for grp in dict.fromkeys(groups):  # fdikit.diagnosis.isolate: per filter, its faults ('?k': untied)
+            cols = [k for k, gg in enumerate(groups) if gg == grp]
+            names_k = sorted({iso[k] if iso[k] is not None else f"?{k}" for k in cols})
+            for k in cols:
+                res_key[k] = len(keys) + names_k.index(iso[k] if iso[k] is not None else f"?{k}")
+            keys += names_k
+            grp_start.append(len(keys))
+        faults = list(dict.fromkeys(k for k in keys if not k.startswith("?")))
+        kind = {"kind": "logic", "res_key": res_key, "grp_start": grp_start,
+                "key_fault": [-1 if k.startswith("?") else faults.index(k) for k in keys]}
+    if "unknown" not in faults:
+        faults.append("unknown")
+    kind.update(faults=faults, res_faults=[str(f) if f is not None else "" for f in iso])
+    return kind
+
+
+# ---------------------------------------------------------------------------------------------------- filter
+def _patterns(g, extra) -> list[np.ndarray]:
+    """Missing-signal patterns (bool masks over [u; y]) to precompute: all missing first, then the defaults or the
+    given ones."""
+    signals = g.controls + g.outputs
+    nv, mu = len(signals), len(g.controls)
+    out = [np.ones(nv, bool)]
+    if extra is not None:
+        combos = []
+        if isinstance(extra, (str, bytes)) or not isinstance(extra, Sequence):
+            raise ParameterError("gap_patterns must be a sequence of sets of signal names, e.g. [('y1', 'y2')]")
+        for pat in extra:
+            pat = (pat,) if isinstance(pat, str) else tuple(pat)
+            unknown = [s for s in pat if s not in signals]
+            if unknown or not pat:
+                raise ParameterError(f"gap pattern {list(pat)} must name one or more signals the detector reads "
+                                     f"{list(signals)}; unknown {unknown}")
+            combos.append(tuple(signals.index(s) for s in pat))
+    elif nv <= _AUTO_ALL:
+        combos = [c for k in range(nv - 1, 0, -1) for c in itertools.combinations(range(nv), k)]
+    else:
+        combos = [tuple(range(mu, nv)), tuple(range(mu))] if mu and nv > mu else []
+        combos += [(j,) for j in range(nv)]
+    seen = {out[0].tobytes()}
+    for c in combos:
+        m = np.zeros(nv, bool)
+        m[list(c)] = True
+        if m.tobytes() not in seen:
+            seen.add(m.tobytes())
+            out.append(m)
+    if len(out) > _MAX_PATTERNS:
+        raise ParameterError(f"{len(out)} gap patterns; export_c precomputes at most {_MAX_PATTERNS}")
+    return out
+
+
+def _gap_map(g, rule, ok: np.ndarray) -> np.ndarray:
+    """``F`` with ``z+ = F [z; v0; last]`` on an invalid sample of pattern ``ok`` (v0: v with the bad entries 0):
+    :meth:`fdikit.gaps.GapRule.propagate` written as one matrix."""
+    n, nv, mu = g.n, g.B.shape[1], rule.mu
+    bad_y, _, _, parts, _, _, _ = rule.pattern(ok)
+    W0 = np.zeros((nv, n + 2 * nv))  # w = W x: valid entries v0, bad controls (and outputs, for now) last
+    for j in range(nv):
+        W0[j, n + j if ok[j] else n + nv + j] = 1.0
+    W0[mu + bad_y] = 0.0
+    F = np.zeros((n, n + 2 * nv))
+    for states, rows, Mp, Pi in parts:
+        if not states.size:
+            continue
+        W = W0.copy()
+        if bad_y.size:
+            K = g.D[rows] @ W0  # known = C z + D_u w_u + D_good v_good
+            K[:, states] += g.C[np.ix_(rows, states)]
+            L = np.zeros((bad_y.size, n + 2 * nv))
+            L[:, n + nv + mu + bad_y] = Pi
+            W[mu + bad_y] = -(Mp @ K) + L
+        F[states] = g.B[states] @ W
+        F[np.ix_(states, states)] += g.A[np.ix_(states, states)]
+    return F
+
+
+def _csr(M: np.ndarray) -> tuple[list[int], list[int], list[float]]:
+    rows, cols = np.nonzero(M)
+    ptr = np.searchsorted(rows, np.arange(M.shape[0] + 1)).tolist()
+    return ptr, cols.tolist(), M[rows, cols].tolist()
+
+
+def _stacked_csr(mats: list[np.ndarray]) -> tuple[list[int], list[int], list[float]]:
+    """Compressed rows of several matrices of equal shape: ptr per matrix (absolute offsets), shared idx/val."""
+    ptr, idx, val = [], [], []
+    for M in mats:
+        p, i, v = _csr(M)
+        ptr += [x + len(idx) for x in p]
+        idx += i
+        val += v
+    return ptr, idx, val
+
+
+def _blocks(n: int, coupling: list[np.ndarray], C: np.ndarray) -> list[list[int]]:
+    """Groups of states coupled by any of the matrices or by a residual row (the blocks the covariance lives in)."""
+    parent = list(range(n))
+
+    def find(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    for M in coupling:
+        for i, j in zip(*np.nonzero(M)):
+            parent[find(int(i))] = find(int(j))
+    for row in C:
+        nz = np.flatnonzero(row)
+        for j in nz[1:]:
+            parent[find(int(j))] = find(int(nz[0]))
+    out: dict[int, list[int]] = {}
+    for i in range(n):
+        out.setdefault(find(i), []).append(i)
+    return sorted(out.values())
+
+
+def _filter_plan(g, rule, idx: list[int], patterns: list[np.ndarray], single: bool) -> dict:
+    """Matrices of the C step in the block order of the states: filter, gap maps, recovery rule."""
+    n, nv = g.n, g.B.shape[1]
+    maps = [(_gap_map(g, rule, ~bad), *rule.pattern(~bad)[4:]) for bad in patterns]
+    blocks = _blocks(n, [g.A] + [m[1] for m in maps] + [m[2] for m in maps], g.C)
+    perm = np.array([i for b in blocks for i in b], dtype=int)
+    where = np.empty(n, int)
+    where[perm] = np.arange(n)
+    A, B, C = g.A[np.ix_(perm, perm)], g.B[perm], g.C[:, perm]
+    starts = np.cumsum([0] + [len(b) for b in blocks]).tolist()
+    offs = np.cumsum([0] + [len(b) ** 2 for b in blocks]).tolist()
+    blk_of = np.repeat(np.arange(len(blocks)), [len(b) for b in blocks])
+
+    def pos(i: int, j: int) -> int:  # place of P[i, j] (permuted indices, same block) in the block storage
+        b = blk_of[i]
+        nb = starts[b + 1] - starts[b]
+        return offs[b] + (i - starts[b]) * nb + (j - starts[b])
+
+    Fs, Ts, q_ptr, q_pos, q_val = [], [], [0], [], []
+    for F, T, Q, _ in maps:
+        F = F[perm]
+        F[:, :n] = F[:, :n][:, perm]
+        Fs.append(F)
+        Ts.append(T[np.ix_(perm, perm)])
+        Qp = Q[np.ix_(perm, perm)]
+        for i, j in zip(*np.nonzero(Qp)):
+            q_pos.append(pos(int(i), int(j)))
+            q_val.append(float(Qp[i, j]))
+        q_ptr.append(len(q_pos))
+    row_blk = [int(blk_of[np.flatnonzero(row)[0]]) if np.any(row) else -1 for row in C]
+    width = n + 2 * nv
+    return {
+        "n": n, "mu": rule.mu, "nv": nv, "nr": len(idx), "idx_t": "uint16_t" if width < 65535 else "uint32_t",
+        "AB": _csr(np.hstack([A, B])), "CD": _csr(np.hstack([C, g.D])[idx]), "A": _csr(A), "Cg": _csr(C),
+        "F": _stacked_csr(Fs), "T": _stacked_csr(Ts), "Q": (q_ptr, q_pos, q_val), "held": [int(m[3]) for m in maps],
+        "pat_bad": [int(b) for bad in patterns for b in bad], "npat": len(patterns), "row_blk": row_blk,
+        "limit": [float(x) for x in rule.limit], "settle": int(rule.settle), "blk_start": starts, "blk_off": offs,
+        "sizes": {"z": max(n, 1), "P": max(offs[-1], 1), "W": max(max((len(b) ** 2 for b in blocks), default=1), 1)},
+    }
+
+
+_SIZES = {"double": 8, "float": 4, "int32_t": 4, "uint16_t": 2, "uint32_t": 4, "uint8_t": 1, "uint64_t": 8}
+
+
+def _const_bytes(source: str, single: bool) -> int:
+    """Bytes of the ``static const`` arrays of a generated source."""
+    types = {"real_t": "float" if single else "double",
+             "IDX_T": re.search(r"typedef (\w+) IDX_T;", source).group(1)}
+    return sum(_SIZES[types.get(ctype, ctype)] * int(count)
+               for ctype, count in re.findall(r"static const (\w+) \w+\[(\d+)\]", source))
+
+
+def _error_gain(g, idx: list[int], eps: float, tol: float = 1e-10, cap: int = 20000) -> float:
+    """First-order bound on ``max |r̂ − r|`` per unit of ``max ||v||∞`` for arithmetic of unit roundoff ``eps``."""
+    A, B, C, D = g.A, g.B, g.C[idx], g.D[idx]
+    n = g.n
+    m = max(int(np.count_nonzero(np.hstack([A, B]), axis=1).max(initial=0)),
+            int(np.count_nonzero(np.hstack([C, D]), axis=1).max(initial=0))) + 1
+    gam = m * eps / (1 - m * eps)  # rounding of the matrices and of one sum of m terms
+    nrm = (lambda M: float(np.abs(M).sum(axis=1).max(initial=0.0)))  # noqa: E731
+    if n == 0:
+        return (gam + eps) * nrm(D)
+    sCA, sAB = np.zeros_like(C), np.zeros_like(B)
+    Ak, head, tail_sum = np.eye(n), 0.0, None
+    for j in range(cap):
+        a = nrm(Ak)
+        if tail_sum is None and j > 0 and a < 0.5:
+            tail_sum = head / (1 - a)  # Σ_j ||A^j|| ≤ (Σ_{l<J} ||A^l||) / (1 − ||A^J||)
+        if tail_sum is not None and a < tol:
+            sCA, sAB = nrm(sCA) + nrm(C) * a * tail_sum, nrm(sAB) + a * tail_sum * nrm(B)
+            break
+        head += a
+        sCA += np.abs(C @ Ak)
+        sAB += np.abs(Ak @ B)
+        Ak = Ak @ A
+    else:
+        return float("inf")
+    Z = sAB  # max ||z||∞ per unit of max ||v||∞
+    delta = gam * (nrm(A) * Z + nrm(B)) + eps * nrm(B)  # per-step state error drive
+    return sCA * delta + eps * nrm(D) + gam * (nrm(C) * Z + nrm(D))
