@@ -131,8 +131,8 @@ class CompiledKalman:
         ----------
         u, y : numpy.ndarray of float64, or array_like
             Input ``u(k)`` (m; None when m = 0) and measurement ``y(k)`` (p; a NaN/inf entry skips the update).
-            1-D float64 arrays take the compiled path as they are; anything else is checked and converted as
-            the reference does.
+            1-D float64 arrays (``np.zeros(0)`` for no input) take the compiled path as they are; anything else
+            (None, lists, other dtypes, columns) is checked and converted as the reference does, at its cost.
 
         Returns
         -------
@@ -213,7 +213,9 @@ class CompiledKalman:
 
     @property
     def gain(self) -> np.ndarray:
-        """Kalman gain ``K`` (n x p) of the last valid update, the steady gain once settled (covariance form)."""
+        """Kalman gain ``K`` (n x p) of the last valid update, the steady gain once settled (a copy).
+
+        Covariance form only (the square-root form never forms ``K``: NaN there)."""
         return self._f["KsT" if self.steady else "KT"].T.copy()
 
     @property
@@ -352,7 +354,8 @@ class CompiledIMM:
         ----------
         u, y : numpy.ndarray of float64, or array_like
             ``u_k`` (m; None when m = 0) and ``y_k`` (p; a NaN/inf entry: prediction only).  1-D float64 arrays
-            take the compiled path; anything else is checked and converted as the reference does.
+            (``np.zeros(0)`` for no input) take the compiled path; anything else is checked and converted as the
+            reference does, at its cost.
 
         Returns
         -------
