@@ -38,6 +38,7 @@ PAGES = [
     ("spc", "fdikit.spc", "Subspace predictive control"),
     ("ftc", "fdikit.ftc", "Fault-tolerant control"),
     ("campaign", "fdikit.campaign", "Campaigns: Monte Carlo over plants, faults, designs and evaluators"),
+    ("runtime", "fdikit.runtime", "Runtime: compiled online steps, batch kernels, C export"),
     ("studies-path1996", "fdikit.studies.path1996", "Study: Douglas et al. 1996 (PATH)"),
     ("studies-hallouzi2008", "fdikit.studies.hallouzi2008", "Study: Hallouzi 2008"),
     ("studies-vanderploeg2018", "fdikit.studies.vanderploeg2018", "Study: van der Ploeg 2018"),
