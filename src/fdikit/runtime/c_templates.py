@@ -164,7 +164,7 @@ static bool evaluate(@P@state *s, const real_t r[NR], bool use)
             s->wfill += 1;
         }
         for (i = 0; i < NR; ++i) {
-            const uint8_t x = (uint8_t)(fabs(r[i] - center[i]) > tau[i]);
+            const uint8_t x = (uint8_t)(fabs((double)r[i] - center[i]) > tau[i]);
             w[i] = x;
             s->cnt[i] += x;
             s->fired[i] = s->cnt[i] >= KOFN_K;
