@@ -76,6 +76,20 @@ def us(t: float) -> str:
     return f"{t * 1e6:.2f} µs"
 
 
+def hand_stepper(gen, U, Y):
+    """A hand-written numpy step of ``gen`` over the rows of ``U``, ``Y`` (the peer of the compiled step)."""
+    AB, CD = np.hstack([gen.A, gen.B]), np.hstack([gen.C, gen.D])
+    x = np.zeros(gen.n)
+
+    def hand(k):
+        nonlocal x
+        xv = np.concatenate([x, U[k], Y[k]])
+        x = AB @ xv
+        return CD @ xv
+
+    return hand
+
+
 def demo_generator(N: int):
     from fdikit.design import kalman
     from fdikit.simulate import simulate
@@ -111,15 +125,7 @@ def bench_filter(N: int) -> None:
     st.reset()
     r_r = np.array([st.step(U[k], Y[k]) for k in range(rows)])
     assert np.abs(r_c - r_r).max() <= 1e-12 * np.abs(r_r).max()
-    AB, CD = np.hstack([gen.A, gen.B]), np.hstack([gen.C, gen.D])
-    x = np.zeros(gen.n)
-
-    def hand(k):
-        nonlocal x
-        xv = np.concatenate([x, U[k], Y[k]])
-        x = AB @ xv
-        return CD @ xv
-
+    hand = hand_stepper(gen, U, Y)
     t_c = per_call(lambda k: s.step(U[k], Y[k]), rows)
     t_r = per_call(lambda k: st.step(U[k], Y[k]), rows)
     t_h = per_call(hand, rows)
@@ -155,15 +161,7 @@ def bench_bank(N: int) -> None:
     r_c = np.array([s.step(U[k], Y[k]).copy() for k in range(rows)])
     r_r = np.array([st.step(U[k], Y[k]) for k in range(rows)])
     assert np.abs(r_c - r_r).max() <= 1e-12 * np.abs(r_r).max()
-    AB, CD = np.hstack([gen.A, gen.B]), np.hstack([gen.C, gen.D])
-    x = np.zeros(gen.n)
-
-    def hand(k):
-        nonlocal x
-        xv = np.concatenate([x, U[k], Y[k]])
-        x = AB @ xv
-        return CD @ xv
-
+    hand = hand_stepper(gen, U, Y)
     t_c, t_h = per_call(lambda k: s.step(U[k], Y[k]), rows), per_call(hand, rows)
     t_r = per_call(lambda k: st.step(U[k], Y[k]), rows)
     ev = ThresholdEvaluator(groups=gen.isolates).fit(gen.run(trace), false_alarm_prob=1e-3)
