@@ -24,7 +24,34 @@ import numpy as np
 from fdikit.detector import Detector
 from fdikit.errors import ParameterError
 
-__all__ = ["DetectorStepper"]
+__all__ = ["DetectorStepper", "missing_sample"]
+
+
+def missing_sample(values):
+    """NaN in place of every value of a sample flagged invalid, keeping the names and the shape to be checked.
+
+    Parameters
+    ----------
+    values : sequence of float or mapping of name to float
+        One sample's controls or outputs.
+
+    Returns
+    -------
+    numpy.ndarray or dict
+        The same shape (or names) with every value NaN; anything that is not numbers is returned as it is, for
+        the generator's step to report.
+
+    Examples
+    --------
+    >>> missing_sample({"u": 1.0}), missing_sample([1.0, 2.0]).tolist()
+    ({'u': nan}, [nan, nan])
+    """
+    if isinstance(values, Mapping):
+        return {k: float("nan") for k in values}
+    try:
+        return values if values is None or isinstance(values, (str, bytes)) else np.full(np.shape(values), np.nan)
+    except ValueError:  # ragged: the generator's step reports it
+        return values
 
 
 class DetectorStepper:
@@ -89,16 +116,6 @@ class DetectorStepper:
     def invalid(self) -> int:
         return self._gen.invalid
 
-    @staticmethod
-    def _bad(values):
-        """NaN in place of every value (the sample was flagged invalid), keeping the names and shape checked."""
-        if isinstance(values, Mapping):
-            return {k: float("nan") for k in values}
-        try:
-            return values if values is None or isinstance(values, (str, bytes)) else np.full(np.shape(values), np.nan)
-        except ValueError:  # ragged: the generator's step reports it
-            return values
-
     def step(self, u, y, *, valid: bool = True):
         """Decision for one sample.
 
@@ -122,7 +139,7 @@ class DetectorStepper:
             For values that are not numbers, a mapping with other names, or the wrong number of values.
         """
         if not valid:
-            u, y = self._bad(u), self._bad(y)
+            u, y = missing_sample(u), missing_sample(y)
         r = self._gen.step(u, y)
         idx = self.detector._index
         r = r if idx is None else r[idx]

@@ -22,26 +22,16 @@ Examples
 from __future__ import annotations
 
 import copy
-from collections.abc import Mapping
 
 import numpy as np
 
 from fdikit.detector import Detector
+from fdikit.detector_online import missing_sample
 from fdikit.errors import ParameterError
 from fdikit.runtime.evaluators import compile_evaluator
 from fdikit.runtime.generator import CompiledGenerator
 
 __all__ = ["Monitor", "compile_detector"]
-
-
-def _missing(values):
-    """NaN in place of every value of a sample flagged invalid (names and shape kept for the checks)."""
-    if isinstance(values, Mapping):
-        return {k: float("nan") for k in values}
-    try:
-        return values if values is None or isinstance(values, (str, bytes)) else np.full(np.shape(values), np.nan)
-    except ValueError:  # ragged: the generator's step reports it
-        return values
 
 
 class Monitor:
@@ -138,7 +128,7 @@ class Monitor:
             For values that are not numbers, a mapping with other names, or the wrong number of values.
         """
         if not valid:
-            u, y = _missing(u), _missing(y)
+            u, y = missing_sample(u), missing_sample(y)
         r = self.generator.step(u, y)
         self._last = r
         ok = self.generator.reference.last_valid
