@@ -285,7 +285,7 @@ def test_path_bank_exports_and_equals_python(tmp_path):
     bank = path_bank()
     g = bank.generator
     rng = np.random.default_rng(4)
-    N = 400
+    N = 400  # the recovery after the first gap (sample 100) outlasts the run, so the fault starts before it
     tr0 = Trace(np.arange(N) * DT, 0.01 * rng.standard_normal((N, len(g.controls))),
                 0.01 * rng.standard_normal((N, len(g.outputs))), g.controls, g.outputs)
     gd = g.discretize(DT)
@@ -297,7 +297,7 @@ def test_path_bank_exports_and_equals_python(tmp_path):
     lib = tmp_path / "libpath.so"
     subprocess.run([cc, *FLAGS, "-shared", "-fPIC", "-o", str(lib), str(ex.source), "-lm"], check=True)
     y = 0.01 * rng.standard_normal((N, len(g.outputs)))
-    y[200:, 3] += 0.2  # a sensor bias
+    y[40:, 3] += 1.0  # a sensor bias of 100 noise standard deviations
     y[100:103, 0] = np.nan
     y[120, :2] = np.nan  # the listed two-sensor pattern
     valid = np.ones(N, bool)
