@@ -1,0 +1,381 @@
+"""Exact fault detection and isolation by the nullspace method: ``efdsyn`` and ``efdisyn`` (Varga 2017, §5.2, §5.4).
+
+``efdsyn`` solves the exact fault detection problem (EFDP): a filter ``Q`` with ``Q [Gu Gd Gn; I 0 0] = 0`` whose
+fault part ``R_f = Q [G_f; 0]`` has every targeted column nonzero (weakly, or strongly at ``fdfreq``), stable, of
+least order when ``minimal=True`` (Procedure EFD).  ``efdisyn`` solves the exact fault detection and isolation
+problem (EFDIP) for a structure matrix ``S``: one ``efdsyn`` filter per row, decoupling the faults of the zero
+entries (Procedure EFDI).  The basis is :func:`~fdikit.design.nullspace.basis.left_nullspace`; the selection of
+basis rows follows the reference's ``efdbasesel``: the rows of least degree that detect every targeted fault.
+
+The filters read ``[u; y]`` (fdikit's generator order; the reference's ``Q`` reads ``[y; u]``) and run in fdikit's
+batch and online runtime like any other design.
+
+References
+----------
+Varga (2017), §5.2 (EFDP, Procedure EFD), §5.4 (EFDIP, Procedure EFDI); fdtools (``efdsyn``, ``efdisyn``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from fdikit.design.nullspace.basis import NullspaceBasis, denominator, left_nullspace, realize_rows
+from fdikit.design.nullspace.detectability import row_structure
+from fdikit.errors import DesignError, ParameterError
+from fdikit.model import FaultModel
+from fdikit.protocols import FieldReport
+from fdikit.residuals import ResidualGenerator
+
+__all__ = ["NullspaceDesign", "NullspaceBankDesign", "efdsyn", "efdisyn", "split_faults"]
+
+
+def split_faults(model: FaultModel, targets, nuisance) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """The targeted and the nuisance fault inputs, by fdikit's ``targets=`` / ``nuisance=`` conventions.
+
+    Parameters
+    ----------
+    model : FaultModel
+        The plant; faults are its fault inputs (group ``f``).
+    targets : str or sequence of str or None
+        The faults to detect; None → every fault input that is not a nuisance.
+    nuisance : str or sequence of str or "others"
+        The faults to decouple; ``"others"`` → every fault input that is not a target.
+
+    Returns
+    -------
+    tuple
+        ``(targets, nuisance)``.
+
+    Raises
+    ------
+    ParameterError
+        A fault both targeted and decoupled, ``"others"`` without targets, or no target.
+
+    Examples
+    --------
+    >>> m = FaultModel([[-1.0]], [[1.0]], Bf=[[1.0, 2.0]])
+    >>> split_faults(m, "f0", "others")
+    (('f0',), ('f1',))
+    """
+    from fdikit.fault_maps import check_fault_inputs
+
+    if isinstance(nuisance, str) and nuisance == "others":
+        if targets is None:
+            raise ParameterError("nuisance='others' needs targets= (the faults to detect)")
+        tg = check_fault_inputs(model, targets, "target fault")
+        nz = tuple(f for f in model.faults if f not in tg)
+    else:
+        nz = check_fault_inputs(model, nuisance, "nuisance fault") if nuisance else ()
+        tg = (tuple(f for f in model.faults if f not in nz) if targets is None
+              else check_fault_inputs(model, targets, "target fault"))
+    both = sorted(set(tg) & set(nz))
+    if both:
+        raise ParameterError(f"faults {both} are both targets and nuisance; name each in one of the two")
+    if not tg:
+        raise ParameterError("no fault to detect: the model has no fault inputs outside nuisance=; give targets=")
+    return tuple(tg), tuple(nz)
+
+
+@dataclass(frozen=True, eq=False)
+class NullspaceDesign(FieldReport):
+    """A nullspace-based fault detection filter (``efdsyn``) and its report.
+
+    Attributes
+    ----------
+    generator : ResidualGenerator
+        The filter ``Q`` (inputs ``[u; y]``), minimal, with the assigned stable poles.
+    basis : NullspaceBasis
+        The left nullspace basis the filter was selected from.
+    degrees : tuple of int
+        The degrees of the basis rows (the left minimal indices; reference ``info.degs``).
+    selection : numpy.ndarray
+        ``(q, len(used))`` combination of the basis rows ``used`` (reference ``info.HDesign``, restricted to the used
+        rows).
+    used : tuple of int
+        The basis rows combined.
+    order : int
+        The filter order.
+    structure : numpy.ndarray
+        ``(q, len(targets) + len(nuisance))`` booleans: which of ``targets + nuisance`` each residual detects
+        (strong at ``fdfreq`` when given, weak otherwise).
+    basis_structure : numpy.ndarray
+        The same for every basis row (reference ``info.S``), over ``targets``.
+    targets, nuisance : tuple of str
+        The detected and the decoupled fault inputs.
+    poles : numpy.ndarray
+        The filter eigenvalues.
+    """
+
+    generator: ResidualGenerator
+    basis: NullspaceBasis
+    degrees: tuple[int, ...]
+    selection: np.ndarray
+    used: tuple[int, ...]
+    order: int
+    structure: np.ndarray
+    basis_structure: np.ndarray
+    targets: tuple[str, ...]
+    nuisance: tuple[str, ...]
+    poles: np.ndarray
+
+    REPORT = ("degrees", "selection", "used", "order", "structure", "basis_structure", "targets", "nuisance",
+              "poles")
+
+
+def _selection(selection, q: int, k: int) -> np.ndarray:
+    """The ``(q, k)`` combination: given (checked) or a fixed generic one of orthonormal rows."""
+    if selection is not None:
+        H = np.atleast_2d(np.asarray(selection, dtype=float))
+        if H.shape != (q, k) or not np.all(np.isfinite(H)) or np.linalg.matrix_rank(H) < q:
+            raise ParameterError(f"selection must be a finite ({q}, {k}) matrix of full row rank, got shape "
+                                 f"{H.shape}")
+        return H
+    if q == k:
+        return np.eye(k)
+    G = np.random.default_rng(20170).standard_normal((k, q))
+    return np.linalg.qr(G)[0].T
+
+
+def _minimal_generator(A, B, C, D, model: FaultModel, names) -> ResidualGenerator:
+    import control
+
+    if A.shape[0]:
+        sys = control.ss(A, B, C, D).minreal()
+        n = sys.nstates
+        A, B, C = (np.asarray(sys.A).reshape(n, n), np.asarray(sys.B).reshape(n, -1),
+                   np.asarray(sys.C).reshape(-1, n))
+    return ResidualGenerator(A, B, C, D, controls=model.controls, outputs=model.outputs, residuals=names,
+                             dt=model.dt)
+
+
+def efdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = None, minimal: bool = True,
+           poles: Sequence[complex] | None = None, sdeg: float | None = None, fdtol: float = 1e-4,
+           fdgaintol: float = 0.01, fdfreq=None, selection=None, tol: float = 1e-9, names=None,
+           isolates=None) -> NullspaceDesign:
+    """Exact fault detection filter by the nullspace method (Procedure EFD).
+
+    Parameters
+    ----------
+    model : FaultModel
+        The plant with its controls ``u``, disturbances ``d`` and fault inputs ``f`` (noise ``w`` is ignored).
+    targets : str or sequence of str, optional
+        The faults to detect (default: every fault input not in ``nuisance``).
+    nuisance : str or sequence of str or "others", default ()
+        Fault inputs to decouple exactly, like disturbances.
+    rdim : int, optional
+        Number of residuals ``q`` (default 1 when ``minimal``, else the number of basis rows).
+    minimal : bool, default True
+        Least order: the rows of least degree ``d`` that detect every target, combined over one denominator of
+        degree ``d`` (order ``d`` for ``q = 1``).  False: all basis rows, each over its own denominator
+        (order ``Σ ν_i``).
+    poles : sequence of complex, optional
+        Filter poles (the first ``d`` of them per denominator); default all at ``sdeg``.
+    sdeg : float, optional
+        Stability degree of the poles when ``poles`` is None (default −0.05, or 0.95 discrete).
+    fdtol : float, default 1e-4
+        Relative threshold of weak detectability (reference ``FDtol``).
+    fdgaintol : float, default 0.01
+        Gain threshold of strong detectability at ``fdfreq`` (reference ``FDGainTol``).
+    fdfreq : float or sequence of float, optional
+        Frequencies (rad/s) at which each target must be strongly detected (reference ``FDfreq``).
+    selection : array_like, optional
+        The ``(q, k)`` combination of the ``k`` selected basis rows (reference ``HDesign``); default a fixed
+        generic one (identity when ``q = k``).
+    tol : float, default 1e-9
+        Relative rank tolerance of the nullspace computation.
+    names, isolates : optional
+        Residual labels (``fdikit.design.labels``).
+
+    Returns
+    -------
+    NullspaceDesign
+
+    Raises
+    ------
+    DesignError
+        When no filter exists: the decoupled inputs use up the outputs, or a target is not detectable once they
+        are decoupled (the message names the faults), or fewer than ``rdim`` rows are available.
+    ParameterError
+        Bad options.
+
+    Examples
+    --------
+    Varga (2017), Example 5.4: the least-order detector of two faults has order 1.
+
+    ``Gu = [(s+1)/(s−2); (s+2)/(s−3)]``, ``Gd = [(s−1)/(s+2); 0]``, ``Gf = [Gu [0; 1]]`` realised by hand:
+
+    >>> m = FaultModel([[2.0, 0, 0], [0, 3.0, 0], [0, 0, -2.0]], [[3.0, 0, -3.0], [0, 5.0, 0]],
+    ...                Bu=[[1.0], [1.0], [0.0]], Bd=[[0.0], [0.0], [1.0]], Du=[[1.0], [1.0]], Dd=[[1.0], [0.0]],
+    ...                Bf=[[1.0, 0.0], [1.0, 0.0], [0.0, 0.0]], Df=[[1.0, 0.0], [1.0, 1.0]])
+    >>> d = efdsyn(m, sdeg=-3.0)
+    >>> d.order, d.degrees, d.structure.tolist()
+    (1, (1,), [[True, True]])
+
+    References
+    ----------
+    Varga (2017), §5.2, Procedure EFD; fdtools (``efdsyn``).
+    """
+    from fdikit.design.labels import label_generator
+
+    targets, nuisance = split_faults(model, targets, nuisance)
+    basis = left_nullspace(model, nuisance, tol=tol)
+    k_all = len(basis.rows)
+    if not k_all:
+        raise DesignError(f"no residual is free of the controls, disturbances and nuisance faults {list(nuisance)}: "
+                          f"[Gd Gn] has full row rank {len(model.outputs)}")
+    q = (1 if minimal else k_all) if rdim is None else int(rdim)
+    if not 1 <= q <= k_all:
+        raise DesignError(f"rdim={rdim}: the nullspace basis has {k_all} rows, so 1 ≤ rdim ≤ {k_all}")
+    dens_own = [denominator(nu, poles, sdeg, model.dt) for nu in basis.degrees]
+    S_basis = row_structure(model, basis, targets, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol, dens=dens_own)
+    missing = [f for f, hit in zip(targets, S_basis.any(axis=0)) if not hit]
+    if missing:
+        kind = f"strongly at {np.atleast_1d(fdfreq).tolist()} rad/s" if fdfreq is not None else "weakly"
+        raise DesignError(f"faults {missing} cannot be detected {kind} once the controls, disturbances and nuisance "
+                          f"faults {list(nuisance)} are decoupled; the EFDP has no solution "
+                          "(fdigenspec lists the achievable structures)")
+    if minimal:
+        for d in sorted(set(basis.degrees)):
+            used = tuple(i for i, nu in enumerate(basis.degrees) if nu <= d)
+            if len(used) >= q and S_basis[list(used)].any(axis=0).all():
+                break
+        H = _selection(selection, q, len(used))
+        rows = basis.combined(H, used)
+        dens = [denominator(d, poles, sdeg, model.dt)] * q
+        A, B, C, D = realize_rows(rows, dens, basis.scale)
+    else:
+        used = tuple(range(k_all))
+        H = _selection(selection, q, k_all)
+        A, B, C, D = realize_rows(basis.rows, dens_own, basis.scale)
+        C, D = H @ C, H @ D
+        rows = [None] * q
+    names_default = tuple(f"r{i}" for i in range(q))
+    gen = _minimal_generator(A, B, C, D, model, names_default)
+    gen = label_generator(gen, model, names, isolates)
+    faults = targets + nuisance
+    if minimal:
+        S = row_structure(model, basis, faults, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol, dens=dens,
+                          rows=rows)
+    else:
+        S = _combined_structure(model, basis, H, dens_own, faults, fdtol, fdfreq, fdgaintol)
+    if not S[:, : len(targets)].any(axis=0).all():
+        raise DesignError(f"the selection {H.round(3).tolist()} of the basis rows {list(used)} misses a target; "
+                          "give another selection=")
+    return NullspaceDesign(gen, basis, basis.degrees, H, used, gen.n, S, S_basis, targets, nuisance,
+                           np.linalg.eigvals(gen.A) if gen.n else np.zeros(0, complex), model=model)
+
+
+def _combined_structure(model, basis, H, dens, faults, fdtol, fdfreq, fdgaintol) -> np.ndarray:
+    """Structure of ``H · diag(N_i / φ_i)``: a residual detects what its nonzero-weighted rows detect, generically."""
+    S_rows = row_structure(model, basis, faults, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol, dens=dens)
+    weights = np.abs(H) > 1e-12 * np.max(np.abs(H))
+    return (weights.astype(int) @ S_rows.astype(int)) > 0
+
+
+@dataclass(frozen=True, eq=False)
+class NullspaceBankDesign(FieldReport):
+    """A bank of nullspace filters, one per row of a structure matrix (``efdisyn``).
+
+    Attributes
+    ----------
+    generator : ResidualGenerator
+        The stacked bank (``residuals.stack_generators``); residual ``r<i>`` (or ``r<i>_<k>``) belongs to row ``i``.
+    filters : tuple of NullspaceDesign
+        One design per row of ``specification``.
+    specification : numpy.ndarray
+        The structure matrix ``S`` asked for, ``(rows, len(faults))``.
+    faults : tuple of str
+        The columns of ``specification``.
+    groups : tuple of tuple of str
+        The residual names of each filter (for ``ThresholdEvaluator(groups=...)``).
+    orders : tuple of int
+        The order of each filter.
+    """
+
+    generator: ResidualGenerator
+    filters: tuple[NullspaceDesign, ...]
+    specification: np.ndarray
+    faults: tuple[str, ...]
+    groups: tuple[tuple[str, ...], ...]
+    orders: tuple[int, ...]
+
+    REPORT = ("specification", "faults", "groups", "orders")
+
+
+def _specification(model: FaultModel, structure, faults) -> tuple[np.ndarray, tuple[str, ...]]:
+    from fdikit.fault_maps import check_fault_inputs
+
+    faults = tuple(model.faults) if faults is None else tuple(check_fault_inputs(model, faults))
+    S = np.atleast_2d(np.asarray(structure))
+    if S.ndim != 2 or S.shape[1] != len(faults) or not np.isin(S, (0, 1)).all():
+        raise ParameterError(f"structure must be a 0/1 matrix with one column per fault {list(faults)}, got shape "
+                             f"{S.shape}")
+    return S.astype(bool), faults
+
+
+def efdisyn(model: FaultModel, structure, *, faults=None, rdim: int | None = None, minimal: bool = True,
+            poles=None, sdeg: float | None = None, fdtol: float = 1e-4, fdgaintol: float = 0.01, fdfreq=None,
+            tol: float = 1e-9) -> NullspaceBankDesign:
+    """A bank of exact fault detection filters achieving the structure matrix ``structure`` (Procedure EFDI).
+
+    Parameters
+    ----------
+    model : FaultModel
+        The plant.
+    structure : array_like of bool
+        ``S``: row ``i`` asks for a filter that detects the faults of its ones and decouples those of its zeros.
+    faults : sequence of str, optional
+        The columns of ``S`` (default the model's fault inputs, in order).
+    rdim, minimal, poles, sdeg, fdtol, fdgaintol, fdfreq, tol
+        As :func:`efdsyn`, for every row.
+
+    Returns
+    -------
+    NullspaceBankDesign
+
+    Raises
+    ------
+    DesignError
+        A row that cannot be achieved (the message gives the row and the faults).
+    ParameterError
+        A malformed ``structure``.
+
+    Examples
+    --------
+    Two faults on two sensors of a first-order plant, isolated by the diagonal structure:
+
+    >>> m = FaultModel([[-1.0]], [[1.0], [1.0]], Bu=[[1.0]], Df=np.eye(2))
+    >>> bank = efdisyn(m, np.eye(2))
+    >>> bank.orders, bank.generator.residuals
+    ((1, 1), ('r0', 'r1'))
+
+    References
+    ----------
+    Varga (2017), §5.4, Procedure EFDI; fdtools (``efdisyn``).
+    """
+    from fdikit.residuals import stack_generators
+
+    S, faults = _specification(model, structure, faults)
+    filters = []
+    for i, row in enumerate(S):
+        tg = tuple(f for f, s in zip(faults, row) if s)
+        nz = tuple(f for f, s in zip(faults, row) if not s) + tuple(f for f in model.faults if f not in faults)
+        if not tg:
+            raise ParameterError(f"row {i} of the structure has no fault to detect")
+        try:
+            d = efdsyn(model, targets=tg, nuisance=nz, rdim=rdim, minimal=minimal, poles=poles, sdeg=sdeg, fdtol=fdtol,
+                       fdgaintol=fdgaintol, fdfreq=fdfreq, tol=tol)
+        except DesignError as err:
+            raise DesignError(f"row {i} of the structure ({row.astype(int).tolist()}) is not achievable: {err}") from err
+        q = len(d.generator.residuals)
+        names = (f"r{i}",) if q == 1 else tuple(f"r{i}_{k}" for k in range(q))
+        iso = tg[0] if len(tg) == 1 else None
+        filters.append(dataclasses.replace(d, generator=dataclasses.replace(d.generator, residuals=names,
+                                                                            isolates=(iso,) * q)))
+    gen = stack_generators([f.generator for f in filters])
+    groups = tuple(tuple(f.generator.residuals) for f in filters)
+    return NullspaceBankDesign(gen, tuple(filters), S, faults, groups, tuple(f.order for f in filters), model=model)
