@@ -42,7 +42,7 @@ import numpy as np
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 
-__all__ = ["NullspaceBasis", "left_nullspace", "denominator", "realize_rows", "default_sdeg"]
+__all__ = ["NullspaceBasis", "left_nullspace", "denominator", "realize_rows", "default_sdeg", "minimal_realization"]
 
 
 def default_sdeg(dt: float | None) -> float:
@@ -167,17 +167,46 @@ def realize_rows(rows: Sequence[np.ndarray], dens: Sequence[np.ndarray], scale: 
     return A, B.reshape(n, m), C.reshape(len(rows), n), D
 
 
-def _decoupled_realization(model: FaultModel, cols: list[int]):
-    """A minimal realisation of the columns ``cols`` of ``[B; D]`` (controls, disturbances, nuisance faults)."""
+def minimal_realization(A, B, C, D, tol: float = 1e-7):
+    """A minimal realisation of ``(A, B, C, D)``: slycot's ``tb01pd`` (orthogonal staircase forms).
+
+    Parameters
+    ----------
+    A, B, C, D : numpy.ndarray
+        The realisation.
+    tol : float, default 1e-7
+        ``tb01pd``'s rank tolerance: a lower bound of the reciprocal condition number of the blocks kept (a
+        relative tolerance; the reference's tests use ``atol = 1e-7``).  ``tb01pd``'s own default ``n² ε`` keeps
+        unobservable modes of series connections that a filter cancels (Example 5.4 keeps two of them).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+
+    Examples
+    --------
+    >>> A, B, C, D = minimal_realization(np.diag([2.0, 3.0, -3.0]), np.ones((3, 1)), [[0.0, 0.0, 1.0]], [[0.0]])
+    >>> A.tolist()
+    [[-3.0]]
+    """
     import control
 
-    A, C = model.A, model.C
+    A, B, C, D = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (A, B, C, D))
+    n, m, p = A.shape[0], D.shape[1], D.shape[0]
+    if n == 0 or A.size == 0:
+        return np.zeros((0, 0)), np.zeros((0, m)), np.zeros((p, 0)), D
+    sys = control.ss(A, B.reshape(n, m), C.reshape(p, n), D).minreal(tol)
+    k = sys.nstates
+    return (np.asarray(sys.A).reshape(k, k), np.asarray(sys.B).reshape(k, m), np.asarray(sys.C).reshape(p, k),
+            np.asarray(sys.D).reshape(p, m))
+
+
+def _decoupled_realization(model: FaultModel, cols: list[int]):
+    """A minimal realisation of the columns ``cols`` of ``[B; D]`` (controls, disturbances, nuisance faults)."""
     B, D = model.B[:, cols], model.D[:, cols]
-    if A.shape[0] == 0 or B.shape[1] == 0:
-        return np.zeros((0, 0)), np.zeros((0, B.shape[1])), np.zeros((C.shape[0], 0)), D
-    sys = control.ss(A, B, C, D).minreal()
-    return (np.atleast_2d(sys.A).reshape(sys.nstates, sys.nstates), np.asarray(sys.B).reshape(sys.nstates, -1),
-            np.asarray(sys.C).reshape(-1, sys.nstates), np.asarray(sys.D).reshape(D.shape))
+    if model.n == 0 or B.shape[1] == 0:
+        return np.zeros((0, 0)), np.zeros((0, B.shape[1])), np.zeros((model.C.shape[0], 0)), D
+    return minimal_realization(model.A, B, model.C, D)
 
 
 def _toeplitz(C, A, B, D, k):
@@ -271,6 +300,29 @@ class NullspaceBasis:
         idx = range(len(self.rows)) if rows is None else rows
         mu = lam / self.scale
         return np.array([np.polynomial.polynomial.polyval(mu, self.rows[i]) for i in idx]).reshape(len(idx), -1)
+
+    def generator(self, poles: Sequence[complex] | None = None, sdeg: float | None = None, names=None):
+        """The simple proper basis: one residual per row, row ``i`` over its own stable ``φ_i`` of degree ``ν_i``.
+
+        Parameters
+        ----------
+        poles, sdeg : optional
+            As :func:`denominator` (the first ``ν_i`` poles for row ``i``).
+        names : sequence of str, optional
+            Residual names (default ``n0, n1, …``).
+
+        Returns
+        -------
+        ResidualGenerator
+            Order ``Σ ν_i``, inputs ``[u; y]``.
+        """
+        from fdikit.residuals import ResidualGenerator
+
+        dens = [denominator(nu, poles, sdeg, self.dt) for nu in self.degrees]
+        A, B, C, D = realize_rows(self.rows, dens, self.scale)
+        names = tuple(f"n{i}" for i in range(len(self.rows))) if names is None else tuple(names)
+        return ResidualGenerator(A, B, C, D, controls=self.controls, outputs=self.outputs, residuals=names,
+                                 dt=self.dt)
 
     def combined(self, H: np.ndarray, rows: Sequence[int]) -> list[np.ndarray]:
         """The rows ``H @ N_rows(μ)`` as coefficient arrays padded to the largest degree of ``rows``.

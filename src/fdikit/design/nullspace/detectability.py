@@ -159,6 +159,8 @@ def row_structure(model: FaultModel, basis, faults: Sequence[str], *, fdtol: flo
         for lam0 in pts:
             G, lam = _response(model, faults, lam0)
             for i, N in enumerate(coeffs):
-                gain = np.abs(poly(lam / basis.scale, N)[mu:] @ G) / abs(np.polyval(dens[i], lam))
+                # the realised row is N(λ/α) / φ'(λ/α) with the monic φ'(μ) = φ(αμ) / α^d (basis.realize_rows)
+                d = len(dens[i]) - 1
+                gain = np.abs(poly(lam / basis.scale, N)[mu:] @ G) * basis.scale ** d / abs(np.polyval(dens[i], lam))
                 S[i] &= gain > fdgaintol
     return S

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fdikit.design.nullspace.basis import NullspaceBasis, denominator, left_nullspace, realize_rows
+from fdikit.design.nullspace.basis import NullspaceBasis, denominator, left_nullspace, minimal_realization, realize_rows
 from fdikit.design.nullspace.detectability import row_structure
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
@@ -141,13 +141,7 @@ def _selection(selection, q: int, k: int) -> np.ndarray:
 
 
 def _minimal_generator(A, B, C, D, model: FaultModel, names) -> ResidualGenerator:
-    import control
-
-    if A.shape[0]:
-        sys = control.ss(A, B, C, D).minreal()
-        n = sys.nstates
-        A, B, C = (np.asarray(sys.A).reshape(n, n), np.asarray(sys.B).reshape(n, -1),
-                   np.asarray(sys.C).reshape(-1, n))
+    A, B, C, D = minimal_realization(A, B, C, D)
     return ResidualGenerator(A, B, C, D, controls=model.controls, outputs=model.outputs, residuals=names,
                              dt=model.dt)
 
@@ -370,7 +364,8 @@ def efdisyn(model: FaultModel, structure, *, faults=None, rdim: int | None = Non
             d = efdsyn(model, targets=tg, nuisance=nz, rdim=rdim, minimal=minimal, poles=poles, sdeg=sdeg, fdtol=fdtol,
                        fdgaintol=fdgaintol, fdfreq=fdfreq, tol=tol)
         except DesignError as err:
-            raise DesignError(f"row {i} of the structure ({row.astype(int).tolist()}) is not achievable: {err}") from err
+            raise DesignError(f"row {i} of the structure ({row.astype(int).tolist()}) is not achievable: {err}"
+                              ) from err
         q = len(d.generator.residuals)
         names = (f"r{i}",) if q == 1 else tuple(f"r{i}_{k}" for k in range(q))
         iso = tg[0] if len(tg) == 1 else None

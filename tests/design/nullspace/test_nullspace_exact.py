@@ -1,0 +1,117 @@
+"""efdsyn / efdisyn / the nullspace basis against the reference's tests (FaultDetectionTools.jl test_efdsyn.jl).
+
+Numbers ported: the orders of Niemann (1998) and Xiong and Saif (2000, Ex. 1) banks (all 1; [2, 1, 1]), the strong
+structure at ω = 0 of those banks, the order 1 of Varga (2017) Example 5.4, the failure of Example 5.2.  Decoupling
+is checked on the internal form (fdikit's ResidualGenerator.internal_form, independent of the synthesis) at several
+points, relative to the filter's gain.
+"""
+
+import numpy as np
+import pytest
+from varga_examples import example_5_2, example_5_4, niemann, random_plant, response, xiong_saif_1, yuan
+
+from fdikit.design.nullspace import efdisyn, efdsyn, left_nullspace
+from fdikit.errors import DesignError, ParameterError
+from fdikit.protocols import DesignResult
+
+POINTS = (0.37 + 1.1j, 2.3j, -0.2 + 0.05j)
+
+
+def decoupling(form, groups=("u", "d")):
+    """Largest |R_g(λ)| over the groups and points, relative to the largest fault gain there."""
+    out, scale = 0.0, 0.0
+    for lam in POINTS:
+        for g in groups:
+            if form.inputs[g]:
+                out = max(out, np.abs(response(form, g, lam)).max())
+        scale = max(scale, np.abs(response(form, "f", lam)).max())
+    return out / scale
+
+
+def test_basis_rows_annihilate_and_have_least_degrees():
+    m = yuan()
+    b = left_nullspace(m)
+    # [Gu; I] with (C, A) observable: the left minimal indices are the observability indices of (C, A), sum n
+    assert b.degrees == (1, 1, 2) and sum(b.degrees) == m.n
+    G = np.vstack([np.eye(1), m.C @ np.linalg.solve(0.4j * np.eye(4) - m.A, m.B[:, :1])])
+    assert np.abs(b.evaluate(0.4j) @ G).max() < 1e-12
+    bn = left_nullspace(m, ["f0", "f1"])
+    assert bn.degrees == (1,)       # p − rank [Gf0 Gf1] = 1 row
+
+
+def test_example_5_4_least_order():
+    d = efdsyn(example_5_4(), sdeg=-3.0)
+    assert isinstance(d, DesignResult)
+    assert d.order == 1 and d.degrees == (1,)
+    np.testing.assert_allclose(d.poles, [-3.0], rtol=1e-12)
+    assert decoupling(d.internal_form()) < 1e-10
+    # strongly detects both faults at ω = 0 (reference: fdisspec(Rf, [0]) == [1 1])
+    strong = efdsyn(example_5_4(), sdeg=-3.0, fdfreq=0.0)
+    assert strong.structure.tolist() == [[True, True]]
+
+
+def test_example_5_2_has_no_solution():
+    with pytest.raises(DesignError, match=r"\['f0'\] cannot be detected"):
+        efdsyn(example_5_2())
+
+
+@pytest.mark.parametrize("plant, orders", [(niemann, (1, 1, 1)), (xiong_saif_1, (2, 1, 1))])
+def test_banks_of_the_reference(plant, orders):
+    m = plant()
+    S = np.array([[1, 0], [0, 1], [1, 1]], dtype=bool)
+    bank = efdisyn(m, S, sdeg=-5.0, fdfreq=0.0, fdgaintol=1e-4)
+    assert bank.orders == orders
+    form = bank.internal_form()
+    assert decoupling(form) < 1e-9
+    # strong structure at ω = 0 of the stacked R_f equals S (reference: fdisspec_(Rftilde, 0) == SFDI)
+    R0 = np.abs(response(form, "f", 0.0))
+    assert ((R0 > 1e-4 * R0.max()) == S).all()
+    for f in bank.filters:
+        assert np.all(f.poles.real < 0)
+
+
+def test_full_order_and_selection():
+    m = yuan()
+    full = efdsyn(m, minimal=False)
+    assert full.order == 4 and len(full.generator.residuals) == 3
+    least = efdsyn(m)
+    assert least.order == 2 and len(least.generator.residuals) == 1      # = fdichkspec least order of [1 … 1]
+    # the two degree-1 rows miss a fault, so the least-order pair combines all three rows over degree 2
+    two = efdsyn(m, rdim=2, selection=[[1.0, 0.0, 0.0], [0.0, 1.0, 1.0]])
+    assert two.used == (0, 1, 2) and two.order <= 4 and two.structure.any(axis=0).all()
+    assert decoupling(two.internal_form(), ("u",)) < 1e-10
+
+
+def test_generator_runs_batch_and_online():
+    from fdikit.trace import Trace
+
+    m = random_plant(4, 3, 3, 1, 1, 2, dt=0.1)
+    d = efdsyn(m, targets=["f0"], nuisance=["f1"], sdeg=0.5)
+    rng = np.random.default_rng(0)
+    N = 200
+    u, dd, f = rng.standard_normal((N, 1)), rng.standard_normal((N, 1)), np.zeros((N, 2))
+    f[100:, 1] = 1.0                   # the nuisance fault only: decoupled
+    x, ys = np.zeros(m.n), []
+    for k in range(N):
+        v = np.concatenate([u[k], dd[k], f[k]])
+        ys.append(m.C @ x + m.D @ v)
+        x = m.A @ x + m.B @ v
+    trace = Trace(np.arange(N) * 0.1, u, np.array(ys), m.controls, m.outputs)
+    r = d.generator.run(trace).r
+    scale = np.abs(d.generator.D).max() * np.abs(np.array(ys)).max()
+    assert np.abs(r).max() < 1e-9 * scale
+    stepper = d.generator.online()
+    online = np.array([stepper.step(u[k], ys[k]) for k in range(N)])
+    np.testing.assert_allclose(online, r, atol=1e-12 * scale)
+
+
+def test_bad_input():
+    m = yuan()
+    with pytest.raises(ParameterError, match="both targets and nuisance"):
+        efdsyn(m, targets=["f0"], nuisance=["f0"])
+    with pytest.raises(DesignError, match="rdim"):
+        efdsyn(m, rdim=4)
+    with pytest.raises(ParameterError, match="not stable"):
+        efdsyn(m, poles=[1.0])
+    with pytest.raises(ParameterError, match="0/1 matrix"):
+        efdisyn(m, [[1, 0]])
