@@ -186,7 +186,7 @@ def minimal_realization(A, B, C, D, tol: float = 1e-7):
     Examples
     --------
     >>> A, B, C, D = minimal_realization(np.diag([2.0, 3.0, -3.0]), np.ones((3, 1)), [[0.0, 0.0, 1.0]], [[0.0]])
-    >>> A.tolist()
+    >>> np.round(A, 9).tolist()
     [[-3.0]]
     """
     import control
