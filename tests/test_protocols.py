@@ -161,12 +161,27 @@ def _state_space_parity():
     return parity_design(m, 2), m
 
 
+def _efdsyn():
+    from fdikit.design.nullspace import efdsyn
+
+    m = _ws_sensors()
+    return efdsyn(m, targets="y1_sensor", nuisance="y2_sensor", sdeg=-2.0), m
+
+
+def _efdisyn():
+    from fdikit.design.nullspace import efdisyn
+
+    m = _ws_sensors()
+    return efdisyn(m, np.eye(2), sdeg=-2.0), m
+
+
 LTI_DESIGNS = {
     "ObserverDesign(observer)": _observer, "ObserverDesign(kalman)": _kalman, "BeardJonesDesign": _beard_jones,
     "RestrictedDiagonalDesign": _restricted_diagonal, "UIODesign": _uio, "HinfDesign": _hinf,
     "Enhancement": _enhancement, "SingleFaultGameDesign": _single_game, "GameBankDesign": _game_bank,
     "GameDesign": _game, "DiscreteGtfdfDesign": _dgtfdf, "DiscreteGtmfdfDesign": _dgtmfdf,
     "GohFilterDesign": _goh, "PolynomialParityDesign": _polynomial_parity, "ParityDesign": _state_space_parity,
+    "NullspaceDesign": _efdsyn, "NullspaceBankDesign": _efdisyn,
 }
 
 

@@ -9,6 +9,9 @@ The most used designs are importable from here; every name of a family is in its
   continuous, discrete and time-varying filters, and the γ → 0 limit (Goh transformation, reduced-order detector).
 * :mod:`fdikit.design.parity` — Parity-space residual generators: state-space parity relations, polynomial (DAE)
   parity filters, speed-scheduled parity filters and the robust LPV parity design.
+* :mod:`fdikit.design.nullspace` — Synthesis by the nullspace method (Varga 2017; FDITOOLS): least-degree
+  nullspace bases, exact fault detection and isolation (``efdsyn``, ``efdisyn``), approximate synthesis maximising
+  the fault-to-noise gap (``afdsyn``, ``afdisyn``) and the achievable specifications (``fdigenspec``, ``fdichkspec``).
 * :mod:`fdikit.design.labels` — the ``names=`` / ``isolates=`` every design takes (what its residuals are called
   and which fault each one isolates), and the warning of a parity residual that responds to an unlisted fault.
 """
@@ -17,7 +20,7 @@ import lazy_loader as lazy
 
 __getattr__, __dir__, __all__ = lazy.attach(
     __name__,
-    submodules=["observers", "game", "parity", "labels"],
+    submodules=["observers", "game", "parity", "nullspace", "labels"],
     submod_attrs={
         "labels": ["fault_label", "label_generator", "residual_labels", "warn_unlisted_faults"],
         "observers": [
@@ -37,5 +40,6 @@ __getattr__, __dir__, __all__ = lazy.attach(
             "lpv_parity_residuals", "minimal_degree", "parity_design", "parity_filter", "robust_lpv_parity",
             "scheduled_parity_filter", "theorem1",
         ],
+        "nullspace": ["efdisyn", "efdsyn", "fdichkspec", "fdigenspec"],
     },
 )
