@@ -12,6 +12,7 @@ from varga_examples import example_5_2, example_5_4, niemann, random_plant, resp
 
 from fdikit.design.nullspace import efdisyn, efdsyn, left_nullspace
 from fdikit.errors import DesignError, ParameterError
+from fdikit.model import FaultModel
 from fdikit.protocols import DesignResult
 
 POINTS = (0.37 + 1.1j, 2.3j, -0.2 + 0.05j)
@@ -115,3 +116,42 @@ def test_bad_input():
         efdsyn(m, poles=[1.0])
     with pytest.raises(ParameterError, match="0/1 matrix"):
         efdisyn(m, [[1, 0]])
+
+
+def _simulate(m, u, f, noise, rng):
+    x, ys = np.zeros(m.n), []
+    mu, md = len(m.controls), len(m.disturbances)
+    for k in range(len(u)):
+        v = np.concatenate([u[k], rng.standard_normal(md), f[k]])
+        ys.append(m.C @ x + m.D @ v + noise * rng.standard_normal(len(m.outputs)))
+        x = m.A @ x + m.B[:, : mu + md + len(f[k])] @ v
+    return np.array(ys)
+
+
+def test_bank_plugs_into_evaluators_and_the_compiled_runtime():
+    from fdikit.decision import ThresholdEvaluator
+    from fdikit.runtime import compile_generator
+    from fdikit.trace import Trace
+
+    m = random_plant(7, 3, 3, 1, 1, 0, dt=0.05)
+    m = FaultModel(m.A, m.C, Bu=m.Bu, Bd=m.Bd, Du=m.Du, Dd=m.Dd, Df=np.eye(3)[:, :2], faults=("s0", "s1"), dt=0.05)
+    bank = efdisyn(m, np.eye(2), sdeg=0.6)
+    assert bank.generator.isolates == ("s0", "s1")
+    rng = np.random.default_rng(3)
+    N = 4000
+    u = rng.standard_normal((N, 1))
+    t = np.arange(N) * 0.05
+    healthy = Trace(t, u, _simulate(m, u, np.zeros((N, 2)), 0.01, rng), m.controls, m.outputs)
+    ev = ThresholdEvaluator().fit(bank.generator.run(healthy), false_alarm_prob=1e-4)
+    f = np.zeros((N, 2))
+    f[2000:, 1] = 0.5                  # 50 noise standard deviations on the second sensor
+    faulty = Trace(t, u, _simulate(m, u, f, 0.01, rng), m.controls, m.outputs)
+    res = bank.generator.run(faulty)
+    diag = ev.run(res)
+    named = diag.isolated[2100:]
+    assert np.mean(named == "s1") > 0.95 and not np.any(named == "s0")
+    compiled = compile_generator(bank.generator)
+    ref = bank.generator.online()
+    for k in range(200):
+        a, b = compiled.step(u[k], faulty.y[k]), ref.step(u[k], faulty.y[k])
+        np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12 * max(1.0, np.abs(b).max()))
