@@ -155,3 +155,36 @@ def test_bank_plugs_into_evaluators_and_the_compiled_runtime():
     for k in range(200):
         a, b = compiled.step(u[k], faulty.y[k]), ref.step(u[k], faulty.y[k])
         np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12 * max(1.0, np.abs(b).max()))
+
+
+def _kronecker_left_indices(m, nuisance=()):
+    """Left Kronecker indices of the system pencil of ``[Gu Gd Gn; I 0 0]`` by SLICOT AB08ND (independent)."""
+    import slycot
+
+    from fdikit.design.nullspace.basis import minimal_realization
+
+    mu, md = len(m.controls), len(m.disturbances)
+    cols = list(range(mu + md)) + [mu + md + i for i in m.index("f", list(nuisance))]
+    A, B, C, D = minimal_realization(m.A, m.B[:, cols], m.C, m.D[:, cols])
+    n = A.shape[0]
+    Ce = np.vstack([C, np.zeros((mu, n))])
+    De = np.vstack([D, np.hstack([np.eye(mu), np.zeros((mu, len(cols) - mu))])])
+    out = slycot.ab08nd(n, len(cols), C.shape[0] + mu, A, B, Ce, De, equil="S")
+    return tuple(sorted(int(k) for k in out[7][: out[4]]))
+
+
+@pytest.mark.parametrize("case", ["yuan", "yuan-f0f1", "ex54", "niemann", "niemann-f0", "xiong-saif-f1", "path",
+                                  "path-2", "random", "random-discrete"])
+def test_degrees_are_the_left_kronecker_indices(case):
+    from fdikit.studies.path1996.bank import path_fault_model
+
+    m, nz = {
+        "yuan": (yuan, ()), "yuan-f0f1": (yuan, ("f0", "f1")), "ex54": (example_5_4, ()), "niemann": (niemann, ()),
+        "niemann-f0": (niemann, ("f0",)), "xiong-saif-f1": (xiong_saif_1, ("f1",)),
+        "path": (lambda: path_fault_model(14), ()),
+        "path-2": (lambda: path_fault_model(14), ("accel_x_sensor", "throttle_actuator")),
+        "random": (lambda: random_plant(5, 6, 5, 2, 2, 3), ("f0",)),
+        "random-discrete": (lambda: random_plant(6, 5, 4, 1, 1, 2, dt=0.1), ()),
+    }[case]
+    model = m()
+    assert left_nullspace(model, nz).degrees == _kronecker_left_indices(model, nz)
