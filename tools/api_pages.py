@@ -26,6 +26,7 @@ PAGES = [
     ("design-observers", "fdikit.design.observers", "Design: observer-type filters"),
     ("design-game", "fdikit.design.game", "Design: game-theoretic filters"),
     ("design-parity", "fdikit.design.parity", "Design: parity space"),
+    ("design-nullspace", "fdikit.design.nullspace", "Design: nullspace synthesis (FDITOOLS)"),
     ("decision", "fdikit.decision", "Decision: residual evaluators"),
     ("decision-learned", "fdikit.decision.learned", "Decision: learned classifiers"),
     ("multimodel", "fdikit.multimodel", "Multiple-model estimation"),

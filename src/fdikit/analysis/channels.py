@@ -18,7 +18,7 @@ Varga's ``R(λ) = [R_u R_d R_f R_w]``).  This module holds what they share:
 
 References
 ----------
-Varga (2017), §3.1 (internal form of a filter) and §3.4 (structure matrices); :cite:`fdtools`.
+Varga (2017), §3.1 (internal form of a filter) and §3.4 (structure matrices); fdtools.
 
 Examples
 --------
@@ -61,7 +61,21 @@ HINF_TOL = 1e-10
 
 @dataclass(frozen=True, eq=False)
 class Channel:
-    """A state-space realisation ``(A, B, C, D)`` of one transfer channel (``dt`` None: continuous)."""
+    """A state-space realisation ``(A, B, C, D)`` of one transfer channel (``dt`` None: continuous).
+
+    Attributes
+    ----------
+    A, B, C, D : numpy.ndarray
+        The realisation (``A`` may be ``(0, 0)``: a static channel).
+    dt : float or None
+        Sample time (None: continuous).
+
+    Examples
+    --------
+    >>> ch = Channel(np.array([[-1.0]]), np.array([[1.0]]), np.array([[1.0]]), np.zeros((1, 1)))
+    >>> ch.n
+    1
+    """
 
     A: np.ndarray
     B: np.ndarray
@@ -89,6 +103,14 @@ class InternalForms:
         Whether a bank was given (a sequence, a mapping or ``groups=``), even of one filter.
     members : tuple of tuple of str
         The residual names of each filter.
+
+    Examples
+    --------
+    >>> from fdikit import FaultModel
+    >>> R = FaultModel(A=-np.eye(2), C=np.eye(2), Bf=np.eye(2), faults=["a", "b"], outputs=["r1", "r2"])
+    >>> bank = internal_forms(R, groups=[["r1"], ["r2"]])
+    >>> bank.names, bank.members, bank.faults
+    (('filter0', 'filter1'), (('r1',), ('r2',)), ('a', 'b'))
     """
 
     names: tuple[str, ...]
@@ -247,6 +269,13 @@ def minimal_channel(form: FaultModel, inputs: Sequence[str] | None = None, outpu
     Channel
         A minimal realisation (controllable and observable part), by python-control's ``minreal``.
 
+    Raises
+    ------
+    ModelError
+        An input name the form does not have.
+    ParameterError
+        An ``output_mask`` of the wrong shape.
+
     Examples
     --------
     >>> from fdikit import FaultModel
@@ -294,6 +323,18 @@ def _reduce(A, B, C, D, dt) -> Channel:
 def check_stable(form: FaultModel, outputs=None) -> None:
     """Raise :class:`~fdikit.errors.ModelError` when the minimal realisation of ``form`` (its ``outputs``) is unstable.
 
+    Parameters
+    ----------
+    form : FaultModel
+        The internal form.
+    outputs : sequence of str, optional
+        The residuals checked (default all).
+
+    Raises
+    ------
+    ModelError
+        When the minimal channel has a pole with ``Re ≥ 0`` (``|z| ≥ 1``); the message lists them.
+
     Examples
     --------
     >>> from fdikit import FaultModel
@@ -309,6 +350,22 @@ def check_stable(form: FaultModel, outputs=None) -> None:
 
 def input_columns(form: FaultModel, inputs) -> list[str]:
     """Input names of ``form`` (any group) as a list, checked; ``None`` gives the faults.
+
+    Parameters
+    ----------
+    form : FaultModel
+        The internal form.
+    inputs : str, sequence of str or None
+        Input names of any group; None: the fault inputs.
+
+    Returns
+    -------
+    list of str
+
+    Raises
+    ------
+    ParameterError
+        A name the form does not have.
 
     Examples
     --------
@@ -329,6 +386,17 @@ def input_columns(form: FaultModel, inputs) -> list[str]:
 def is_stable(A, dt: float | None) -> bool:
     """Whether every eigenvalue of ``A`` is in the open left half plane (``dt`` None) or open unit disc.
 
+    Parameters
+    ----------
+    A : array_like
+        Square state matrix (``(0, 0)`` is stable).
+    dt : float or None
+        Sample time (None: continuous).
+
+    Returns
+    -------
+    bool
+
     Examples
     --------
     >>> is_stable([[-1.0]], None), is_stable([[1.0]], 0.1), is_stable(np.zeros((0, 0)), None)
@@ -346,6 +414,16 @@ def hinf_norm(ch: Channel) -> tuple[float, float]:
 
     python-control's ``linfnorm`` (SLICOT AB13DD, relative tolerance ``1e-10``) on the minimal
     realisation; a static or empty channel gives ``σ_max(D)`` at frequency 0.
+
+    Parameters
+    ----------
+    ch : Channel
+        Preferably minimal (:func:`minimal_channel`): stability is judged on its ``A``.
+
+    Returns
+    -------
+    (float, float)
+        ``(‖G‖∞, ω_peak)``.
 
     Examples
     --------
@@ -372,6 +450,15 @@ def h2_norm(ch: Channel) -> float:
     Infinite for an unstable channel and for a continuous channel with ``D ≠ 0`` (not strictly proper;
     ``D`` counts as zero when ``‖D‖ ≤ 100 ε max(1, ‖C‖ ‖B‖)``).  Discrete time: the sum of the squared
     impulse-response samples (``D Dᵀ`` included).
+
+    Parameters
+    ----------
+    ch : Channel
+        Preferably minimal (:func:`minimal_channel`).
+
+    Returns
+    -------
+    float
 
     Examples
     --------
@@ -402,6 +489,22 @@ def h2_norm(ch: Channel) -> float:
 def check_freqs(freqs, dt: float | None) -> np.ndarray:
     """Frequencies [rad/s] as a non-empty 1-D float array; ``inf`` (the ``D`` term) only in continuous time.
 
+    Parameters
+    ----------
+    freqs : float or array_like
+        Frequencies in rad/s.
+    dt : float or None
+        Sample time (None: continuous).
+
+    Returns
+    -------
+    numpy.ndarray
+
+    Raises
+    ------
+    ParameterError
+        Empty, not 1-D, NaN or ``-inf``, or ``inf`` in discrete time.
+
     Examples
     --------
     >>> check_freqs(0, None).tolist(), check_freqs([1.0, np.inf], None).tolist()
@@ -420,6 +523,18 @@ def check_freqs(freqs, dt: float | None) -> np.ndarray:
 
 def frequency_response(ch: Channel, freqs) -> np.ndarray:
     """``G(λ_k)`` at ``λ = jω`` (continuous; ``ω = inf`` gives ``D``) or ``λ = e^{jω dt}``, shape (N, p, m).
+
+    Parameters
+    ----------
+    ch : Channel
+        The channel.
+    freqs : float or array_like
+        Frequencies in rad/s (:func:`check_freqs`).
+
+    Returns
+    -------
+    numpy.ndarray
+        Complex ``(N, p, m)``.
 
     Raises
     ------

@@ -13,7 +13,7 @@ zero can be missed; the frequencies of the zeros are where ``σ_m`` vanishes, so
 
 References
 ----------
-Varga (2017), §3.3 (fault sensitivity measures); :cite:`fdtools`.
+Varga (2017), §3.3 (fault sensitivity measures); fdtools.
 
 Examples
 --------

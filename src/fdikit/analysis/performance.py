@@ -30,7 +30,7 @@ must detect: fault names or a boolean vector (one filter), a boolean ``rows × f
 References
 ----------
 Varga (2017), §3.3 (fault sensitivity, the H∞− index), §5.3 (fault-to-noise gap, eq. (5.41)–(5.42)) and
-§5.6 (model matching); :cite:`fdtools` (``fdhinfminus``, ``fdiscond``, ``fdif2ngap``, ``fdimmperf``).
+§5.6 (model matching); fdtools (``fdhinfminus``, ``fdiscond``, ``fdif2ngap``, ``fdimmperf``).
 
 Examples
 --------
@@ -71,7 +71,23 @@ _EPS = np.finfo(float).eps
 
 @dataclass(frozen=True, eq=False)
 class ColumnNorm:
-    """An extreme column norm: its value, the input (column) and the frequency [rad/s] where attained."""
+    """An extreme column norm: its value, the input (column) and the frequency [rad/s] where attained.
+
+    Attributes
+    ----------
+    value : float
+        The norm.
+    column : str or None
+        The input whose column attains it (None when there is no column).
+    freq : float
+        The frequency [rad/s] where it is attained.
+
+    Examples
+    --------
+    >>> value, column, freq = ColumnNorm(2.0, "f1", 0.0)
+    >>> column
+    'f1'
+    """
 
     value: float
     column: str | None
@@ -95,6 +111,12 @@ class NormRatio:
         The filter or residual names of the entries (one name for a float result).
 
     Unpacks as ``ratio, beta, gamma`` (the reference's ``(gap, β, γ)``).
+
+    Examples
+    --------
+    >>> gap, beta, gamma = NormRatio(2.0, 4.0, 2.0, ("r",))
+    >>> gap
+    2.0
     """
 
     ratio: float | np.ndarray
@@ -261,6 +283,15 @@ def fdhinfminus(sysr, freqs=None, *, inputs: Sequence[str] | None = None) -> Col
 
 def fdhinfmax(sysr, freqs=None, *, inputs: Sequence[str] | None = None) -> ColumnNorm:
     """Largest column norm ``max_j ‖g_j‖∞`` (or over ``freqs``), as :func:`fdhinfminus` with the maximum.
+
+    Parameters
+    ----------
+    sysr, freqs, inputs
+        As :func:`fdhinfminus`.
+
+    Returns
+    -------
+    ColumnNorm
 
     Examples
     --------

@@ -21,7 +21,7 @@ Poles at a frequency of ``freqs`` are refused (the reference's default ``stabili
 
 References
 ----------
-Varga (2017), §3.4 (structure matrices, Corollaries 7.1–7.2 for their computation); :cite:`fdtools`.
+Varga (2017), §3.4 (structure matrices, Corollaries 7.1–7.2 for their computation); fdtools.
 
 Examples
 --------
@@ -75,6 +75,12 @@ class StructureMatrix:
         The frequencies [rad/s] of a strong matrix.
     gains : (rows, faults, len(freqs)) ndarray or None
         :func:`fdisspec`'s gains ``|R_f,ij(λ_k)|`` (column 2-norms for blocks).
+
+    Examples
+    --------
+    >>> S = StructureMatrix(np.array([[True, False]]), ("r",), ("f1", "f2"), (("r",),), "weak")
+    >>> S.to_pandas()["r"].tolist()
+    [True, False]
     """
 
     matrix: np.ndarray

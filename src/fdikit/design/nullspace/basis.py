@@ -61,6 +61,10 @@ def default_sdeg(dt: float | None) -> float:
     --------
     >>> default_sdeg(None), default_sdeg(0.01)
     (-0.05, 0.95)
+
+    References
+    ----------
+    Varga (2017), §5.2 (``sdeg``); fdtools (``efdsyn`` defaults).
     """
     return -0.05 if dt is None else 0.95
 
@@ -93,6 +97,10 @@ def denominator(degree: int, poles: Sequence[complex] | None, sdeg: float | None
     --------
     >>> denominator(2, None, -1.0, None).tolist()
     [1.0, 2.0, 1.0]
+
+    References
+    ----------
+    Varga (2017), §5.1 (stable denominators of the proper basis) and §7.5 (coprime factorisation).
     """
     if poles is None:
         s = default_sdeg(dt) if sdeg is None else float(sdeg)
@@ -139,6 +147,10 @@ def realize_rows(rows: Sequence[np.ndarray], dens: Sequence[np.ndarray], scale: 
     >>> A, B, C, D = realize_rows([np.array([[1.0], [1.0]])], [np.array([1.0, 2.0])], 1.0)
     >>> A.tolist(), B.tolist(), C.tolist(), D.tolist()
     ([[-2.0]], [[-1.0]], [[1.0]], [[1.0]])
+
+    References
+    ----------
+    Varga (2017), §7.4 (realisation of a polynomial basis over its denominators).
     """
     m = rows[0].shape[1]
     blocks = []
@@ -188,6 +200,10 @@ def minimal_realization(A, B, C, D, tol: float = 1e-7):
     >>> A, B, C, D = minimal_realization(np.diag([2.0, 3.0, -3.0]), np.ones((3, 1)), [[0.0, 0.0, 1.0]], [[0.0]])
     >>> np.round(A, 9).tolist()
     [[-3.0]]
+
+    References
+    ----------
+    Varga (2017), §7.3 (minimal realisations; SLICOT ``TB01PD``).
     """
     import control
 
@@ -273,6 +289,10 @@ class NullspaceBasis:
     >>> b = left_nullspace(m)
     >>> b.degrees
     (0,)
+
+    References
+    ----------
+    Varga (2017), §7.4 (minimal polynomial bases) and §5.1 (the nullspace method); Forney (1975).
     """
 
     rows: tuple[np.ndarray, ...]

@@ -50,6 +50,10 @@ def frequency_points(freqs: Sequence[float] | float | None, dt: float | None) ->
     --------
     >>> frequency_points([0.0, 2.0], None).tolist()
     [0j, 2j]
+
+    References
+    ----------
+    Varga (2017), §3.3 (strong detectability at given frequencies).
     """
     if freqs is None:
         return np.zeros(0, dtype=complex)
@@ -80,6 +84,10 @@ def fault_response(model: FaultModel, faults: Sequence[str], lam: complex) -> np
     >>> m = FaultModel([[-1.0]], [[1.0]], Bf=[[1.0]])
     >>> complex(fault_response(m, ["f0"], 0.0)[0, 0])
     (1+0j)
+
+    References
+    ----------
+    Varga (2017), §3.3 (fault detectability conditions).
     """
     return _response(model, faults, lam)[0]
 
@@ -137,6 +145,10 @@ def row_structure(model: FaultModel, basis, faults: Sequence[str], *, fdtol: flo
     >>> m = FaultModel([[-1.0]], [[1.0], [1.0]], Bd=[[1.0]], Bf=[[1.0, 0.0]], Df=[[0.0, 0.0], [0.0, 1.0]])
     >>> row_structure(m, left_nullspace(m), ["f0", "f1"]).tolist()
     [[False, True]]
+
+    References
+    ----------
+    Varga (2017), §3.4 (weak and strong structure matrices); fdtools (``fdisspec``).
     """
     coeffs = list(basis.rows if rows is None else rows)
     faults = tuple(faults)

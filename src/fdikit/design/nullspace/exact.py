@@ -60,6 +60,10 @@ def split_faults(model: FaultModel, targets, nuisance) -> tuple[tuple[str, ...],
     >>> m = FaultModel([[-1.0]], [[1.0]], Bf=[[1.0, 2.0]])
     >>> split_faults(m, "f0", "others")
     (('f0',), ('f1',))
+
+    References
+    ----------
+    Varga (2017), §5.2 (detected and decoupled fault inputs).
     """
     from fdikit.fault_maps import check_fault_inputs
 
@@ -108,6 +112,17 @@ class NullspaceDesign(FieldReport):
         The detected and the decoupled fault inputs.
     poles : numpy.ndarray
         The filter eigenvalues.
+
+    Examples
+    --------
+    >>> m = FaultModel([[-1.0]], [[1.0], [1.0]], Bu=[[1.0]], Df=np.eye(2))
+    >>> d = efdsyn(m, targets=["f0"], nuisance=["f1"])
+    >>> d.order, d.structure.astype(int).tolist()
+    (1, [[1, 0]])
+
+    References
+    ----------
+    Varga (2017), §5.2, Procedure EFD; fdtools (``efdsyn``).
     """
 
     generator: ResidualGenerator
@@ -288,6 +303,16 @@ class NullspaceBankDesign(FieldReport):
         The residual names of each filter (for ``ThresholdEvaluator(groups=...)``).
     orders : tuple of int
         The order of each filter.
+
+    Examples
+    --------
+    >>> m = FaultModel([[-1.0]], [[1.0], [1.0]], Bu=[[1.0]], Df=np.eye(2))
+    >>> efdisyn(m, np.eye(2)).groups
+    (('r0',), ('r1',))
+
+    References
+    ----------
+    Varga (2017), §5.4, Procedure EFDI; fdtools (``efdisyn``).
     """
 
     generator: ResidualGenerator

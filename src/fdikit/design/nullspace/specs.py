@@ -114,6 +114,17 @@ class SpecificationCheck:
         Least order of a scalar filter ``[q r_f]`` achieving row ``i`` (``minimal=True``); −1 otherwise.
     feasible : numpy.ndarray
         ``rdims > 0``.
+
+    Examples
+    --------
+    >>> from fdikit.model import FaultModel
+    >>> m = FaultModel([[-1.0]], [[1.0], [1.0]], Bu=[[1.0]], Df=np.eye(2))
+    >>> fdichkspec(m, [[1, 0], [1, 1]]).feasible.tolist()
+    [True, True]
+
+    References
+    ----------
+    Varga (2017), §5.4 (achievable specifications); fdtools (``fdichkspec``).
     """
 
     rdims: np.ndarray
@@ -148,6 +159,10 @@ def joint_order(generator, model: FaultModel, faults) -> int:
     >>> m = FaultModel([[-1.0]], [[1.0], [1.0]], Bd=[[1.0]], Bf=[[1.0, 0.0]], Df=[[0.0, 0.0], [0.0, 1.0]])
     >>> joint_order(efdsyn(m, targets="f1", nuisance="f0").generator, m, ["f0", "f1"])
     0
+
+    References
+    ----------
+    Varga (2017), §5.2 (least order of ``[Q R_f]``).
     """
     cols = [len(model.controls) + len(model.disturbances) + i for i in model.index("f", list(faults))]
     Bf, Df = model.B[:, cols], model.D[:, cols]
