@@ -20,6 +20,7 @@ from fdikit.decision import (
     GaussianMlEvaluator,
     GlrEvaluator,
     MhsprtEvaluator,
+    NarendraEvaluator,
     SprtEvaluator,
     ThresholdEvaluator,
     Whitened,
@@ -290,6 +291,8 @@ def _fit(kind, ev=None):
         "bnn": (lambda: BnnEvaluator(inputs="raw", max_iter=8, rm_steps=0), lambda e: e.fit(labelled)),
         "whitened_cusum": (lambda: Whitened(CusumEvaluator(hold=2), order=2),
                            lambda e: e.fit(h, arl0=500.0, shift=1.0)),
+        "narendra": (lambda: NarendraEvaluator(alpha=1.0, beta=0.5, gamma=0.5),
+                     lambda e: e.fit(h, false_alarm_prob=2e-2)),
     }[kind]
     return fit(new() if ev is None else ev)
 
@@ -318,7 +321,7 @@ def _assert_same(d, stepped, what):
 
 
 @pytest.mark.parametrize("kind", ["threshold", "cusum", "glr", "sprt", "mhsprt", "gaussian_ml", "bnn",
-                                  "whitened_cusum"])
+                                  "whitened_cusum", "narendra"])
 def test_evaluator_protocol_batch_online_refit_reset(kind):
     ev = _fit(kind)
     assert isinstance(ev, Evaluator)

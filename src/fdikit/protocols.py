@@ -88,6 +88,7 @@ class Evaluator(Protocol):
     Implemented by :class:`~fdikit.decision.threshold.ThresholdEvaluator`,
     :class:`~fdikit.decision.cusum.CusumEvaluator`, :class:`~fdikit.decision.glr.GlrEvaluator`,
     :class:`~fdikit.decision.sprt.SprtEvaluator`, :class:`~fdikit.decision.mhsprt.MhsprtEvaluator`,
+    :class:`~fdikit.decision.narendra.NarendraEvaluator`,
     :class:`~fdikit.decision.learned.gaussian_ml.GaussianMlEvaluator` and
     :class:`~fdikit.decision.learned.bnn.BnnEvaluator`.
 

@@ -8,7 +8,14 @@ import scipy.signal
 
 from fdikit import FaultModel
 from fdikit.analysis import (
-    fdhinfmax, fdhinfminus, fdif2ngap, fdimmperf, fdiscond, fditspec, fdisspec, hminus_index,
+    fdhinfmax,
+    fdhinfminus,
+    fdif2ngap,
+    fdimmperf,
+    fdiscond,
+    fdisspec,
+    fditspec,
+    hminus_index,
 )
 from fdikit.errors import ModelError, ParameterError
 from fdikit.residuals import ResidualGenerator

@@ -57,6 +57,10 @@ __all__ = [
 _EPS = np.finfo(float).eps
 #: Relative tolerance of the H∞ norm (python-control ``linfnorm``, SLICOT AB13DD).
 HINF_TOL = 1e-10
+#: Rank tolerance of the minimal realisations (SLICOT TB01PD's ``TOL``, the reference's ``atol = 1e-7``): the
+#: default ``n² ε`` keeps the cancelled modes of a filter in series with a badly scaled plant (the Niemann 1998
+#: bank discretised at 0.01 s keeps six modes in a decoupled channel whose gain is 1e-16).
+MINREAL_TOL = 1e-7
 
 
 @dataclass(frozen=True, eq=False)
@@ -313,7 +317,7 @@ def _reduce(A, B, C, D, dt) -> Channel:
     import control
 
     sys = control.ss(A, B, C, D, 0 if dt is None else dt)
-    red = control.minreal(sys, verbose=False)
+    red = control.minreal(sys, tol=MINREAL_TOL, verbose=False)
     Ar, Br, Cr = (np.asarray(x, dtype=float) for x in (red.A, red.B, red.C))
     if Ar.size == 0:
         Ar, Br, Cr = np.zeros((0, 0)), np.zeros((0, D.shape[1])), np.zeros((D.shape[0], 0))

@@ -31,6 +31,8 @@ given ``names=`` (or a mapping ``{name: value}``).  Bad arguments raise
   1996, §7.2).
 * :mod:`fdikit.decision.whiten` — Prewhitening of coloured residuals before a test that assumes white ones (CUSUM,
   GLR, SPRT).
+* :mod:`fdikit.decision.narendra` — Narendra-type evaluation filters with thresholds and structure-matrix matching
+  (FDITOOLS' online FDD, Varga 2017 §3.6).
 * :mod:`fdikit.decision.signature` — Isolation from a fault-signature (structure) table: the fault whose pattern
   of residual groups fired.
 * :mod:`fdikit.decision.calibration` — Calibration on a list of fault-free runs, and the report of the false-alarm
@@ -71,6 +73,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
         "whiten": [
             "Whitened", "yule_walker",
         ],
+        "narendra": ["NarendraEvaluator", "narendra_signal"],
         "signature": [
             "MATCH_RULES", "SignatureTable", "as_signature_table", "signature_isolation",
         ],

@@ -309,8 +309,9 @@ def as_signature_table(signatures) -> SignatureTable | None:
 
     Parameters
     ----------
-    signatures : SignatureTable, mapping, pandas.DataFrame or None
-        The fault signatures.
+    signatures : SignatureTable, StructureMatrix, mapping, pandas.DataFrame or None
+        The fault signatures (a :class:`~fdikit.analysis.structure.StructureMatrix` gives its
+        :meth:`~fdikit.analysis.structure.StructureMatrix.signature_table`).
 
     Returns
     -------
@@ -334,6 +335,8 @@ def as_signature_table(signatures) -> SignatureTable | None:
     """
     if signatures is None or isinstance(signatures, SignatureTable):
         return signatures
+    if hasattr(signatures, "signature_table"):  # a StructureMatrix (fdikit.analysis.structure): rows are the groups
+        return signatures.signature_table()
     return SignatureTable(signatures)
 
 

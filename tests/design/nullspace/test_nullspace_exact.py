@@ -150,6 +150,13 @@ def test_bank_plugs_into_evaluators_and_the_compiled_runtime():
     diag = ev.run(res)
     named = diag.isolated[2100:]
     assert np.mean(named == "s1") > 0.95 and not np.any(named == "s0")
+    # the bank's structure matrix as the signature table of the decision logic: the same isolation
+    from fdikit.analysis import fditspec
+
+    S = fditspec(bank.generator.internal_form(m), groups=bank.groups)
+    by_table = ThresholdEvaluator(signatures=S).fit(bank.generator.run(healthy), false_alarm_prob=1e-4)
+    assert S.matrix.tolist() == np.eye(2, dtype=bool).tolist()
+    assert by_table.run(res).isolated.tolist() == diag.isolated.tolist()
     compiled = compile_generator(bank.generator)
     ref = bank.generator.online()
     for k in range(200):

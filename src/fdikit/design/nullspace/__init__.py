@@ -14,7 +14,9 @@ import lazy_loader as lazy
 __getattr__, __dir__, __all__ = lazy.attach(
     __name__,
     submod_attrs={
-        "basis": ["NullspaceBasis", "default_sdeg", "denominator", "left_nullspace", "minimal_realization", "realize_rows"],
+        "basis": [
+            "NullspaceBasis", "default_sdeg", "denominator", "left_nullspace", "minimal_realization", "realize_rows",
+        ],
         "detectability": ["fault_response", "frequency_points", "row_structure"],
         "exact": ["NullspaceBankDesign", "NullspaceDesign", "efdisyn", "efdsyn", "split_faults"],
         "specs": ["SpecificationCheck", "fdichkspec", "fdigenspec", "joint_order"],

@@ -91,7 +91,9 @@ class NullspaceDesign(FieldReport):
     Attributes
     ----------
     generator : ResidualGenerator
-        The filter ``Q`` (inputs ``[u; y]``), minimal, with the assigned stable poles.
+        The filter ``Q`` (inputs ``[u; y]``), minimal, with the assigned stable poles, scaled as the reference scales
+        it: the smallest column gain of its fault part ``R_f`` (targets) is 1 (the DC gain with ``fdfreq`` ∋ 0, the H∞
+        norm otherwise).
     basis : NullspaceBasis
         The left nullspace basis the filter was selected from.
     degrees : tuple of int
@@ -159,6 +161,26 @@ def _minimal_generator(A, B, C, D, model: FaultModel, names) -> ResidualGenerato
     A, B, C, D = minimal_realization(A, B, C, D)
     return ResidualGenerator(A, B, C, D, controls=model.controls, outputs=model.outputs, residuals=names,
                              dt=model.dt)
+
+
+def _unit_fault_gain(gen: ResidualGenerator, model: FaultModel, targets, fdfreq) -> ResidualGenerator:
+    """``gen`` scaled as the reference scales its filter: the smallest column gain of ``R_f`` (targets) is 1.
+
+    With ``fdfreq`` containing 0: the smallest over the targets of the largest |DC gain| over the residuals, and the
+    sign that makes the largest entry of that column positive; otherwise ``1 / fdhinfminus(R_f)``.
+    """
+    from fdikit.analysis.channels import frequency_response, minimal_channel
+    from fdikit.analysis.performance import fdhinfminus
+
+    R = gen.internal_form(model)
+    if fdfreq is not None and np.min(np.atleast_1d(fdfreq)) == 0:
+        dcg = frequency_response(minimal_channel(R, list(targets)), [0.0])[0].real
+        y = np.abs(dcg).max(axis=0)
+        j = int(np.argmin(y))
+        sc = np.sign(dcg[int(np.argmax(np.abs(dcg[:, j]))), j]) / y[j]
+    else:
+        sc = 1.0 / fdhinfminus(R, inputs=list(targets)).value
+    return dataclasses.replace(gen, C=sc * gen.C, D=sc * gen.D)
 
 
 def efdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = None, minimal: bool = True,
@@ -263,7 +285,7 @@ def efdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
         C, D = H @ C, H @ D
         rows = [None] * q
     names_default = tuple(f"r{i}" for i in range(q))
-    gen = _minimal_generator(A, B, C, D, model, names_default)
+    gen = _unit_fault_gain(_minimal_generator(A, B, C, D, model, names_default), model, targets, fdfreq)
     gen = label_generator(gen, model, names, isolates)
     faults = targets + nuisance
     if minimal:
