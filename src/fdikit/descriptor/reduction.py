@@ -6,16 +6,17 @@
   reduction that the reference's ``gir`` (and ``gss2ss``) performs after its controllability/observability steps.
 * :func:`minimal_realization` (``gminreal``-like) removes in addition every uncontrollable and unobservable
   eigenvalue, finite and infinite: the infinite and finite parts of ``A − λE`` are separated (the orthogonal
-  staircase of :func:`fdikit.descriptor.staircase.split_infinite`, a generalised Schur form of each part and a
-  generalised Sylvester equation, LAPACK ``tgsyl``), the finite part ``Ef⁻¹(Af, Bf)`` and the infinite part
+  staircase of :func:`fdikit.descriptor.staircase.split_infinite`, then the rows scaled to ``A∞ = I``,
+  ``Ef = I`` and the generalised Sylvester equation solved as ``X − N X F = R``, a finite sum since ``N`` is
+  nilpotent), the finite part ``Ef⁻¹(Af, Bf)`` and the infinite part
   ``A∞⁻¹(E∞, B∞)`` (a nilpotent standard system with the same Markov parameters ``C N^k B``) are each reduced
   by SLICOT ``TB01PD`` (orthogonal staircase, slycot), recombined, and the non-dynamic modes removed again.
 
 Covered: regular pencils ``A − λE`` of any index, proper or improper, continuous or discrete.  Not covered: the
 result of :func:`minimal_realization` has ``E = diag(I, N)`` (not the reference's upper-triangular ``E`` from
-orthogonal transformations only): the finite part is inverted by ``Ef`` and the decoupling uses a (non-orthogonal)
-Sylvester transformation, so models with ``Ef`` or the Sylvester solution badly conditioned lose accuracy in
-proportion; no balancing is done.
+orthogonal transformations only): the parts are scaled by ``Ef⁻¹`` and ``A∞⁻¹`` and decoupled by a
+(non-orthogonal) Sylvester transformation, so models with ``Ef``, ``A∞`` or the Sylvester solution badly
+conditioned lose accuracy in proportion; no balancing is done.
 
 References
 ----------
@@ -212,32 +213,22 @@ def minimal_realization(model: DescriptorModel, *, tol: float | None = None) -> 
         return m.with_matrices(np.eye(Ar.shape[0]), Ar, Br, Cr, m.D)
     Q, Z, ni = split_infinite(m.A, m.E, tol=tol)
     A, E, B, C = Q.T @ m.A @ Z, Q.T @ m.E @ Z, Q.T @ m.B, m.C @ Z
-    A[ni:, :ni] = 0.0
-    E[ni:, :ni] = 0.0
-    parts = []
-    for sl in (slice(0, ni), slice(ni, n)):
-        if sl.stop > sl.start:
-            AA, EE, Qi, Zi = scipy.linalg.qz(A[sl, sl], E[sl, sl], output="real")
-        else:
-            AA, EE, Qi, Zi = (np.zeros((0, 0)),) * 4
-        parts.append((AA, EE, Qi, Zi))
-    Q2 = scipy.linalg.block_diag(parts[0][2], parts[1][2])
-    Z2 = scipy.linalg.block_diag(parts[0][3], parts[1][3])
-    A, E, B, C = Q2.T @ A @ Z2, Q2.T @ E @ Z2, Q2.T @ B, C @ Z2
     i, f = slice(0, ni), slice(ni, n)
-    if n > ni:
-        from scipy.linalg.lapack import dtgsyl
-
-        R, L, scale, _, info = dtgsyl(A[i, i], A[f, f], -A[i, f], E[i, i], E[f, f], -E[i, f])
-        if info != 0 or scale == 0:
-            raise ModelError(f"the finite and infinite parts of A − λE could not be separated (LAPACK tgsyl "
-                             f"info={info}); the pencil is too close to one with a common eigenvalue")
-        X, Y = R / scale, -L / scale
-        B = np.vstack([B[i] + Y @ B[f], B[f]])
-        C = np.hstack([C[:, i], C[:, i] @ X + C[:, f]])
-    Ninf, Binf, Cinf = _tb01pd(np.linalg.solve(A[i, i], E[i, i]), np.linalg.solve(A[i, i], B[i]), C[:, i], tol)
-    Af, Bf, Cf = _tb01pd(np.linalg.solve(E[f, f], A[f, f]), np.linalg.solve(E[f, f], B[f]), C[:, f], tol) \
-        if n > ni else (np.zeros((0, 0)), np.zeros((0, m.B.shape[1])), np.zeros((m.p, 0)))
+    # rows scaled to A∞ = I and Ef = I: the blocks are (N − λ·… ) with N = A∞⁻¹E∞ nilpotent and F = Ef⁻¹Af
+    Ninf = np.linalg.solve(A[i, i], E[i, i])
+    A12, E12, B1 = (np.linalg.solve(A[i, i], M) for M in (A[i, f], E[i, f], B[i]))
+    F = np.linalg.solve(E[f, f], A[f, f])
+    B2 = np.linalg.solve(E[f, f], B[f])
+    # decoupling [[I, Y], [0, I]] (·) [[I, X], [0, I]]: X − N X F = E12 F − A12 (a finite sum, N nilpotent),
+    # Y = −E12 − N X
+    R = E12 @ F - A12
+    X, term = R.copy(), R
+    for _ in range(ni - 1):
+        term = Ninf @ term @ F
+        X += term
+    Y = -E12 - Ninf @ X
+    Ninf, Binf, Cinf = _tb01pd(Ninf, B1 + Y @ B2, C[:, i], tol)
+    Af, Bf, Cf = _tb01pd(F, B2, C[:, i] @ X + C[:, f], tol)
     kf, ki = Af.shape[0], Ninf.shape[0]
     reduced = m.with_matrices(scipy.linalg.block_diag(np.eye(kf), Ninf), scipy.linalg.block_diag(Af, np.eye(ki)),
                               np.vstack([Bf, Binf]), np.hstack([Cf, Cinf]), m.D)
