@@ -165,7 +165,7 @@ def _tb01pd(A, B, C, tol):
     if n == 0 or m == 0 or p == 0:
         return np.zeros((0, 0)), np.zeros((0, m)), np.zeros((p, 0))
     Ar, Br, Cr, nr = tb01pd(n, m, p, A.copy(), B.copy(), C.copy(), job="M", equil="N",
-                            tol=0.0 if tol is None else tol)
+                            tol=1e3 * n * _EPS if tol is None else tol)
     return Ar[:nr, :nr], Br[:nr, :m], Cr[:p, :nr]
 
 
@@ -178,7 +178,8 @@ def minimal_realization(model: DescriptorModel, *, tol: float | None = None) -> 
         The model (any regular pencil; proper or improper).
     tol : float, optional
         Relative rank tolerance of every step (``TB01PD``'s lower bound on reciprocal condition numbers);
-        default ``n² ε`` for the pencil steps and SLICOT's default for ``TB01PD``.  Cancellations that hold only
+        default ``n² ε`` for the pencil steps and ``1e3 · n · ε`` for ``TB01PD`` (the rounding of the
+        transformations before it exceeds SLICOT's own default ``n² ε``).  Cancellations that hold only
         to a looser accuracy (e.g. a series connection designed to cancel) need a larger ``tol`` (``1e-7``).
 
     Returns
