@@ -27,6 +27,7 @@ PAGES = [
     ("design-game", "fdikit.design.game", "Design: game-theoretic filters"),
     ("design-parity", "fdikit.design.parity", "Design: parity space"),
     ("design-nullspace", "fdikit.design.nullspace", "Design: nullspace synthesis (FDITOOLS)"),
+    ("descriptor", "fdikit.descriptor", "Descriptor models: reductions and Kronecker structure"),
     ("decision", "fdikit.decision", "Decision: residual evaluators"),
     ("decision-learned", "fdikit.decision.learned", "Decision: learned classifiers"),
     ("multimodel", "fdikit.multimodel", "Multiple-model estimation"),
