@@ -3,7 +3,8 @@
 The layers, from data to decisions (``docs/ARCHITECTURE.md``):
 
 * model layer — :mod:`fdikit.model` (:class:`FaultModel`, LTI with named signals), :mod:`fdikit.lpv`,
-  :mod:`fdikit.ltv`, :mod:`fdikit.dae`, :mod:`fdikit.gaussian`; :mod:`fdikit.plants` (benchmark plants);
+  :mod:`fdikit.ltv`, :mod:`fdikit.dae`, :mod:`fdikit.gaussian`, :mod:`fdikit.descriptor` (:class:`DescriptorModel`);
+  :mod:`fdikit.plants` (benchmark plants);
 * signals — :mod:`fdikit.faults` (+ :mod:`fdikit.fault_spec`), :mod:`fdikit.simulate`, :mod:`fdikit.trace`
   (+ :mod:`fdikit.trace_io`), :mod:`fdikit.gaps`;
 * residual generation — :mod:`fdikit.design` (observers, game, parity families), :mod:`fdikit.residuals`;
@@ -27,6 +28,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
         "detector": ["Detector"],
         "detector_online": ["DetectorStepper"],
         "model": ["FaultModel"],
+        "descriptor.model": ["DescriptorModel"],
     },
 )
 __version__ = "0.1.0"
