@@ -10,8 +10,8 @@ EFDI).  That is what a Beard–Jones filter achieves geometrically (each fault's
 others of its group) and what the game bank (:mod:`~fdikit.studies.path1996.game_bank`) approximates; the faults
 outside the group are not inputs of the group's design model, so they are unconstrained, as in the report.
 Each row is achievable on both the App. D models and fdikit's own (``fdichkspec`` finds 9 basis rows for every
-sensor row, 8 or 9 for filter 4) and every target is detected **strongly at ω = 0** (``fdfreq=0``), so a bias
-gives a steady residual and the report's scaling to the nominal fault (§5.1.1,
+row on App. D; on fdikit's car 9, and 8 or 9 for filter 4) and every target is detected **strongly at ω = 0**
+(``fdfreq=0``), so a bias gives a steady residual and the report's scaling to the nominal fault (§5.1.1,
 :func:`~fdikit.studies.path1996.bank.scale_to_nominal`) applies.  Filters 1–3 are designed on the 12-state model
 with the group's sensor faults, filter 4 on the 14-state model with the three actuator faults and the air-mass
 sensor fault (as an additive output fault: the exact design needs no detection space, so the report's "magnitude
