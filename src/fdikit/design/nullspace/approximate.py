@@ -1,0 +1,471 @@
+"""Approximate fault detection and isolation by the nullspace method: afdsyn, afdisyn (Varga 2017, §5.3, §5.5).
+
+``afdsyn`` solves the approximate fault detection problem (AFDP, Procedure AFD): a stable filter ``Q`` that
+decouples the controls, disturbances and nuisance faults exactly (``Q = Q̄ Q_1``, ``Q_1`` a left nullspace basis of
+``[Gu Gd Gn; I 0 0]``), detects every targeted fault and maximises the fault-to-noise gap
+``‖R_f‖∞− / ‖R_w‖∞`` with ``‖R_w‖∞ = γ``.  The steps: select ``q_1 ≤ rank R_w`` rows of the basis (least order,
+all targets detected, ``H R_w`` of full row rank at a test frequency); factor their noise part
+``R_w = R_wo R_wi`` (co-outer–co-inner, :mod:`~fdikit.design.nullspace.factorization`) and set ``Q ← R_wo⁻¹ Q``
+(non-standard case: the quasi factor with its boundary and infinite zeros moved to the assigned poles, or the
+regularised factor); scale to ``‖R_w‖∞ = γ``.  When ``rdim`` exceeds ``rank R_w`` the remaining residuals come
+from the rows that decouple the noise too (an exact design, scaled so that its fault gain is the first part's gap;
+reference ``scale2``).  Without noise (or ``R_w = 0``) the problem is exact and :func:`~.exact.efdsyn` solves it.
+
+``afdisyn`` builds one ``afdsyn`` filter per row of a structure matrix (Procedure AFDI).
+
+Differences from the reference: the basis is the least-degree polynomial basis over stable denominators
+(:mod:`~fdikit.design.nullspace.basis`), so state coordinates and the design matrices ``H`` differ; ``smarg`` is
+not offered (only the boundary and infinite zeros of the quasi factor are moved, the reference's default
+``smarg = −√ε``); the weak fallback of the reference's ``afdsyn(sysf, SFDI)`` (non-decoupled faults as noise) is
+not attempted.
+
+References
+----------
+Varga (2017), §5.3 (AFDP, Procedure AFD), §5.5 (AFDIP, Procedure AFDI), Remark 5.8; fdtools (``afdsyn``,
+``afdisyn``, ``afdredsyn``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from fdikit.design.nullspace.basis import NullspaceBasis, denominator, left_nullspace, minimal_realization, realize_rows
+from fdikit.design.nullspace.detectability import row_structure
+from fdikit.design.nullspace.exact import efdsyn, split_faults
+from fdikit.design.nullspace.factorization import (
+    coouter_coinner,
+    inverse,
+    quasi_coouter_row,
+    regularized_coouter,
+    series,
+)
+from fdikit.errors import DesignError, ParameterError
+from fdikit.model import FaultModel
+from fdikit.protocols import FieldReport
+from fdikit.residuals import ResidualGenerator
+
+__all__ = ["ApproximateDesign", "ApproximateBankDesign", "afdsyn", "afdisyn"]
+
+_TEST_FREQ = 0.6180339887          # fixed test frequency of the rank checks (the reference draws one at random)
+
+
+@dataclass(frozen=True, eq=False)
+class ApproximateDesign(FieldReport):
+    """An approximate fault detection filter (``afdsyn``) and its report.
+
+    Attributes
+    ----------
+    generator : ResidualGenerator
+        The filter ``Q`` (inputs ``[u; y]``), minimal and stable; ``‖R_w‖∞ = γ`` for the noise-attenuating part.
+    basis : NullspaceBasis
+        The left nullspace basis of ``[Gu Gd Gn; I 0 0]``.
+    degrees : tuple of int
+        Its row degrees (reference ``info.degs``).
+    selection : numpy.ndarray
+        ``(q_1, len(used))`` combination of the basis rows ``used`` (reference ``info.HDesign``).
+    used : tuple of int
+        The basis rows of the noise-attenuating part.
+    order : int
+        The filter order.
+    gap : float
+        The achieved fault-to-noise gap ``β/γ`` (:func:`~fdikit.analysis.performance.fdif2ngap` over the targets,
+        at ``fdfreq`` when given; ``inf`` without noise).
+    beta : float
+        ``‖R_f‖∞−`` of the targets (at ``fdfreq`` when given).
+    gamma : float
+        ``‖R_w‖∞`` achieved (``γ`` asked for; 0 without noise).
+    noise_rank : int
+        The normal rank of ``R_w`` of the basis (reference ``rw``).
+    factorization : str
+        ``"standard"``, ``"quasi"``, ``"regularized"`` or ``"none"`` (exact problem).
+    shifted : int
+        Number of boundary / infinite zeros of the noise factor moved to the assigned poles.
+    targets, nuisance : tuple of str
+        The detected and the decoupled fault inputs.
+    poles : numpy.ndarray
+        The filter eigenvalues.
+
+    Examples
+    --------
+    >>> m = FaultModel([[-2.0]], [[1.0]], Bf=[[1.0]], Df=[[1.0]], Bw=[[1.0]], faults=["f"])
+    >>> d = afdsyn(m, sdeg=-3.0)
+    >>> round(d.gap, 6), d.order, d.factorization
+    (3.0, 1, 'quasi')
+
+    References
+    ----------
+    Varga (2017), §5.3, Procedure AFD; fdtools (``afdsyn``).
+    """
+
+    generator: ResidualGenerator
+    basis: NullspaceBasis
+    degrees: tuple[int, ...]
+    selection: np.ndarray
+    used: tuple[int, ...]
+    order: int
+    gap: float
+    beta: float
+    gamma: float
+    noise_rank: int
+    factorization: str
+    shifted: int
+    targets: tuple[str, ...]
+    nuisance: tuple[str, ...]
+    poles: np.ndarray
+
+    REPORT = ("degrees", "selection", "used", "order", "gap", "beta", "gamma", "noise_rank", "factorization",
+              "shifted", "targets", "nuisance", "poles")
+
+
+def _noise_numerators(model: FaultModel, basis: NullspaceBasis, lam: complex) -> np.ndarray:
+    """``N(λ) [0; G_w(λ)]``: the noise part of the basis numerators at ``λ`` (rank as ``R_w``)."""
+    mu = len(model.controls)
+    Nl = basis.evaluate(lam)
+    if not model.noise:
+        return np.zeros((Nl.shape[0], 0))
+    A, C = model.A, model.C
+    Bw, Dw = model.b("w"), model.d("w")
+    Gw = Dw + (C @ np.linalg.solve(lam * np.eye(model.n) - A, Bw) if model.n else 0)
+    return Nl[:, mu:] @ Gw
+
+
+def _rank(M: np.ndarray, scale: float, tol: float = 1e-7) -> int:
+    """Rank with singular values below ``tol · scale`` counted as zero (``scale``: the norms of the factors)."""
+    if not M.size:
+        return 0
+    return int(np.sum(np.linalg.svd(M, compute_uv=False) > tol * scale))
+
+
+def _candidates(k: int, q: int, degrees, selection=None):
+    """``(used, H)`` pairs in the order of the reference's ``afdbasesel``: ``q`` rows alone, then more, combined."""
+    if selection is not None:
+        H = np.atleast_2d(np.asarray(selection, dtype=float))
+        if H.shape != (q, k) or not np.all(np.isfinite(H)) or np.linalg.matrix_rank(H) < q:
+            raise ParameterError(f"selection must be a finite ({q}, {k}) matrix of full row rank (the noise-"
+                                 f"attenuating residuals from the {k} basis rows), got shape {H.shape}")
+        yield tuple(range(k)), H
+        return
+    rng = np.random.default_rng(20170)
+    for nout in range(q, k + 1):
+        combos = sorted(itertools.combinations(range(k), nout),
+                        key=lambda c: (sum(degrees[i] for i in c) if nout == q else q * max(degrees[i] for i in c)))
+        H = np.eye(q) if nout == q else np.linalg.qr(rng.standard_normal((nout, q)))[0].T
+        for used in combos:
+            yield used, H
+
+
+def _select(model, basis, targets, q, minimal, poles, sdeg, fdtol, fdfreq, fdgaintol, Nw, wscale, selection):
+    """The first candidate that detects every target and keeps ``H R_w`` of rank ``q``: (used, H, A, B, C, D)."""
+    dens_own = [denominator(nu, poles, sdeg, model.dt) for nu in basis.degrees]
+    for used, H in _candidates(len(basis.rows), q, basis.degrees, selection):
+        if _rank(H @ Nw[list(used)], wscale * np.linalg.norm(H, 2)) < q:
+            continue
+        if minimal:
+            rows = basis.combined(H, used)
+            d = max(basis.degrees[i] for i in used)
+            dens = [denominator(d, poles, sdeg, model.dt)] * q
+            S = row_structure(model, basis, targets, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol, dens=dens,
+                              rows=rows)
+            if not S.any(axis=0).all():
+                continue
+            return used, H, realize_rows(rows, dens, basis.scale)
+        S = row_structure(model, basis, targets, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol, dens=dens_own)
+        if not S[list(used)].any(axis=0).all():
+            continue
+        A, B, C, D = realize_rows([basis.rows[i] for i in used], [dens_own[i] for i in used], basis.scale)
+        return used, H, (A, B, H @ C, H @ D)
+    raise DesignError(f"no combination of {q} residual(s) from the {len(basis.rows)} basis rows (degrees "
+                      f"{list(basis.degrees)}) detects every target {list(targets)} with a noise part of full row "
+                      f"rank {q}; lower rdim or check fdigenspec")
+
+
+def _factor(ch, dt, nonstd, epsreg, poles, sdeg):
+    """The noise factor ``R_wo`` of the channel ``ch`` and its kind (the reference's ``nonstd`` handling)."""
+    try:
+        return coouter_coinner(ch.A, ch.B, ch.C, ch.D, dt)
+    except DesignError as err:
+        if nonstd == "regularize":
+            return regularized_coouter(ch.A, ch.B, ch.C, ch.D, dt, epsreg=epsreg)
+        if ch.C.shape[0] == 1 and dt is None:
+            return quasi_coouter_row(ch.A, ch.B, ch.C, ch.D, poles=poles,
+                                     sdeg=-0.05 if sdeg is None else sdeg)
+        raise DesignError(f"{err}; the quasi factorisation is implemented for one residual of a continuous model "
+                          "only: use nonstd='regularize' or rdim=1") from err
+
+
+def _gen(A, B, C, D, model, names) -> ResidualGenerator:
+    A, B, C, D = minimal_realization(A, B, C, D)
+    return ResidualGenerator(A, B, C, D, controls=model.controls, outputs=model.outputs, residuals=names,
+                             dt=model.dt)
+
+
+def _noise_free(model: FaultModel) -> FaultModel:
+    """The model with its noise inputs moved to the disturbances (for the rows that decouple the noise too)."""
+    return FaultModel(model.A, model.C, Bu=model.b("u"), Du=model.d("u"),
+                      Bd=np.hstack([model.b("d"), model.b("w")]), Dd=np.hstack([model.d("d"), model.d("w")]),
+                      Bf=model.b("f"), Df=model.d("f"), states=model.states, outputs=model.outputs,
+                      controls=model.controls, disturbances=model.disturbances + model.noise, faults=model.faults,
+                      dt=model.dt)
+
+
+def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = None, minimal: bool = True,
+           poles: Sequence[complex] | None = None, sdeg: float | None = None, gamma: float = 1.0,
+           nonstd: str = "quasi", epsreg: float = 0.1, exact: bool = False, fdtol: float = 1e-4,
+           fdgaintol: float = 0.01, fdfreq=None, selection=None, tol: float = 1e-9, names=None,
+           isolates=None) -> ApproximateDesign:
+    """Approximate fault detection filter by the nullspace method (Procedure AFD).
+
+    Parameters
+    ----------
+    model : FaultModel
+        The plant with controls ``u``, disturbances ``d``, fault inputs ``f`` and noise ``w``.
+    targets, nuisance
+        As :func:`~fdikit.design.nullspace.exact.efdsyn` (nuisance faults are decoupled exactly).
+    rdim : int, optional
+        Number of residuals (default 1 when ``minimal``, else all basis rows); the first ``min(rdim, rank R_w)``
+        attenuate the noise, the others decouple it.
+    minimal : bool, default True
+        Least order selection of the basis rows (as ``efdsyn``).
+    poles, sdeg : optional
+        The filter poles / stability degree of the basis denominators and of the zeros moved in the non-standard
+        case (default −0.05, discrete 0.95).
+    gamma : float, default 1
+        ``‖R_w‖∞`` of the result.
+    nonstd : {"quasi", "regularize"}, default "quasi"
+        Non-standard case (``R_w`` with zeros at infinity or on the boundary): the quasi factor with those zeros
+        moved to the poles (reference ``nonstd = 1``; one residual of a continuous model), or the factor of
+        ``[R_w εI]`` (reference ``nonstd = 2``).
+    epsreg : float, default 0.1
+        ``ε`` of the regularisation.
+    exact : bool, default False
+        Solve the exact problem instead (``efdsyn`` ignoring the noise); the gap is still reported.
+    selection : array_like, optional
+        ``(q_1, k)`` combination of all ``k`` basis rows for the noise-attenuating residuals (reference
+        ``HDesign``, in fdikit's basis coordinates); default the least-order search.
+    fdtol, fdgaintol, fdfreq, tol, names, isolates
+        As :func:`~fdikit.design.nullspace.exact.efdsyn`; ``fdfreq`` also sets the frequencies of ``β``.
+
+    Returns
+    -------
+    ApproximateDesign
+
+    Raises
+    ------
+    DesignError
+        No basis, a target that cannot be detected once ``u``, ``d`` and the nuisance faults are decoupled,
+        ``rdim`` too large, a zero gap, or a non-standard case outside the implemented ones (the message says
+        which).
+    ParameterError
+        Bad options.
+
+    Examples
+    --------
+    Varga (2017), Example 5.6: ``Gu = [(s+1)/(s+2); (s+2)/(s+3)]``, ``Gw = [1/(s+2); 0]``,
+    ``Gf = [(s+1)/(s+2) 0; 0 1]``; with ``sdeg = −3`` and the selection ``[0.1 1]`` of the two basis rows (here
+    ``y_i − Gu_i u`` up to scaling) the gap is the book's 3, by a first-order filter:
+
+    >>> m = FaultModel([[-2.0, 0, 0], [0, -3.0, 0], [0, 0, -2.0]], [[-1.0, 0, 1.0], [0, -1.0, 0]],
+    ...                Bu=[[1.0], [1.0], [0.0]], Du=[[1.0], [1.0]], Bf=[[1.0, 0], [0, 0], [0, 0]],
+    ...                Df=[[1.0, 0], [0, 1.0]], Bw=[[0.0], [0.0], [1.0]])
+    >>> d = afdsyn(m, sdeg=-3.0, selection=[[0.1, 1.0]])
+    >>> round(d.gap, 6), d.order, np.round(d.poles.real, 6).tolist()
+    (3.0, 1, [-3.0])
+
+    References
+    ----------
+    Varga (2017), §5.3, Procedure AFD, Remark 5.8; fdtools (``afdsyn``, ``afdredsyn``).
+    """
+    from fdikit import validate
+    from fdikit.analysis.channels import hinf_norm, minimal_channel
+    from fdikit.analysis.performance import fdhinfminus, fdif2ngap
+    from fdikit.design.labels import label_generator
+    from fdikit.residuals import stack_generators
+
+    gamma = validate.positive("gamma", gamma)
+    nonstd = validate.choice("nonstd", nonstd, ("quasi", "regularize"))
+    targets, nuisance = split_faults(model, targets, nuisance)
+    basis = left_nullspace(model, nuisance, tol=tol)
+    k = len(basis.rows)
+    if not k:
+        raise DesignError(f"no residual is free of the controls, disturbances and nuisance faults {list(nuisance)}: "
+                          f"[Gd Gn] has full row rank {len(model.outputs)}; the AFDP has no solution")
+    lam = 1j * _TEST_FREQ if model.dt is None else np.exp(1j * _TEST_FREQ * model.dt)
+    Nw = _noise_numerators(model, basis, lam)
+    wscale = max(1.0, float(np.linalg.norm(basis.evaluate(lam), 2))) * max(1.0, float(np.linalg.norm(
+        np.hstack([model.b("w").ravel(), model.d("w").ravel(), np.ones(1)]))))
+    rw = _rank(Nw, wscale)
+
+    def finish(gen, used, H, kind, shifted):
+        gen = label_generator(gen, model, names, isolates)
+        form = gen.internal_form(model)
+        g = fdif2ngap(form, list(targets), fdfreq) if model.noise else None
+        beta = float(g.beta) if g is not None else float(fdhinfminus(form, fdfreq, inputs=list(targets)).value)
+        ratio, gam = (float(g.ratio), float(g.gamma)) if g is not None else (np.inf, 0.0)
+        if not beta > 0:
+            raise DesignError(f"the filter detects no fault: β = ‖R_f‖∞− = {beta:.3g} (γ = {gam:.3g}); the gap is 0")
+        return ApproximateDesign(gen, basis, basis.degrees, H, tuple(used), gen.n, ratio, beta, gam, rw, kind,
+                                 shifted, targets, nuisance,
+                                 np.linalg.eigvals(gen.A) if gen.n else np.zeros(0, complex), model=model)
+
+    if rw == 0 or exact:
+        d = efdsyn(model, targets=targets, nuisance=nuisance, rdim=rdim, minimal=minimal, poles=poles, sdeg=sdeg,
+                   fdtol=fdtol, fdgaintol=fdgaintol, fdfreq=fdfreq, tol=tol)
+        return finish(d.generator, d.used, d.selection, "none", 0)
+    if rdim is None:
+        q1, q2 = (1, 0) if minimal else (rw, k - rw)
+    else:
+        q = validate.integer("rdim", rdim, minimum=1)
+        if q > k:
+            raise DesignError(f"rdim={q}: the nullspace basis has {k} rows, so 1 ≤ rdim ≤ {k}")
+        q1, q2 = min(q, rw), q - min(q, rw)
+    used, H, (A, B, C, D) = _select(model, basis, targets, q1, minimal, poles, sdeg, fdtol, fdfreq, fdgaintol, Nw,
+                                    wscale, selection)
+    g1 = _gen(A, B, C, D, model, tuple(f"r{i}" for i in range(q1)))
+    ch = minimal_channel(g1.internal_form(model), list(model.noise))
+    fac = _factor(ch, model.dt, nonstd, epsreg, poles, sdeg)
+    A, B, C, D = series((g1.A, g1.B, g1.C, g1.D), inverse(*fac.outer))
+    g1 = _gen(A, B, C, D, model, g1.residuals)
+    wn = hinf_norm(minimal_channel(g1.internal_form(model), list(model.noise)))[0]
+    if not (np.isfinite(wn) and wn > 0):
+        raise DesignError(f"‖R_w‖∞ = {wn} after the factorisation; the filter is unstable or the noise vanished")
+    g1 = dataclasses.replace(g1, C=(gamma / wn) * g1.C, D=(gamma / wn) * g1.D)
+    gen = g1
+    if q2:
+        beta1 = float(fdhinfminus(g1.internal_form(model), fdfreq, inputs=list(targets)).value)
+        try:
+            d2 = efdsyn(_noise_free(model), targets=targets, nuisance=nuisance, rdim=q2, minimal=minimal,
+                        poles=poles, sdeg=sdeg, fdtol=fdtol, fdgaintol=fdgaintol, fdfreq=fdfreq, tol=tol)
+        except DesignError as err:
+            raise DesignError(f"rdim={q1 + q2}: the {q2} residual(s) that decouple the noise are not available: "
+                              f"{err}") from err
+        g2 = d2.generator
+        rf = hinf_norm(minimal_channel(g2.internal_form(_noise_free(model)), list(targets)))[0]
+        g2 = dataclasses.replace(g2, C=(gamma * beta1 / rf) * g2.C, D=(gamma * beta1 / rf) * g2.D,
+                                 residuals=tuple(f"r{q1 + i}" for i in range(q2)))
+        gen = stack_generators([g1, g2])
+    return finish(gen, used, H, fac.kind, fac.shifted)
+
+
+@dataclass(frozen=True, eq=False)
+class ApproximateBankDesign(FieldReport):
+    """A bank of approximate filters, one per row of a structure matrix (``afdisyn``).
+
+    Attributes
+    ----------
+    generator : ResidualGenerator
+        The stacked bank; residual ``r<i>`` (or ``r<i>_<k>``) belongs to row ``i``.
+    filters : tuple of ApproximateDesign
+        One design per row of ``specification``.
+    specification : numpy.ndarray
+        The structure matrix asked for.
+    faults : tuple of str
+        Its columns.
+    groups : tuple of tuple of str
+        The residual names of each filter.
+    orders : tuple of int
+        The order of each filter.
+    gaps : numpy.ndarray
+        The gap of each filter (reference ``info.gap``).
+
+    Examples
+    --------
+    >>> m = FaultModel([[-1.0]], [[1.0], [1.0]], Bu=[[1.0]], Df=np.eye(2), Dw=[[0.1], [0.0]])
+    >>> afdisyn(m, np.eye(2)).groups
+    (('r0',), ('r1',))
+
+    References
+    ----------
+    Varga (2017), §5.5, Procedure AFDI; fdtools (``afdisyn``).
+    """
+
+    generator: ResidualGenerator
+    filters: tuple[ApproximateDesign, ...]
+    specification: np.ndarray
+    faults: tuple[str, ...]
+    groups: tuple[tuple[str, ...], ...]
+    orders: tuple[int, ...]
+    gaps: np.ndarray
+
+    REPORT = ("specification", "faults", "groups", "orders", "gaps")
+
+
+def afdisyn(model: FaultModel, structure, *, faults=None, rdim: int | None = None, **options) -> ApproximateBankDesign:
+    """A bank of approximate fault detection filters for the structure matrix ``structure`` (Procedure AFDI).
+
+    Parameters
+    ----------
+    model : FaultModel
+        The plant.
+    structure : array_like of bool
+        ``S``: row ``i`` asks for a filter that detects the faults of its ones, decouples those of its zeros
+        exactly and attenuates the noise.
+    faults : sequence of str, optional
+        The columns of ``S`` (default the model's fault inputs).
+    rdim : int, optional
+        Residuals per filter.
+    **options
+        ``minimal``, ``poles``, ``sdeg``, ``gamma``, ``nonstd``, ``epsreg``, ``exact``, ``fdtol``, ``fdgaintol``,
+        ``fdfreq``, ``tol``: as :func:`afdsyn`, for every row.
+
+    Returns
+    -------
+    ApproximateBankDesign
+
+    Raises
+    ------
+    DesignError
+        A row that cannot be achieved (the row and the reason).
+    ParameterError
+        A malformed ``structure`` or an unknown option.
+
+    Examples
+    --------
+    Varga (2017), Example 5.11: the plant of Example 5.6 with ``S = I``; gaps 3 and ∞.
+
+    >>> m = FaultModel([[-2.0, 0, 0], [0, -3.0, 0], [0, 0, -2.0]], [[-1.0, 0, 1.0], [0, -1.0, 0]],
+    ...                Bu=[[1.0], [1.0], [0.0]], Du=[[1.0], [1.0]], Bf=[[1.0, 0], [0, 0], [0, 0]],
+    ...                Df=[[1.0, 0], [0, 1.0]], Bw=[[0.0], [0.0], [1.0]])
+    >>> np.round(afdisyn(m, np.eye(2), sdeg=-3.0).gaps, 6).tolist()
+    [3.0, inf]
+
+    References
+    ----------
+    Varga (2017), §5.5, Procedure AFDI; fdtools (``afdisyn``).
+    """
+    from fdikit.fault_maps import check_fault_inputs
+    from fdikit.residuals import stack_generators
+
+    allowed = {"minimal", "poles", "sdeg", "gamma", "nonstd", "epsreg", "exact", "fdtol", "fdgaintol", "fdfreq", "tol"}
+    bad = sorted(set(options) - allowed)
+    if bad:
+        raise ParameterError(f"unknown option(s) {bad}; afdisyn takes {sorted(allowed)}")
+    faults = tuple(model.faults) if faults is None else tuple(check_fault_inputs(model, faults))
+    S = np.atleast_2d(np.asarray(structure))
+    if S.ndim != 2 or S.shape[1] != len(faults) or not np.isin(S, (0, 1)).all():
+        raise ParameterError(f"structure must be a 0/1 matrix with one column per fault {list(faults)}, got shape "
+                             f"{S.shape}")
+    S = S.astype(bool)
+    filters = []
+    for i, row in enumerate(S):
+        tg = tuple(f for f, s in zip(faults, row) if s)
+        nz = tuple(f for f, s in zip(faults, row) if not s) + tuple(f for f in model.faults if f not in faults)
+        if not tg:
+            raise ParameterError(f"row {i} of the structure has no fault to detect")
+        try:
+            d = afdsyn(model, targets=tg, nuisance=nz, rdim=rdim, **options)
+        except DesignError as err:
+            raise DesignError(f"row {i} of the structure ({row.astype(int).tolist()}) is not achievable: {err}"
+                              ) from err
+        q = len(d.generator.residuals)
+        names = (f"r{i}",) if q == 1 else tuple(f"r{i}_{j}" for j in range(q))
+        iso = tg[0] if len(tg) == 1 else None
+        filters.append(dataclasses.replace(d, generator=dataclasses.replace(d.generator, residuals=names,
+                                                                            isolates=(iso,) * q)))
+    gen = stack_generators([f.generator for f in filters])
+    return ApproximateBankDesign(gen, tuple(filters), S, faults, tuple(tuple(f.generator.residuals) for f in filters),
+                                 tuple(f.order for f in filters), np.array([f.gap for f in filters]), model=model)

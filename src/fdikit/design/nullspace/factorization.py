@@ -1,0 +1,409 @@
+"""Co-outer–co-inner factorisation of a stable proper system, and its quasi / regularised forms (Varga 2017, §7.9).
+
+A stable ``G(λ) = C (λI − A)⁻¹ B + D`` (``p × m``, full row rank ``p``) factors as ``G = G_o G_i`` with ``G_i``
+co-inner (``G_i G_i~ = I``, ``G_i~(s) = G_i(−s)ᵀ``, discrete ``G_i(1/z)ᵀ``) and ``G_o`` square, stable and
+minimum phase (its zeros are the stable zeros of ``G`` and the mirror images of the unstable ones).  Procedure AFD
+(Varga 2017, §5.3) uses ``G_o`` of the noise part ``R_w`` of the nullspace filter: ``Q ← G_o⁻¹ Q`` makes the noise
+channel co-inner, which maximises the fault-to-noise gap.
+
+What is covered
+---------------
+* **Standard case** (:func:`coouter_coinner`): continuous with ``D Dᵀ > 0`` and no zeros on the imaginary axis,
+  discrete with ``D Dᵀ > 0`` and no zeros on the unit circle.  Riccati method — the dual of the inner–outer
+  factorisation of ``Gᵀ`` (Zhou, Doyle and Glover 1996, Thm. 13.34 / 21.19): the stabilising solution ``X`` of the
+  filter ARE ``A X + X Aᵀ − (X Cᵀ + B Dᵀ) (D Dᵀ)⁻¹ (C X + D Bᵀ) + B Bᵀ = 0`` (SciPy's ``solve_continuous_are``, or
+  ``solve_discrete_are`` with ``R = D Dᵀ + C X Cᵀ``) gives ``G_o = (A, (B Dᵀ + X Cᵀ) R^{-1/2}, C, R^{1/2})``.
+* **Non-standard case, one row** (:func:`quasi_coouter_row`): a row ``G`` (``p = 1``), continuous, with zeros at
+  infinity (``D = 0``) or on the imaginary axis.  The quasi-co-outer factor has those zeros; the reference inverts it
+  and then stabilises ``G_o⁻¹ Q`` by a left coprime factorisation with poles at ``sdeg`` (``nonstd = 1``).  For one
+  row this is the same as inverting the *shifted* factor whose boundary and infinite zeros are moved to the
+  assigned poles, which is what is returned (``n_o(λ)`` from the spectral factor of ``G G~`` by polynomial roots:
+  meant for the small orders of a residual row).
+* **Regularised case** (:func:`regularized_coouter`): the co-outer factor of ``[G  εI]`` (Varga 2017, Remark 5.8;
+  reference ``nonstd = 2``), always standard.
+
+Not covered: the quasi factorisation of several rows with zeros on the boundary or at infinity, discrete systems
+with zeros on the unit circle, and ``D Dᵀ`` singular in discrete time (use the regularised form there).
+
+References
+----------
+Varga (2017), §5.3 (Procedure AFD), Remark 5.8, §7.9 (inner–outer factorisations); fdtools (``goifac``);
+Zhou, Doyle and Glover (1996), §13.7.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+
+from fdikit.errors import DesignError, ParameterError
+
+__all__ = ["CoOuterFactor", "coouter_coinner", "regularized_coouter", "quasi_coouter_row", "boundary_zeros",
+           "series", "inverse"]
+
+
+@dataclass(frozen=True, eq=False)
+class CoOuterFactor:
+    """A co-outer–co-inner factorisation ``G = G_o G_i`` of a stable system.
+
+    Attributes
+    ----------
+    outer : tuple of numpy.ndarray
+        ``(A, B, C, D)`` of ``G_o`` (square ``p × p``, stable; minimum phase, with ``D`` invertible in the standard
+        and the regularised cases; for :func:`quasi_coouter_row` the shifted factor).
+    inner : tuple of numpy.ndarray or None
+        ``(A, B, C, D)`` of ``G_i`` (``p × m``, ``G_i G_i~ = I``) in the standard case; None otherwise.
+    dt : float or None
+        Sample time.
+    kind : str
+        ``"standard"``, ``"quasi"`` (boundary/infinite zeros shifted) or ``"regularized"``.
+    shifted : int
+        Number of zeros on the boundary or at infinity moved to the assigned poles (``"quasi"`` only).
+
+    Examples
+    --------
+    >>> f = coouter_coinner([[-1.0]], [[1.0, 0.0]], [[1.0]], [[0.0, 1.0]])
+    >>> f.kind, np.round(f.outer[3], 6).tolist()
+    ('standard', [[1.0]])
+    """
+
+    outer: tuple[np.ndarray, ...]
+    inner: tuple[np.ndarray, ...] | None
+    dt: float | None
+    kind: str
+    shifted: int = 0
+
+
+def _abcd(A, B, C, D):
+    A, B, C, D = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (A, B, C, D))
+    n = A.shape[0] if A.size else 0
+    p, m = D.shape
+    return A.reshape(n, n), B.reshape(n, m), C.reshape(p, n), D
+
+
+def _sqrtm_sym(R: np.ndarray, inverse_: bool = False) -> np.ndarray:
+    w, V = np.linalg.eigh((R + R.T) / 2)
+    s = np.sqrt(w) if not inverse_ else 1.0 / np.sqrt(w)
+    return (V * s) @ V.T
+
+
+def series(first, second):
+    """``second · first``: the realisation of the series connection (``first``'s output feeds ``second``).
+
+    Parameters
+    ----------
+    first, second : tuple of numpy.ndarray
+        ``(A, B, C, D)`` each.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        States of ``first`` followed by those of ``second``.
+
+    Examples
+    --------
+    >>> A, B, C, D = series(([[-1.0]], [[1.0]], [[1.0]], [[0.0]]), ([], np.zeros((0, 1)), np.zeros((1, 0)), [[2.0]]))
+    >>> C.tolist()
+    [[2.0]]
+    """
+    A1, B1, C1, D1 = _abcd(*first)
+    A2, B2, C2, D2 = _abcd(*second)
+    n1, n2 = A1.shape[0], A2.shape[0]
+    A = np.block([[A1, np.zeros((n1, n2))], [B2 @ C1, A2]])
+    B = np.vstack([B1, B2 @ D1])
+    C = np.hstack([D2 @ C1, C2])
+    return A, B, C, D2 @ D1
+
+
+def inverse(A, B, C, D):
+    """The inverse ``G⁻¹`` of a square system with invertible ``D``: ``(A − B D⁻¹ C, B D⁻¹, −D⁻¹ C, D⁻¹)``.
+
+    Parameters
+    ----------
+    A, B, C, D : array_like
+        The realisation.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+
+    Raises
+    ------
+    DesignError
+        When ``D`` is singular (relative to its norm).
+
+    Examples
+    --------
+    >>> [M.tolist() for M in inverse([[-2.0]], [[1.0]], [[1.0]], [[1.0]])]
+    [[[-3.0]], [[1.0]], [[-1.0]], [[1.0]]]
+    """
+    A, B, C, D = _abcd(A, B, C, D)
+    if D.shape[0] != D.shape[1]:
+        raise DesignError(f"only a square system is inverted here, got {D.shape}")
+    s = np.linalg.svd(D, compute_uv=False)
+    if not s.size or s[-1] <= 1e-12 * max(s[0], 1.0):
+        raise DesignError(f"D is singular (singular values {np.round(s, 12).tolist()}): G has zeros at infinity")
+    Di = np.linalg.inv(D)
+    return A - B @ Di @ C, B @ Di, -Di @ C, Di
+
+
+def boundary_zeros(A, B, C, D, dt: float | None = None, *, tol: float = 1e-7) -> np.ndarray:
+    """Zeros of a full-row-rank ``G`` on the stability boundary (imaginary axis or unit circle).
+
+    The zeros of ``G`` on the boundary are those of the spectral density ``G G~`` there; they are the boundary
+    eigenvalues of the Hamiltonian (symplectic) pencil of the filter Riccati equation.  Used to tell the standard
+    case from the non-standard one; relative tolerance ``tol`` (to the norm of the Hamiltonian).
+
+    Parameters
+    ----------
+    A, B, C, D : array_like
+        A stable realisation with ``D Dᵀ > 0``.
+    dt : float or None
+        Sample time.
+    tol : float, default 1e-7
+        Relative distance to the boundary counted as on it.
+
+    Returns
+    -------
+    numpy.ndarray
+        The boundary eigenvalues found (complex).
+
+    Examples
+    --------
+    ``s / (s + 2)`` has a zero at 0:
+
+    >>> z = boundary_zeros([[-2.0]], [[1.0]], [[-2.0]], [[1.0]])
+    >>> len(z), bool(np.all(np.abs(z) < 1e-6))
+    (2, True)
+    """
+    A, B, C, D = _abcd(A, B, C, D)
+    n = A.shape[0]
+    if not n:
+        return np.zeros(0, complex)
+    R = D @ D.T
+    Ri = np.linalg.inv(R)
+    # dual (filter) Hamiltonian of A X + X Aᵀ − (X Cᵀ + S) R⁻¹ (C X + Sᵀ) + B Bᵀ = 0, S = B Dᵀ
+    S = B @ D.T
+    F = A - S @ Ri @ C
+    if dt is None:
+        H = np.block([[F.T, -C.T @ Ri @ C], [-(B @ B.T - S @ Ri @ S.T), -F]])
+        ev = np.linalg.eigvals(H)
+        scale = max(1.0, np.linalg.norm(H, 2))
+        return ev[np.abs(ev.real) <= tol * scale]
+    # discrete: eigenvalues of the symplectic pencil on the unit circle
+    Q = B @ B.T - S @ Ri @ S.T
+    G = C.T @ Ri @ C
+    L = np.block([[F.T, np.zeros((n, n))], [-Q, np.eye(n)]])
+    M = np.block([[np.eye(n), G], [np.zeros((n, n)), F]])
+    ev = sla.eigvals(L, M)
+    ev = ev[np.isfinite(ev)]
+    return ev[np.abs(np.abs(ev) - 1.0) <= tol * max(1.0, np.linalg.norm(L, 2))]
+
+
+def coouter_coinner(A, B, C, D, dt: float | None = None, *, tol: float = 1e-7) -> CoOuterFactor:
+    """Co-outer–co-inner factorisation ``G = G_o G_i`` of a stable system in the standard case (Riccati method).
+
+    Parameters
+    ----------
+    A, B, C, D : array_like
+        A stable realisation of ``G`` (``p × m``), with ``D Dᵀ > 0``.
+    dt : float or None
+        Sample time (None: continuous).
+    tol : float, default 1e-7
+        Relative tolerance of the full-rank and boundary-zero tests.
+
+    Returns
+    -------
+    CoOuterFactor
+        ``outer = (A, B_o, C, D_o)`` (square, ``D_o = (D Dᵀ [+ C X Cᵀ])^{1/2}``) and ``inner`` with
+        ``G_i G_i~ = I``.
+
+    Raises
+    ------
+    DesignError
+        The non-standard case: ``D Dᵀ`` singular (zeros at infinity) or zeros on the stability boundary (the message
+        names them); the Riccati solver failing.
+
+    Examples
+    --------
+    ``G = [1/(s+1)  1]``: ``G G~ = (ω² + 2)/(ω² + 1)``, so ``G_o = (s + √2)/(s + 1)``:
+
+    >>> f = coouter_coinner([[-1.0]], [[1.0, 0.0]], [[1.0]], [[0.0, 1.0]])
+    >>> Ao, Bo, Co, Do = f.outer
+    >>> round(float(Ao[0, 0] - Bo[0, 0] * Co[0, 0] / Do[0, 0]), 6)   # the zero of G_o
+    -1.414214
+
+    References
+    ----------
+    Varga (2017), §7.9; fdtools (``goifac``); Zhou, Doyle and Glover (1996), Thm. 13.34 (dual form).
+    """
+    A, B, C, D = _abcd(A, B, C, D)
+    n, p, m = A.shape[0], D.shape[0], D.shape[1]
+    sv = np.linalg.svd(D, compute_uv=False)
+    if p > m or not sv.size or sv[-1] <= tol * max(sv[0], 1e-300):
+        raise DesignError(f"D (singular values {np.round(sv, 9).tolist()}) does not have full row rank {p}: G has "
+                          "zeros at infinity (non-standard case); use the quasi factorisation of one row or the "
+                          "regularised factorisation")
+    R = D @ D.T
+    if n == 0:
+        Do = _sqrtm_sym(R)
+        return CoOuterFactor((A, np.zeros((0, p)), C, Do), (A, B, C, _sqrtm_sym(R, True) @ D), dt, "standard")
+    bz = boundary_zeros(A, B, C, D, dt, tol=tol)
+    if bz.size:
+        raise DesignError(f"G has zeros on the stability boundary {np.round(bz, 6).tolist()} (non-standard case); "
+                          "use the quasi factorisation of one row or the regularised factorisation")
+    S = B @ D.T
+    try:
+        if dt is None:
+            X = sla.solve_continuous_are(A.T, C.T, B @ B.T, R, s=S)
+            Rt = R
+        else:
+            X = sla.solve_discrete_are(A.T, C.T, B @ B.T, R, s=S)
+            Rt = R + C @ X @ C.T
+    except (np.linalg.LinAlgError, ValueError) as err:
+        raise DesignError(f"the filter Riccati equation of the co-outer factor has no stabilising solution: {err}"
+                          ) from err
+    Rh, Rhi = _sqrtm_sym(Rt), _sqrtm_sym(Rt, True)
+    if dt is None:
+        K = (X @ C.T + S) @ np.linalg.inv(Rt)
+    else:
+        K = (A @ X @ C.T + S) @ np.linalg.inv(Rt)
+    outer = (A, K @ Rh, C, Rh)
+    # inner = G_o⁻¹ G realised on the observer states: (A − K C, B − K D, −Rh⁻¹ C, Rh⁻¹ D)
+    inner = (A - K @ C, B - K @ D, Rhi @ C, Rhi @ D)
+    return CoOuterFactor(outer, inner, dt, "standard")
+
+
+def regularized_coouter(A, B, C, D, dt: float | None = None, *, epsreg: float = 0.1) -> CoOuterFactor:
+    """The co-outer factor of ``[G  εI]`` (Varga 2017, Remark 5.8; reference ``nonstd = 2``): always standard.
+
+    Parameters
+    ----------
+    A, B, C, D : array_like
+        A stable realisation of ``G``.
+    dt : float or None
+        Sample time.
+    epsreg : float, default 0.1
+        ``ε > 0``.
+
+    Returns
+    -------
+    CoOuterFactor
+        ``kind = "regularized"``; ``outer`` of ``[G εI]`` (its ``inner`` is dropped).
+
+    Raises
+    ------
+    ParameterError
+        ``epsreg ≤ 0``.
+
+    Examples
+    --------
+    ``[1/(s+2)  0.3]``: the zero of the factor is at ``−√(1 + 4·0.09)/0.3``:
+
+    >>> Ao, Bo, Co, Do = regularized_coouter([[-2.0]], [[1.0]], [[1.0]], [[0.0]], epsreg=0.3).outer
+    >>> round(float(Ao[0, 0] - Bo[0, 0] * Co[0, 0] / Do[0, 0]), 6)
+    -3.887301
+
+    References
+    ----------
+    Varga (2017), Remark 5.8; Glover and Varga (2011).
+    """
+    from fdikit import validate
+
+    eps = validate.positive("epsreg", epsreg)
+    A, B, C, D = _abcd(A, B, C, D)
+    p = D.shape[0]
+    f = coouter_coinner(A, np.hstack([B, np.zeros((A.shape[0], p))]), C, np.hstack([D, eps * np.eye(p)]), dt)
+    return CoOuterFactor(f.outer, None, dt, "regularized")
+
+
+def quasi_coouter_row(A, B, C, D, *, poles: Sequence[complex] | None = None, sdeg: float = -0.05,
+                      tol: float = 1e-7) -> CoOuterFactor:
+    """The shifted quasi-co-outer factor ``g_o = k n_s(s) φ(s) / d(s)`` of one stable continuous row ``g``.
+
+    ``g g~ = n_o(s) n_o(−s) / (d(s) d(−s))`` with ``n_o`` the spectral factor (roots in the closed left half
+    plane).  ``n_s`` keeps the strictly stable roots of ``n_o``; its roots on the imaginary axis and the
+    ``deg d − deg n_o`` zeros at infinity are replaced by ``φ`` (the roots ``poles`` or all at ``sdeg``), so that
+    ``g_o`` is biproper, stable and minimum phase and ``g_o⁻¹ Q`` is the reference's ``nonstd = 1`` result
+    (quasi-co-outer inverse, then left coprime stabilisation with those poles).  In the standard case
+    (no shifted zero) ``g_o`` is the co-outer factor.
+
+    Parameters
+    ----------
+    A, B, C, D : array_like
+        A stable **minimal** realisation of the row (``C`` one row).
+    poles : sequence of complex, optional
+        Roots of ``φ`` (first ``deg φ`` of them).
+    sdeg : float, default -0.05
+        Root of ``φ`` when ``poles`` is None.
+    tol : float, default 1e-7
+        Relative distance of a root to the imaginary axis counted as on it.
+
+    Returns
+    -------
+    CoOuterFactor
+        ``kind = "quasi"``, ``shifted = deg φ``.
+
+    Raises
+    ------
+    ParameterError
+        More than one row, or unstable ``poles``.
+    DesignError
+        ``g = 0``.
+
+    Examples
+    --------
+    ``1/(s+2)`` has a zero at infinity; with ``sdeg = −3`` the factor is ``(s + 3)/(s + 2)``:
+
+    >>> f = quasi_coouter_row([[-2.0]], [[1.0]], [[1.0]], [[0.0]], sdeg=-3.0)
+    >>> Ao, Bo, Co, Do = f.outer
+    >>> f.shifted, round(float(Do[0, 0]), 6), round(float(Ao[0, 0] - Bo[0, 0] * Co[0, 0] / Do[0, 0]), 6)
+    (1, 1.0, -3.0)
+
+    References
+    ----------
+    Varga (2017), §5.3 (the quasi-co-outer factor), §7.9; Glover and Varga (2011); fdtools (``afdredsyn``,
+    ``nonstd = 1``).
+    """
+    from fdikit.design.nullspace.basis import denominator
+
+    A, B, C, D = _abcd(A, B, C, D)
+    if C.shape[0] != 1:
+        raise ParameterError(f"quasi_coouter_row factors one row, got {C.shape[0]} rows")
+    n = A.shape[0]
+    d = np.poly(A) if n else np.ones(1)
+    # numerators n_i = d(s) (c (sI−A)⁻¹ b_i + d_i) = det(sI − A + b_i c) − d(s) + d_i d(s)
+    nums = [np.poly(A - B[:, [i]] @ C) - d + D[0, i] * d if n else D[0, i] * d for i in range(B.shape[1])]
+    P = np.zeros(2 * n + 1)
+    for num in nums:
+        k = len(num) - 1
+        mirror = num * (-1.0) ** (k - np.arange(k + 1))            # n(−s), highest power first
+        P[-(2 * k + 1):] += np.convolve(num, mirror)
+    scale = max(np.max(np.abs(P)), 1e-300)
+    nz = np.flatnonzero(np.abs(P) > 1e-12 * scale)
+    if not nz.size:
+        raise DesignError("the row is zero: no co-outer factor")
+    P = P[nz[0]:]
+    roots = np.roots(P) if P.size > 1 else np.zeros(0, complex)
+    mag = max(1.0, np.max(np.abs(roots), initial=0.0))
+    on_axis = np.abs(roots.real) <= tol * mag
+    stable = roots[(roots.real < 0) & ~on_axis]
+    k_gain = np.sqrt(abs(P[0]))
+    n_shift = n - stable.size
+    phi = denominator(n_shift, poles, sdeg, None)
+    num_o = k_gain * np.real(np.convolve(np.poly(stable), phi)) if stable.size else k_gain * phi
+    # realise g_o = num_o / d (biproper, same degree n) in controller canonical form
+    Do = np.array([[num_o[0] / d[0]]])
+    if n == 0:
+        return CoOuterFactor((A, np.zeros((0, 1)), np.zeros((1, 0)), Do), None, None, "quasi", 0)
+    rem = (num_o - Do[0, 0] * d)[1:]                               # strictly proper numerator, degree n−1
+    Ao = np.zeros((n, n))
+    Ao[0, :] = -d[1:]
+    Ao[1:, :-1] = np.eye(n - 1)
+    Bo = np.zeros((n, 1))
+    Bo[0, 0] = 1.0
+    Co = rem.reshape(1, n)
+    return CoOuterFactor((Ao, Bo, Co, Do), None, None, "quasi", n_shift)

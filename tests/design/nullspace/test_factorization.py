@@ -1,0 +1,106 @@
+"""Co-outer–co-inner factorisation (Riccati), quasi (one row) and regularised factors: checked on frequency grids."""
+
+import numpy as np
+import pytest
+
+from fdikit.design.nullspace.factorization import (
+    boundary_zeros,
+    coouter_coinner,
+    inverse,
+    quasi_coouter_row,
+    regularized_coouter,
+    series,
+)
+from fdikit.errors import DesignError, ParameterError
+
+
+def _resp(sys, lam):
+    A, B, C, D = (np.atleast_2d(np.asarray(M, dtype=float)) for M in sys)
+    n = A.shape[0] if A.size else 0
+    if not n:
+        return D.astype(complex)
+    return D + C.reshape(-1, n) @ np.linalg.solve(lam * np.eye(n) - A, B.reshape(n, -1))
+
+
+def _stable_random(seed, n, p, m, dt=None):
+    rng = np.random.default_rng(seed)
+    A = rng.standard_normal((n, n))
+    if dt is None:
+        A = A - (np.max(np.linalg.eigvals(A).real) + 0.5) * np.eye(n)
+    else:
+        A = 0.8 * A / np.max(np.abs(np.linalg.eigvals(A)))
+    return A, rng.standard_normal((n, m)), rng.standard_normal((p, n)), rng.standard_normal((p, m))
+
+
+@pytest.mark.parametrize("dt", [None, 0.1])
+def test_standard_factorisation_on_a_grid(dt):
+    G = _stable_random(1, 4, 2, 3, dt)
+    f = coouter_coinner(*G, dt)
+    assert f.kind == "standard"
+    Ao, Bo, Co, Do = f.outer
+    zeros_o = np.linalg.eigvals(inverse(Ao, Bo, Co, Do)[0])
+    poles_o = np.linalg.eigvals(Ao)
+    if dt is None:
+        assert zeros_o.real.max() < 0 and poles_o.real.max() < 0
+        lams = 1j * np.logspace(-2, 2, 41)
+    else:
+        assert np.abs(zeros_o).max() < 1 and np.abs(poles_o).max() < 1
+        lams = np.exp(1j * np.linspace(0, np.pi, 41))
+    scale = max(np.linalg.norm(_resp(G, lam), 2) for lam in lams)
+    for lam in lams:
+        Gl, Gol, Gil = _resp(G, lam), _resp(f.outer, lam), _resp(f.inner, lam)
+        np.testing.assert_allclose(Gol @ Gil, Gl, atol=1e-9 * scale)
+        np.testing.assert_allclose(Gil @ Gil.conj().T, np.eye(2), atol=1e-9)
+        np.testing.assert_allclose(Gol @ Gol.conj().T, Gl @ Gl.conj().T, atol=1e-9 * scale**2)
+
+
+def test_first_order_row_by_hand():
+    # G = [1/(s+1)  1]: |G|² = (ω² + 2)/(ω² + 1), Go = (s + √2)/(s + 1)
+    f = coouter_coinner([[-1.0]], [[1.0, 0.0]], [[1.0]], [[0.0, 1.0]])
+    for w in (0.0, 0.7, 3.0):
+        np.testing.assert_allclose(_resp(f.outer, 1j * w)[0, 0], (1j * w + np.sqrt(2)) / (1j * w + 1), rtol=1e-12)
+    q = quasi_coouter_row([[-1.0]], [[1.0, 0.0]], [[1.0]], [[0.0, 1.0]])     # standard: the same factor
+    assert q.shifted == 0
+    for w in (0.0, 0.7, 3.0):
+        np.testing.assert_allclose(_resp(q.outer, 1j * w), _resp(f.outer, 1j * w), rtol=1e-10)
+
+
+def test_non_standard_cases_are_refused_with_the_zeros():
+    with pytest.raises(DesignError, match="zeros at infinity"):
+        coouter_coinner([[-2.0]], [[1.0]], [[1.0]], [[0.0]])                 # 1/(s+2)
+    with pytest.raises(DesignError, match="stability boundary"):
+        coouter_coinner([[-2.0]], [[-2.0]], [[1.0]], [[1.0]])                # s/(s+2)
+    assert boundary_zeros([[-2.0]], [[-2.0]], [[1.0]], [[1.0]]).size == 2
+    assert boundary_zeros([[-2.0]], [[1.0]], [[1.0]], [[1.0]]).size == 0
+    with pytest.raises(ParameterError, match="one row"):
+        quasi_coouter_row(np.eye(1), np.ones((1, 1)), np.ones((2, 1)), np.zeros((2, 1)))
+
+
+def test_quasi_row_shifts_boundary_and_infinite_zeros():
+    # 1/(s+2): zero at ∞ → (s+3)/(s+2);  s/(s+2): zero at 0 → (s+0.3)/(s+2)
+    for (A, B, C, D), sdeg, zero in [(([[-2.0]], [[1.0]], [[1.0]], [[0.0]]), -3.0, -3.0),
+                                     (([[-2.0]], [[-2.0]], [[1.0]], [[1.0]]), -0.3, -0.3)]:
+        f = quasi_coouter_row(A, B, C, D, sdeg=sdeg)
+        assert f.kind == "quasi" and f.shifted == 1
+        z = np.linalg.eigvals(inverse(*f.outer)[0])
+        np.testing.assert_allclose(z, [zero], rtol=1e-10)
+        # |g_o(jω)| / |g(jω)| = |jω − sdeg| / |n_b(jω)| with the shifted factor only
+        np.testing.assert_allclose(np.linalg.eigvals(f.outer[0]), [-2.0], rtol=1e-12)
+
+
+def test_regularised_factor_by_hand():
+    # [1/(s+2)  0.3]: |.|² = 0.09 (ω² + 1.36/0.09)/(ω² + 4)
+    f = regularized_coouter([[-2.0]], [[1.0]], [[1.0]], [[0.0]], epsreg=0.3)
+    z = np.linalg.eigvals(inverse(*f.outer)[0])
+    np.testing.assert_allclose(z, [-np.sqrt(1.36) / 0.3], rtol=1e-10)
+    for w in (0.0, 1.0, 10.0):
+        np.testing.assert_allclose(abs(_resp(f.outer, 1j * w)[0, 0]) ** 2, 1 / (w * w + 4) + 0.09, rtol=1e-10)
+    with pytest.raises(ParameterError):
+        regularized_coouter([[-2.0]], [[1.0]], [[1.0]], [[0.0]], epsreg=0.0)
+
+
+def test_series_and_inverse_cancel():
+    G = _stable_random(5, 3, 2, 2)
+    A, B, C, D = series(G, inverse(*G))
+    for w in (0.1, 2.0):
+        np.testing.assert_allclose(_resp((A, B, C, D), 1j * w), np.eye(2), atol=1e-9)
