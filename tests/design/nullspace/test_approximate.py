@@ -1,0 +1,144 @@
+"""afdsyn / afdisyn against the numbers of FaultDetectionTools.jl test/test_afdsyn.jl, test_afdisyn.jl and
+Examples/Ex5_6c.jl, Ex5_11c.jl (Varga 2017, Examples 5.6 and 5.11), and independent checks."""
+
+import numpy as np
+import pytest
+from varga_examples import random_plant
+
+from fdikit.analysis.channels import hinf_norm, minimal_channel
+from fdikit.analysis.performance import fdif2ngap
+from fdikit.design.nullspace.approximate import afdisyn, afdsyn
+from fdikit.errors import DesignError
+from fdikit.model import FaultModel
+
+
+def example_5_6():
+    """Gu = [(s+1)/(s+2); (s+2)/(s+3)], Gw = [1/(s+2); 0], Gf = [(s+1)/(s+2) 0; 0 1]."""
+    return FaultModel([[-2.0, 0, 0], [0, -3.0, 0], [0, 0, -2.0]], [[-1.0, 0, 1.0], [0, -1.0, 0]],
+                      Bu=[[1.0], [1.0], [0.0]], Du=[[1.0], [1.0]], Bf=[[1.0, 0], [0, 0], [0, 0]],
+                      Df=[[1.0, 0], [0, 1.0]], Bw=[[0.0], [0.0], [1.0]])
+
+
+def low_pass():
+    """Rf = (s+1)/(s+2), Rw = 1/(s+2) (zero of Rw at infinity)."""
+    return FaultModel([[-2.0]], [[1.0]], Bf=[[-1.0]], Df=[[1.0]], Bw=[[1.0]], faults=["f"])
+
+
+def high_pass():
+    """Rf = (s+1)/(s+2), Rw = s/(s+2) (zero of Rw at 0)."""
+    return FaultModel([[-2.0]], [[1.0]], Bf=[[-1.0]], Df=[[1.0]], Bw=[[-2.0]], Dw=[[1.0]], faults=["f"])
+
+
+def _noise_norm(d):
+    return hinf_norm(minimal_channel(d.internal_form(), list(d.model.noise)))[0]
+
+
+def _decoupled(d, groups=("u", "d")):
+    """Largest gain of the internal form's control and disturbance channels, relative to the filter's size."""
+    form = d.internal_form()
+    names = [x for g in groups for x in form.inputs[g]] + list(getattr(d, "nuisance", ()))
+    if not names:
+        return 0.0
+    return hinf_norm(minimal_channel(form, names))[0] / max(1.0, np.abs(d.generator.D).max(),
+                                                              np.abs(d.generator.C).max())
+
+
+def test_low_pass_non_standard_gap_is_alpha():
+    # test_afdsyn.jl: afdredsyn(nonstd = 1, sdeg = −α): gap ≈ α ≈ fdif2ngap, poles(Q) ≈ [−α], ‖Rw‖∞ ≈ 1
+    d = afdsyn(low_pass(), sdeg=-3.0)
+    assert d.factorization == "quasi" and d.shifted == 1
+    assert d.gap == pytest.approx(3.0, rel=1e-8) and fdif2ngap(d.internal_form()).ratio == pytest.approx(3.0, rel=1e-8)
+    np.testing.assert_allclose(d.poles, [-3.0], rtol=1e-8)
+    assert _noise_norm(d) == pytest.approx(1.0, rel=1e-8) and d.gamma == pytest.approx(1.0, rel=1e-8)
+
+
+def test_high_pass_non_standard_gap_is_one_over_eps():
+    # test_afdsyn.jl: Rw = s/(s+2), sdeg = −ϵ: gap ≈ 1/ϵ, poles(Q) ≈ [−ϵ], ‖Rw‖∞ ≈ 1
+    d = afdsyn(high_pass(), sdeg=-0.3)
+    assert d.gap == pytest.approx(1 / 0.3, rel=1e-7)
+    np.testing.assert_allclose(d.poles, [-0.3], rtol=1e-7)
+    assert _noise_norm(d) == pytest.approx(1.0, rel=1e-8)
+
+
+def test_regularised_low_pass():
+    # test_afdsyn.jl nonstd = 2, epsreg = 0.3: poles(Q) ≈ [−gap]; by hand gap = √(1 + 4ε²)/ε
+    d = afdsyn(low_pass(), nonstd="regularize", epsreg=0.3)
+    assert d.factorization == "regularized"
+    assert d.gap == pytest.approx(np.sqrt(1.36) / 0.3, rel=1e-8)
+    np.testing.assert_allclose(d.poles, [-d.gap], rtol=1e-8)
+    assert _noise_norm(d) == pytest.approx(1.0, rel=1e-8)
+    h = afdsyn(high_pass(), nonstd="regularize", epsreg=0.3)   # by hand: gap = 1/b, b = √(0.36/1.09)
+    assert h.gap == pytest.approx(np.sqrt(1.09 / 0.36), rel=1e-7) and _noise_norm(h) == pytest.approx(1.0, rel=1e-8)
+
+
+def test_two_faults_low_pass_gap_alpha():
+    # test_afdsyn.jl: Rf = [(s+1)/(s+2) 1], Rw = 1/(s+2), sdeg = −3: gap ≈ α, ‖Rw‖∞ ≈ 1
+    m = FaultModel([[-2.0]], [[1.0]], Bf=[[-1.0, 0.0]], Df=[[1.0, 1.0]], Bw=[[1.0]])
+    d = afdsyn(m, sdeg=-3.0)
+    assert d.gap == pytest.approx(3.0, rel=1e-8) and _noise_norm(d) == pytest.approx(1.0, rel=1e-8)
+
+
+def test_example_5_6_gap_three_first_order():
+    # Ex5_6c.jl: "the choice of HDesign preserves the achieved gap of 3", gpole(Q) ≈ [−3]; our basis rows are the
+    # reference's y_i − Gu_i u up to scaling, so the same selection [0.1 1] gives it
+    m = example_5_6()
+    d = afdsyn(m, sdeg=-3.0, selection=[[0.1, 1.0]])
+    assert d.gap == pytest.approx(3.0, rel=1e-8) and d.order == 1
+    np.testing.assert_allclose(d.poles, [-3.0], rtol=1e-8)
+    assert _decoupled(d) < 1e-9
+    g = fdif2ngap(d.internal_form())
+    assert g.ratio == pytest.approx(d.gap, rel=1e-10) and g.gamma == pytest.approx(1.0, rel=1e-8)
+    # the default selection: a valid design, gap at most the supremum 3 (no filter of this basis does better)
+    e = afdsyn(m, sdeg=-3.0)
+    assert 0 < e.gap <= 3.0 * (1 + 1e-8) and _decoupled(e) < 1e-9
+
+
+def test_example_5_11_bank_gaps():
+    # Ex5_11c.jl: afdisyn(S = I, sdeg = −3): gaps ≈ [3, Inf]
+    m = example_5_6()
+    bank = afdisyn(m, np.eye(2), sdeg=-3.0)
+    assert bank.gaps[0] == pytest.approx(3.0, rel=1e-8) and np.isinf(bank.gaps[1])
+    form = bank.generator.internal_form(m)
+    g = fdif2ngap(form, np.eye(2, dtype=bool), groups=bank.groups)
+    np.testing.assert_allclose(g.ratio, bank.gaps, rtol=1e-8)
+    for f in bank.filters:
+        assert _decoupled(f) < 1e-9
+
+
+def test_rdim_beyond_noise_rank_adds_noise_free_residuals():
+    m = random_plant(11, 3, 3, 1, 0, 2)
+    m = FaultModel(m.A, m.C, Bu=m.b("u"), Du=m.d("u"), Bf=m.b("f"), Df=m.d("f"), Bw=m.b("f")[:, :1] + 0.3,
+                   Dw=np.zeros((3, 1)))
+    d = afdsyn(m, rdim=2, sdeg=-1.0)
+    assert d.noise_rank == 1 and d.generator.residuals == ("r0", "r1")
+    form = d.internal_form()
+    w0 = hinf_norm(minimal_channel(form, list(m.noise), ["r0"]))[0]
+    w1 = hinf_norm(minimal_channel(form, list(m.noise), ["r1"]))[0]
+    assert w0 == pytest.approx(1.0, rel=1e-8) and w1 < 1e-8
+    assert d.gap == pytest.approx(fdif2ngap(form).ratio, rel=1e-10) and _decoupled(d) < 1e-9
+
+
+def test_no_noise_is_the_exact_problem():
+    m = random_plant(3, 3, 3, 1, 1, 2)
+    d = afdsyn(m)
+    assert np.isinf(d.gap) and d.factorization == "none" and _decoupled(d) < 1e-9
+
+
+def test_undetectable_fault_raises_with_the_reason():
+    # f enters like the disturbance: decoupling d decouples f (the noise on y0 stays)
+    m = FaultModel([[-1.0]], [[1.0], [1.0]], Bd=[[1.0]], Bf=[[1.0]], Dw=[[1.0], [0.0]], faults=["f"])
+    with pytest.raises(DesignError, match="detects every target"):
+        afdsyn(m)
+
+
+def test_filter_runs_discretised_and_compiled():
+    from fdikit.runtime import compile_generator
+
+    d = afdsyn(example_5_6(), sdeg=-3.0, selection=[[0.1, 1.0]])
+    g = d.generator.discretize(0.01)
+    rng = np.random.default_rng(2)
+    u, y = rng.standard_normal((300, 1)), rng.standard_normal((300, 2))
+    compiled, ref = compile_generator(g), g.online()
+    for k in range(300):
+        a, b = compiled.step(u[k], y[k]), ref.step(u[k], y[k])
+        np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12 * max(1.0, np.abs(b).max()))
