@@ -68,6 +68,10 @@ class CoOuterFactor:
     >>> f = coouter_coinner([[-1.0]], [[1.0, 0.0]], [[1.0]], [[0.0, 1.0]])
     >>> f.kind, np.round(f.outer[3], 6).tolist()
     ('standard', [[1.0]])
+
+    References
+    ----------
+    Varga (2017), §7.9; fdtools (``goifac``).
     """
 
     outer: tuple[np.ndarray, ...]
@@ -108,6 +112,10 @@ def series(first, second):
     >>> A, B, C, D = series(([[-1.0]], [[1.0]], [[1.0]], [[0.0]]), ([], np.zeros((0, 1)), np.zeros((1, 0)), [[2.0]]))
     >>> C.tolist()
     [[2.0]]
+
+    References
+    ----------
+    Varga (2017), §7.3 (operations on state-space realisations).
     """
     A1, B1, C1, D1 = _abcd(*first)
     A2, B2, C2, D2 = _abcd(*second)
@@ -139,6 +147,10 @@ def inverse(A, B, C, D):
     --------
     >>> [M.tolist() for M in inverse([[-2.0]], [[1.0]], [[1.0]], [[1.0]])]
     [[[-3.0]], [[1.0]], [[-1.0]], [[1.0]]]
+
+    References
+    ----------
+    Varga (2017), §7.3 (inverse systems).
     """
     A, B, C, D = _abcd(A, B, C, D)
     if D.shape[0] != D.shape[1]:
@@ -178,6 +190,10 @@ def boundary_zeros(A, B, C, D, dt: float | None = None, *, tol: float = 1e-7) ->
     >>> z = boundary_zeros([[-2.0]], [[1.0]], [[-2.0]], [[1.0]])
     >>> len(z), bool(np.all(np.abs(z) < 1e-6))
     (2, True)
+
+    References
+    ----------
+    Varga (2017), §7.9 (the standard case of the factorisation); Zhou, Doyle and Glover (1996), §13.7.
     """
     A, B, C, D = _abcd(A, B, C, D)
     n = A.shape[0]
