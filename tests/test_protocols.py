@@ -176,6 +176,25 @@ def _efdisyn():
     return efdisyn(m, np.eye(2), sdeg=-2.0), m
 
 
+def _afdsyn_plant():
+    # Gf = (s+1)/(s+2), Gw = 1/(s+2) on one output (test_afdsyn.jl's non-standard case)
+    return FaultModel([[-2.0]], [[1.0]], Bf=[[-1.0]], Df=[[1.0]], Bw=[[1.0]], faults=["f"], noise=["w"])
+
+
+def _afdsyn():
+    from fdikit.design.nullspace import afdsyn
+
+    m = _afdsyn_plant()
+    return afdsyn(m, sdeg=-3.0), m
+
+
+def _afdisyn():
+    from fdikit.design.nullspace import afdisyn
+
+    m = _afdsyn_plant()
+    return afdisyn(m, np.eye(1), sdeg=-3.0), m
+
+
 LTI_DESIGNS = {
     "ObserverDesign(observer)": _observer, "ObserverDesign(kalman)": _kalman, "BeardJonesDesign": _beard_jones,
     "RestrictedDiagonalDesign": _restricted_diagonal, "UIODesign": _uio, "HinfDesign": _hinf,
@@ -183,6 +202,7 @@ LTI_DESIGNS = {
     "GameDesign": _game, "DiscreteGtfdfDesign": _dgtfdf, "DiscreteGtmfdfDesign": _dgtmfdf,
     "GohFilterDesign": _goh, "PolynomialParityDesign": _polynomial_parity, "ParityDesign": _state_space_parity,
     "NullspaceDesign": _efdsyn, "NullspaceBankDesign": _efdisyn,
+    "ApproximateDesign": _afdsyn, "ApproximateBankDesign": _afdisyn,
 }
 
 

@@ -40,6 +40,6 @@ __getattr__, __dir__, __all__ = lazy.attach(
             "lpv_parity_residuals", "minimal_degree", "parity_design", "parity_filter", "robust_lpv_parity",
             "scheduled_parity_filter", "theorem1",
         ],
-        "nullspace": ["efdisyn", "efdsyn", "fdichkspec", "fdigenspec"],
+        "nullspace": ["afdisyn", "afdsyn", "efdisyn", "efdsyn", "fdichkspec", "fdigenspec"],
     },
 )

@@ -5,6 +5,10 @@
 * :mod:`fdikit.design.nullspace.detectability` — weak and strong fault detectability of basis rows.
 * :mod:`fdikit.design.nullspace.exact` — ``efdsyn`` (exact fault detection, least order) and ``efdisyn`` (a bank
   for a structure matrix).
+* :mod:`fdikit.design.nullspace.factorization` — co-outer–co-inner factorisation (standard case by a Riccati
+  equation), the quasi factor of one row, the regularised factor.
+* :mod:`fdikit.design.nullspace.approximate` — ``afdsyn`` / ``afdisyn``: the fault-to-noise gap maximised under
+  ``‖R_w‖∞ = γ`` (Procedures AFD, AFDI).
 * :mod:`fdikit.design.nullspace.specs` — ``fdigenspec`` (all achievable structure matrix rows) and ``fdichkspec``
   (feasibility, orders and least orders of given rows).
 """
@@ -18,6 +22,11 @@ __getattr__, __dir__, __all__ = lazy.attach(
             "NullspaceBasis", "default_sdeg", "denominator", "left_nullspace", "minimal_realization", "realize_rows",
         ],
         "detectability": ["fault_response", "frequency_points", "row_structure"],
+        "approximate": ["ApproximateBankDesign", "ApproximateDesign", "afdisyn", "afdsyn"],
+        "factorization": [
+            "CoOuterFactor", "boundary_zeros", "coouter_coinner", "inverse", "quasi_coouter_row", "regularized_coouter",
+            "series",
+        ],
         "exact": ["NullspaceBankDesign", "NullspaceDesign", "efdisyn", "efdsyn", "split_faults"],
         "specs": ["SpecificationCheck", "fdichkspec", "fdigenspec", "joint_order"],
     },
