@@ -27,7 +27,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
             "CoOuterFactor", "boundary_zeros", "coouter_coinner", "inverse", "quasi_coouter_row", "regularized_coouter",
             "series",
         ],
-        "exact": ["NullspaceBankDesign", "NullspaceDesign", "efdisyn", "efdsyn", "split_faults"],
+        "exact": ["NullspaceBankDesign", "NullspaceDesign", "bank_rows", "efdisyn", "efdsyn", "split_faults"],
         "specs": ["SpecificationCheck", "fdichkspec", "fdigenspec", "joint_order"],
     },
 )

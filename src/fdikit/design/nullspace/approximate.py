@@ -36,7 +36,7 @@ import numpy as np
 
 from fdikit.design.nullspace.basis import NullspaceBasis, denominator, left_nullspace, minimal_realization, realize_rows
 from fdikit.design.nullspace.detectability import row_structure
-from fdikit.design.nullspace.exact import efdsyn, split_faults
+from fdikit.design.nullspace.exact import bank_rows, efdsyn, split_faults
 from fdikit.design.nullspace.factorization import (
     coouter_coinner,
     inverse,
@@ -437,35 +437,11 @@ def afdisyn(model: FaultModel, structure, *, faults=None, rdim: int | None = Non
     ----------
     Varga (2017), §5.5, Procedure AFDI; fdtools (``afdisyn``).
     """
-    from fdikit.fault_maps import check_fault_inputs
-    from fdikit.residuals import stack_generators
-
     allowed = {"minimal", "poles", "sdeg", "gamma", "nonstd", "epsreg", "exact", "fdtol", "fdgaintol", "fdfreq", "tol"}
     bad = sorted(set(options) - allowed)
     if bad:
         raise ParameterError(f"unknown option(s) {bad}; afdisyn takes {sorted(allowed)}")
-    faults = tuple(model.faults) if faults is None else tuple(check_fault_inputs(model, faults))
-    S = np.atleast_2d(np.asarray(structure))
-    if S.ndim != 2 or S.shape[1] != len(faults) or not np.isin(S, (0, 1)).all():
-        raise ParameterError(f"structure must be a 0/1 matrix with one column per fault {list(faults)}, got shape "
-                             f"{S.shape}")
-    S = S.astype(bool)
-    filters = []
-    for i, row in enumerate(S):
-        tg = tuple(f for f, s in zip(faults, row) if s)
-        nz = tuple(f for f, s in zip(faults, row) if not s) + tuple(f for f in model.faults if f not in faults)
-        if not tg:
-            raise ParameterError(f"row {i} of the structure has no fault to detect")
-        try:
-            d = afdsyn(model, targets=tg, nuisance=nz, rdim=rdim, **options)
-        except DesignError as err:
-            raise DesignError(f"row {i} of the structure ({row.astype(int).tolist()}) is not achievable: {err}"
-                              ) from err
-        q = len(d.generator.residuals)
-        names = (f"r{i}",) if q == 1 else tuple(f"r{i}_{j}" for j in range(q))
-        iso = tg[0] if len(tg) == 1 else None
-        filters.append(dataclasses.replace(d, generator=dataclasses.replace(d.generator, residuals=names,
-                                                                            isolates=(iso,) * q)))
-    gen = stack_generators([f.generator for f in filters])
-    return ApproximateBankDesign(gen, tuple(filters), S, faults, tuple(tuple(f.generator.residuals) for f in filters),
+    S, faults, filters, gen = bank_rows(model, structure, faults,
+                                        lambda tg, nz: afdsyn(model, targets=tg, nuisance=nz, rdim=rdim, **options))
+    return ApproximateBankDesign(gen, filters, S, faults, tuple(tuple(f.generator.residuals) for f in filters),
                                  tuple(f.order for f in filters), np.array([f.gap for f in filters]), model=model)

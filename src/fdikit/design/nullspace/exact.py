@@ -30,7 +30,7 @@ from fdikit.model import FaultModel
 from fdikit.protocols import FieldReport
 from fdikit.residuals import ResidualGenerator
 
-__all__ = ["NullspaceDesign", "NullspaceBankDesign", "efdsyn", "efdisyn", "split_faults"]
+__all__ = ["NullspaceDesign", "NullspaceBankDesign", "efdsyn", "efdisyn", "split_faults", "bank_rows"]
 
 
 def split_faults(model: FaultModel, targets, nuisance) -> tuple[tuple[str, ...], tuple[str, ...]]:
@@ -347,15 +347,77 @@ class NullspaceBankDesign(FieldReport):
     REPORT = ("specification", "faults", "groups", "orders")
 
 
-def _specification(model: FaultModel, structure, faults) -> tuple[np.ndarray, tuple[str, ...]]:
+def bank_rows(model: FaultModel, structure, faults, design) -> tuple[np.ndarray, tuple[str, ...], tuple, object]:
+    """One filter per row of a structure matrix, named and stacked: the loop of ``efdisyn`` and ``afdisyn``.
+
+    Parameters
+    ----------
+    model : FaultModel
+        The plant.
+    structure : array_like of bool
+        ``S``: row ``i`` detects the faults of its ones and decouples those of its zeros (and every fault of the
+        model not in ``faults``).
+    faults : sequence of str or None
+        The columns of ``S`` (default the model's fault inputs).
+    design : callable
+        ``design(targets, nuisance)`` returning a design with a ``generator`` (``efdsyn`` or ``afdsyn`` with the
+        caller's options).
+
+    Returns
+    -------
+    S : numpy.ndarray
+        The structure as booleans.
+    faults : tuple of str
+    filters : tuple
+        The designs, their residuals renamed ``r<i>`` (``r<i>_<k>`` for several) and tied to the row's fault when
+        it detects one only.
+    generator : ResidualGenerator
+        The stacked bank.
+
+    Raises
+    ------
+    ParameterError
+        A malformed ``structure`` or a row without ones.
+    DesignError
+        A row that cannot be achieved (the message gives the row).
+
+    Examples
+    --------
+    >>> m = FaultModel([[-1.0]], [[1.0], [1.0]], Bu=[[1.0]], Df=np.eye(2))
+    >>> S, faults, filters, gen = bank_rows(m, np.eye(2), None, lambda t, n: efdsyn(m, targets=t, nuisance=n))
+    >>> gen.residuals, gen.isolates
+    (('r0', 'r1'), ('f0', 'f1'))
+
+    References
+    ----------
+    Varga (2017), §5.4 (one filter per row of the structure matrix).
+    """
     from fdikit.fault_maps import check_fault_inputs
+    from fdikit.residuals import stack_generators
 
     faults = tuple(model.faults) if faults is None else tuple(check_fault_inputs(model, faults))
     S = np.atleast_2d(np.asarray(structure))
     if S.ndim != 2 or S.shape[1] != len(faults) or not np.isin(S, (0, 1)).all():
         raise ParameterError(f"structure must be a 0/1 matrix with one column per fault {list(faults)}, got shape "
                              f"{S.shape}")
-    return S.astype(bool), faults
+    S = S.astype(bool)
+    filters = []
+    for i, row in enumerate(S):
+        tg = tuple(f for f, s in zip(faults, row) if s)
+        nz = tuple(f for f, s in zip(faults, row) if not s) + tuple(f for f in model.faults if f not in faults)
+        if not tg:
+            raise ParameterError(f"row {i} of the structure has no fault to detect")
+        try:
+            d = design(tg, nz)
+        except DesignError as err:
+            raise DesignError(f"row {i} of the structure ({row.astype(int).tolist()}) is not achievable: {err}"
+                              ) from err
+        q = len(d.generator.residuals)
+        names = (f"r{i}",) if q == 1 else tuple(f"r{i}_{k}" for k in range(q))
+        iso = tg[0] if len(tg) == 1 else None
+        filters.append(dataclasses.replace(d, generator=dataclasses.replace(d.generator, residuals=names,
+                                                                            isolates=(iso,) * q)))
+    return S, faults, tuple(filters), stack_generators([f.generator for f in filters])
 
 
 def efdisyn(model: FaultModel, structure, *, faults=None, rdim: int | None = None, minimal: bool = True,
@@ -398,26 +460,9 @@ def efdisyn(model: FaultModel, structure, *, faults=None, rdim: int | None = Non
     ----------
     Varga (2017), §5.4, Procedure EFDI; fdtools (``efdisyn``).
     """
-    from fdikit.residuals import stack_generators
-
-    S, faults = _specification(model, structure, faults)
-    filters = []
-    for i, row in enumerate(S):
-        tg = tuple(f for f, s in zip(faults, row) if s)
-        nz = tuple(f for f, s in zip(faults, row) if not s) + tuple(f for f in model.faults if f not in faults)
-        if not tg:
-            raise ParameterError(f"row {i} of the structure has no fault to detect")
-        try:
-            d = efdsyn(model, targets=tg, nuisance=nz, rdim=rdim, minimal=minimal, poles=poles, sdeg=sdeg, fdtol=fdtol,
-                       fdgaintol=fdgaintol, fdfreq=fdfreq, tol=tol)
-        except DesignError as err:
-            raise DesignError(f"row {i} of the structure ({row.astype(int).tolist()}) is not achievable: {err}"
-                              ) from err
-        q = len(d.generator.residuals)
-        names = (f"r{i}",) if q == 1 else tuple(f"r{i}_{k}" for k in range(q))
-        iso = tg[0] if len(tg) == 1 else None
-        filters.append(dataclasses.replace(d, generator=dataclasses.replace(d.generator, residuals=names,
-                                                                            isolates=(iso,) * q)))
-    gen = stack_generators([f.generator for f in filters])
+    S, faults, filters, gen = bank_rows(
+        model, structure, faults,
+        lambda tg, nz: efdsyn(model, targets=tg, nuisance=nz, rdim=rdim, minimal=minimal, poles=poles, sdeg=sdeg,
+                              fdtol=fdtol, fdgaintol=fdgaintol, fdfreq=fdfreq, tol=tol))
     groups = tuple(tuple(f.generator.residuals) for f in filters)
-    return NullspaceBankDesign(gen, tuple(filters), S, faults, groups, tuple(f.order for f in filters), model=model)
+    return NullspaceBankDesign(gen, filters, S, faults, groups, tuple(f.order for f in filters), model=model)
