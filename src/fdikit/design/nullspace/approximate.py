@@ -169,12 +169,15 @@ def _select(model, basis, targets, q, minimal, poles, sdeg, fdtol, fdfreq, fdgai
             rows = basis.combined(H, used)
             d = max(basis.degrees[i] for i in used)
             dens = [denominator(d, poles, sdeg, model.dt)] * q
-            S = row_structure(model, basis, targets, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol, dens=dens,
+            # strong detectability over the default denominators, not the design's poles (the reference's sdegNS)
+            chk = [denominator(d, None, None, model.dt)] * q
+            S = row_structure(model, basis, targets, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol, dens=chk,
                               rows=rows)
             if not S.any(axis=0).all():
                 continue
             return used, H, realize_rows(rows, dens, basis.scale)
-        S = row_structure(model, basis, targets, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol, dens=dens_own)
+        chk_own = [denominator(nu, None, None, model.dt) for nu in basis.degrees]
+        S = row_structure(model, basis, targets, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol, dens=chk_own)
         if not S[list(used)].any(axis=0).all():
             continue
         A, B, C, D = realize_rows([basis.rows[i] for i in used], [dens_own[i] for i in used], basis.scale)

@@ -210,7 +210,9 @@ def efdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
     fdtol : float, default 1e-4
         Relative threshold of weak detectability (reference ``FDtol``).
     fdgaintol : float, default 0.01
-        Gain threshold of strong detectability at ``fdfreq`` (reference ``FDGainTol``).
+        Gain threshold of strong detectability at ``fdfreq`` (reference ``FDGainTol``), applied, as the reference
+        does, to the basis rows over the default denominators (all poles at −0.05, or 0.95 discrete), so that
+        feasibility does not depend on the ``poles``/``sdeg`` chosen for the filter.
     fdfreq : float or sequence of float, optional
         Frequencies (rad/s) at which each target must be strongly detected (reference ``FDfreq``).
     selection : array_like, optional
@@ -262,7 +264,9 @@ def efdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
     if not 1 <= q <= k_all:
         raise DesignError(f"rdim={rdim}: the nullspace basis has {k_all} rows, so 1 ≤ rdim ≤ {k_all}")
     dens_own = [denominator(nu, poles, sdeg, model.dt) for nu in basis.degrees]
-    S_basis = row_structure(model, basis, targets, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol, dens=dens_own)
+    # strong detectability is judged over the default denominators, not the design's poles (the reference's sdegNS)
+    chk_own = [denominator(nu, None, None, model.dt) for nu in basis.degrees]
+    S_basis = row_structure(model, basis, targets, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol, dens=chk_own)
     missing = [f for f, hit in zip(targets, S_basis.any(axis=0)) if not hit]
     if missing:
         kind = f"strongly at {np.atleast_1d(fdfreq).tolist()} rad/s" if fdfreq is not None else "weakly"
@@ -289,10 +293,10 @@ def efdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
     gen = label_generator(gen, model, names, isolates)
     faults = targets + nuisance
     if minimal:
-        S = row_structure(model, basis, faults, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol, dens=dens,
-                          rows=rows)
+        chk = [denominator(len(dens[0]) - 1, None, None, model.dt)] * q
+        S = row_structure(model, basis, faults, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol, dens=chk, rows=rows)
     else:
-        S = _combined_structure(model, basis, H, dens_own, faults, fdtol, fdfreq, fdgaintol)
+        S = _combined_structure(model, basis, H, chk_own, faults, fdtol, fdfreq, fdgaintol)
     if not S[:, : len(targets)].any(axis=0).all():
         raise DesignError(f"the selection {H.round(3).tolist()} of the basis rows {list(used)} misses a target; "
                           "give another selection=")
