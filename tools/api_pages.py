@@ -44,6 +44,7 @@ PAGES = [
     ("studies-path1996", "fdikit.studies.path1996", "Study: Douglas et al. 1996 (PATH)"),
     ("studies-hallouzi2008", "fdikit.studies.hallouzi2008", "Study: Hallouzi 2008"),
     ("studies-vanderploeg2018", "fdikit.studies.vanderploeg2018", "Study: van der Ploeg 2018"),
+    ("studies-varga2017", "fdikit.studies.varga2017", "Study: Varga 2017, Chapter 8"),
     ("studies-varrier2014", "fdikit.studies.varrier2014", "Study: Varrier et al. 2014"),
 ]
 

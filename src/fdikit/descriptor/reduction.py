@@ -164,7 +164,11 @@ def _tb01pd(A, B, C, tol):
     n, m, p = A.shape[0], B.shape[1], C.shape[0]
     if n == 0 or m == 0 or p == 0:
         return np.zeros((0, 0)), np.zeros((0, m)), np.zeros((p, 0))
-    Ar, Br, Cr, nr = tb01pd(n, m, p, A.copy(), B.copy(), C.copy(), job="M", equil="N",
+    # slycot's wrapper wants B with max(m, p) columns and C with max(m, p) rows (SLICOT's workspace layout)
+    k = max(m, p)
+    Bp, Cp = np.zeros((n, k)), np.zeros((k, n))
+    Bp[:, :m], Cp[:p] = B, C
+    Ar, Br, Cr, nr = tb01pd(n, m, p, A.copy(), Bp, Cp, job="M", equil="N",
                             tol=1e3 * n * _EPS if tol is None else tol)
     return Ar[:nr, :nr], Br[:nr, :m], Cr[:p, :nr]
 
