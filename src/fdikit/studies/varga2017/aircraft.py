@@ -396,9 +396,8 @@ def closed_loop_norms(case: AircraftCase, generator) -> np.ndarray:
     cols = {"u": slice(0, mu), "d": slice(mu, mu + md), "f": slice(mu + md, None)}
     # R̃_f on the nominal open loop: the actuator faults enter as the commands u_j do (B_f, D_f are columns of
     # B_u, D_u), and Q decouples u exactly, so Q_y G_f = −Q_u[:, j]: a stable realisation with the filter's poles
-    prim = [nom.controls.index(c) for c in _fault_commands(nom)]
-    A0, B0, C0, D0 = Q[0], -Q[1][:, [len(nom.outputs) + j for j in prim]], Q[2], -Q[3][:, [len(nom.outputs) + j
-                                                                                          for j in prim]]
+    ju = [len(nom.outputs) + nom.controls.index(c) for c in _fault_commands(nom)]   # u_j among Q's [y; u] inputs
+    A0, B0, C0, D0 = Q[0], -Q[1][:, ju], Q[2], -Q[3][:, ju]
     out = np.zeros((len(case.models), 3))
     for i, ext in enumerate(case.extended):
         cl = positive_feedback(*ext, case.K, range(mu), case.feedback_outputs)
