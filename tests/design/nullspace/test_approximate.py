@@ -3,7 +3,7 @@ Examples/Ex5_6c.jl, Ex5_11c.jl (Varga 2017, Examples 5.6 and 5.11), and independ
 
 import numpy as np
 import pytest
-from varga_examples import random_plant
+from varga_examples import high_pass, low_pass, random_plant
 
 from fdikit.analysis.channels import hinf_norm, minimal_channel
 from fdikit.analysis.performance import fdif2ngap
@@ -17,16 +17,6 @@ def example_5_6():
     return FaultModel([[-2.0, 0, 0], [0, -3.0, 0], [0, 0, -2.0]], [[-1.0, 0, 1.0], [0, -1.0, 0]],
                       Bu=[[1.0], [1.0], [0.0]], Du=[[1.0], [1.0]], Bf=[[1.0, 0], [0, 0], [0, 0]],
                       Df=[[1.0, 0], [0, 1.0]], Bw=[[0.0], [0.0], [1.0]])
-
-
-def low_pass():
-    """Rf = (s+1)/(s+2), Rw = 1/(s+2) (zero of Rw at infinity)."""
-    return FaultModel([[-2.0]], [[1.0]], Bf=[[-1.0]], Df=[[1.0]], Bw=[[1.0]], faults=["f"])
-
-
-def high_pass():
-    """Rf = (s+1)/(s+2), Rw = s/(s+2) (zero of Rw at 0)."""
-    return FaultModel([[-2.0]], [[1.0]], Bf=[[-1.0]], Df=[[1.0]], Bw=[[-2.0]], Dw=[[1.0]], faults=["f"])
 
 
 def _noise_norm(d):

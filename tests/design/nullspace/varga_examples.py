@@ -1,7 +1,7 @@
 """Plants of the reference's tests (FaultDetectionTools.jl test/test_efdsyn.jl, test_fdigenspec.jl), as FaultModels.
 
 The matrices are the printed data of those tests (Varga 2017, Examples 5.2 and 5.4; Yuan et al. 1997; Niemann
-1998; Xiong and Saif 2000, Example 1).
+1998; Xiong and Saif 2000, Example 1), and the one-output plants of test_afdsyn.jl's non-standard cases.
 """
 
 import numpy as np
@@ -95,3 +95,13 @@ def response(model: FaultModel, group: str, lam: complex) -> np.ndarray:
     if not model.n:
         return D.astype(complex)
     return D + model.C @ np.linalg.solve(lam * np.eye(model.n) - model.A, B)
+
+
+def low_pass():
+    """Rf = (s+1)/(s+2), Rw = 1/(s+2) (zero of Rw at infinity)."""
+    return FaultModel([[-2.0]], [[1.0]], Bf=[[-1.0]], Df=[[1.0]], Bw=[[1.0]], faults=["f"])
+
+
+def high_pass():
+    """Rf = (s+1)/(s+2), Rw = s/(s+2) (zero of Rw at 0)."""
+    return FaultModel([[-2.0]], [[1.0]], Bf=[[-1.0]], Df=[[1.0]], Bw=[[-2.0]], Dw=[[1.0]], faults=["f"])

@@ -75,9 +75,13 @@ def test_cs1_bank_structure_and_nominal_decoupling(cs1):
     T = closed_loop_norms(cs1, bank.generator)
     assert T.shape == (11, 3) and np.isfinite(T).all()
     # off-nominal models: the nominal bank is not robust (Table 8.2: large norms)
-    assert np.delete(T, NOMINAL, axis=0).min() > 1.0
-    # the reference asserts all three nominal norms < 1e-6; fdikit reaches it for R_d only
-    assert T[NOMINAL, 1] < 1e-6
+    off = np.delete(T, NOMINAL, axis=0)
+    assert off.min() > 1.0
+    # nominal: decoupled up to rounding.  The filter coefficients come out to about 1e-8 relative (they differ in
+    # the eighth digit between BLAS kernels) and reach 5e4, so the nominal residue is rounding-level, measured
+    # 1e-10 … 5e-10 of the smallest off-nominal norm of each column; 1e-8 bounds it.  The reference's absolute
+    # 1e-6 is the xfail below (R_d alone meets it: 3.5e-7 … 3.9e-7 measured, too close to assert)
+    assert (T[NOMINAL] < 1e-8 * off.min(axis=0)).all()
 
 
 @pytest.mark.xfail(strict=True, reason="nominal closed-loop ‖R_u‖∞ and ‖R_f − R̃_f‖∞ are ~2e-5 at DC, above the "

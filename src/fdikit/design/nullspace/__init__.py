@@ -7,6 +7,8 @@
   for a structure matrix).
 * :mod:`fdikit.design.nullspace.factorization` — co-outer–co-inner factorisation (standard case by a Riccati
   equation), the quasi factor of one row, the regularised factor.
+* :mod:`fdikit.design.nullspace.row_factors` — spectral data and Wiener–Hopf factors of one noise row (the
+  reference's ``nonstd = 3, 4, 5``).
 * :mod:`fdikit.design.nullspace.approximate` — ``afdsyn`` / ``afdisyn``: the fault-to-noise gap maximised under
   ``‖R_w‖∞ = γ`` (Procedures AFD, AFDI).
 * :mod:`fdikit.design.nullspace.specs` — ``fdigenspec`` (all achievable structure matrix rows) and ``fdichkspec``
@@ -27,6 +29,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
             "CoOuterFactor", "boundary_zeros", "coouter_coinner", "inverse", "quasi_coouter_row", "regularized_coouter",
             "series",
         ],
+        "row_factors": ["RowSpectrum", "WIENER_HOPF_JOBS", "realize_biproper", "row_spectrum", "wiener_hopf_row"],
         "exact": ["NullspaceBankDesign", "NullspaceDesign", "bank_rows", "efdisyn", "efdsyn", "split_faults"],
         "specs": ["SpecificationCheck", "fdichkspec", "fdigenspec", "joint_order"],
     },

@@ -14,10 +14,11 @@ reference ``scale2``).  Without noise (or ``R_w = 0``) the problem is exact and 
 ``afdisyn`` builds one ``afdsyn`` filter per row of a structure matrix (Procedure AFDI).
 
 Differences from the reference: the basis is the least-degree polynomial basis over stable denominators
-(:mod:`~fdikit.design.nullspace.basis`), so state coordinates and the design matrices ``H`` differ; ``smarg`` is
-not offered (only the boundary and infinite zeros of the quasi factor are moved, the reference's default
-``smarg = −√ε``); the weak fallback of the reference's ``afdsyn(sysf, SFDI)`` (non-decoupled faults as noise) is
-not attempted.
+(:mod:`~fdikit.design.nullspace.basis`), so state coordinates and the design matrices ``H`` differ, and every basis
+pole is assigned (the reference's ``smarg`` acts here only on the zeros moved in the ``"quasi"`` case); the
+non-standard cases other than ``"regularize"`` are implemented for one residual of a continuous model (several
+rows, or zeros on the unit circle, need the descriptor ``goifac``/``glcf`` reductions); the weak fallback of the
+reference's ``afdsyn(sysf, SFDI)`` (non-decoupled faults as noise) is not attempted.
 
 References
 ----------
@@ -82,9 +83,11 @@ class ApproximateDesign(FieldReport):
     noise_rank : int
         The normal rank of ``R_w`` of the basis (reference ``rw``).
     factorization : str
-        ``"standard"``, ``"quasi"``, ``"regularized"`` or ``"none"`` (exact problem).
+        ``"standard"``, ``"quasi"``, ``"regularized"``, ``"wiener-hopf"``, ``"wiener-hopf-shift"``,
+        ``"wiener-hopf-regularize"`` or ``"none"`` (exact problem).
     shifted : int
-        Number of boundary / infinite zeros of the noise factor moved to the assigned poles.
+        Number of zeros of the noise factor moved (boundary, infinite and, with ``smarg``, slow ones) or handled by
+        the Wiener–Hopf factor.
     targets, nuisance : tuple of str
         The detected and the decoupled fault inputs.
     poles : numpy.ndarray
@@ -187,18 +190,28 @@ def _select(model, basis, targets, q, minimal, poles, sdeg, fdtol, fdfreq, fdgai
                       f"rank {q}; lower rdim or check fdigenspec")
 
 
-def _factor(ch, dt, nonstd, epsreg, poles, sdeg):
-    """The noise factor ``R_wo`` of the channel ``ch`` and its kind (the reference's ``nonstd`` handling)."""
+_NONSTD = ("quasi", "regularize", "wiener-hopf", "wiener-hopf-shift", "wiener-hopf-regularize")   # reference 1 … 5
+
+
+def _factor(ch, dt, nonstd, epsreg, poles, sdeg, smarg, sdegzer):
+    """The noise factor ``F`` of the channel ``ch`` (``Q ← F⁻¹ Q``) and its kind (the reference's ``nonstd``)."""
+    from fdikit.design.nullspace.factorization import CoOuterFactor
+    from fdikit.design.nullspace.row_factors import wiener_hopf_row
+
     try:
         return coouter_coinner(ch.A, ch.B, ch.C, ch.D, dt)
     except DesignError as err:
         if nonstd == "regularize":
             return regularized_coouter(ch.A, ch.B, ch.C, ch.D, dt, epsreg=epsreg)
-        if ch.C.shape[0] == 1 and dt is None:
-            return quasi_coouter_row(ch.A, ch.B, ch.C, ch.D, poles=poles,
-                                     sdeg=-0.05 if sdeg is None else sdeg)
-        raise DesignError(f"{err}; the quasi factorisation is implemented for one residual of a continuous model "
-                          "only: use nonstd='regularize' or rdim=1") from err
+        if ch.C.shape[0] != 1 or dt is not None:
+            raise DesignError(f"{err}; nonstd={nonstd!r} is implemented for one residual of a continuous model "
+                              "only: use nonstd='regularize' or rdim=1") from err
+        if nonstd == "quasi":
+            return quasi_coouter_row(ch.A, ch.B, ch.C, ch.D, poles=poles, sdeg=-0.05 if sdeg is None else sdeg,
+                                     smarg=smarg)
+        job = {"wiener-hopf": "plain", "wiener-hopf-shift": "shift", "wiener-hopf-regularize": "regularize"}[nonstd]
+        F, moved = wiener_hopf_row(ch.A, ch.B, ch.C, ch.D, job=job, sdegzer=sdegzer, epsreg=epsreg)
+        return CoOuterFactor(F, None, None, nonstd, moved)
 
 
 def _gen(A, B, C, D, model, names) -> ResidualGenerator:
@@ -218,7 +231,8 @@ def _noise_free(model: FaultModel) -> FaultModel:
 
 def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = None, minimal: bool = True,
            poles: Sequence[complex] | None = None, sdeg: float | None = None, gamma: float = 1.0,
-           nonstd: str = "quasi", epsreg: float = 0.1, exact: bool = False, fdtol: float = 1e-4,
+           nonstd: str = "quasi", epsreg: float = 0.1, sdegzer: float = -0.05, smarg: float | None = None,
+           exact: bool = False, fdtol: float = 1e-4,
            fdgaintol: float = 0.01, fdfreq=None, selection=None, tol: float = 1e-9, names=None,
            isolates=None) -> ApproximateDesign:
     """Approximate fault detection filter by the nullspace method (Procedure AFD).
@@ -239,12 +253,20 @@ def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
         case (default −0.05, discrete 0.95).
     gamma : float, default 1
         ``‖R_w‖∞`` of the result.
-    nonstd : {"quasi", "regularize"}, default "quasi"
-        Non-standard case (``R_w`` with zeros at infinity or on the boundary): the quasi factor with those zeros
-        moved to the poles (reference ``nonstd = 1``; one residual of a continuous model), or the factor of
-        ``[R_w εI]`` (reference ``nonstd = 2``).
+    nonstd : {"quasi", "regularize", "wiener-hopf", "wiener-hopf-shift", "wiener-hopf-regularize"}, default "quasi"
+        Non-standard case (``R_w`` with zeros at infinity or on the boundary), the reference's ``nonstd = 1 … 5``:
+        the quasi factor with those zeros moved to the poles (1), the factor of ``[R_w εI]`` (2), and the
+        Wiener–Hopf factor ``X`` of ``R_wo = X R`` (3), with ``R``'s zeros shifted by ``sdegzer`` (4) or ``R``
+        regularised by ``epsreg`` (5), :mod:`~fdikit.design.nullspace.row_factors`.  All but 2 for one residual of a
+        continuous model.
     epsreg : float, default 0.1
-        ``ε`` of the regularisation.
+        ``ε`` of the regularisations (``nonstd`` "regularize", "wiener-hopf-regularize").
+    sdegzer : float, default -0.05
+        ``δ`` of the zero shift ("wiener-hopf-shift"): boundary zeros ``jω₀`` move to ``(jω₀ + δ)/(1 + jω₀δ)``
+        (``δ`` for ``ω₀ = 0``; ``jω₀ + δ`` without infinite zeros), zeros at infinity to ``1/δ``.
+    smarg : float, optional
+        Stability margin of the "quasi" case: the zeros of the noise factor with real part at least ``smarg`` are
+        moved to the poles too (default ``−√ε``: only those on the boundary and at infinity).
     exact : bool, default False
         Solve the exact problem instead (``efdsyn`` ignoring the noise); the gap is still reported.
     selection : array_like, optional
@@ -291,7 +313,7 @@ def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
     from fdikit.residuals import stack_generators
 
     gamma = validate.positive("gamma", gamma)
-    nonstd = validate.choice("nonstd", nonstd, ("quasi", "regularize"))
+    nonstd = validate.choice("nonstd", nonstd, _NONSTD)
     targets, nuisance = split_faults(model, targets, nuisance)
     basis = left_nullspace(model, nuisance, tol=tol)
     k = len(basis.rows)
@@ -331,7 +353,7 @@ def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
                                     wscale, selection)
     g1 = _gen(A, B, C, D, model, tuple(f"r{i}" for i in range(q1)))
     ch = minimal_channel(g1.internal_form(model), list(model.noise))
-    fac = _factor(ch, model.dt, nonstd, epsreg, poles, sdeg)
+    fac = _factor(ch, model.dt, nonstd, epsreg, poles, sdeg, smarg, sdegzer)
     A, B, C, D = series((g1.A, g1.B, g1.C, g1.D), inverse(*fac.outer))
     g1 = _gen(A, B, C, D, model, g1.residuals)
     wn = hinf_norm(minimal_channel(g1.internal_form(model), list(model.noise)))[0]
@@ -413,8 +435,8 @@ def afdisyn(model: FaultModel, structure, *, faults=None, rdim: int | None = Non
     rdim : int, optional
         Residuals per filter.
     **options
-        ``minimal``, ``poles``, ``sdeg``, ``gamma``, ``nonstd``, ``epsreg``, ``exact``, ``fdtol``, ``fdgaintol``,
-        ``fdfreq``, ``tol``: as :func:`afdsyn`, for every row.
+        ``minimal``, ``poles``, ``sdeg``, ``gamma``, ``nonstd``, ``epsreg``, ``sdegzer``, ``smarg``, ``exact``,
+        ``fdtol``, ``fdgaintol``, ``fdfreq``, ``tol``: as :func:`afdsyn`, for every row.
 
     Returns
     -------
@@ -441,7 +463,8 @@ def afdisyn(model: FaultModel, structure, *, faults=None, rdim: int | None = Non
     ----------
     Varga (2017), §5.5, Procedure AFDI; fdtools (``afdisyn``).
     """
-    allowed = {"minimal", "poles", "sdeg", "gamma", "nonstd", "epsreg", "exact", "fdtol", "fdgaintol", "fdfreq", "tol"}
+    allowed = {"minimal", "poles", "sdeg", "gamma", "nonstd", "epsreg", "sdegzer", "smarg", "exact", "fdtol",
+               "fdgaintol", "fdfreq", "tol"}
     bad = sorted(set(options) - allowed)
     if bad:
         raise ParameterError(f"unknown option(s) {bad}; afdisyn takes {sorted(allowed)}")

@@ -18,7 +18,8 @@ What is covered
   and then stabilises ``G_o⁻¹ Q`` by a left coprime factorisation with poles at ``sdeg`` (``nonstd = 1``).  For one
   row this is the same as inverting the *shifted* factor whose boundary and infinite zeros are moved to the
   assigned poles, which is what is returned (``n_o(λ)`` from the spectral factor of ``G G~`` by polynomial roots:
-  meant for the small orders of a residual row).
+  meant for the small orders of a residual row); ``smarg`` moves the slow stable zeros as well.  The Wiener–Hopf
+  factors of one row (reference ``nonstd = 3, 4, 5``) are in :mod:`~fdikit.design.nullspace.row_factors`.
 * **Regularised case** (:func:`regularized_coouter`): the co-outer factor of ``[G  εI]`` (Varga 2017, Remark 5.8;
   reference ``nonstd = 2``), always standard.
 
@@ -337,7 +338,7 @@ def regularized_coouter(A, B, C, D, dt: float | None = None, *, epsreg: float = 
 
 
 def quasi_coouter_row(A, B, C, D, *, poles: Sequence[complex] | None = None, sdeg: float = -0.05,
-                      tol: float = 1e-7) -> CoOuterFactor:
+                      smarg: float | None = None, tol: float = 1e-7) -> CoOuterFactor:
     """The shifted quasi-co-outer factor ``g_o = k n_s(s) φ(s) / d(s)`` of one stable continuous row ``g``.
 
     ``g g~ = n_o(s) n_o(−s) / (d(s) d(−s))`` with ``n_o`` the spectral factor (roots in the closed left half
@@ -355,6 +356,9 @@ def quasi_coouter_row(A, B, C, D, *, poles: Sequence[complex] | None = None, sde
         Roots of ``φ`` (first ``deg φ`` of them).
     sdeg : float, default -0.05
         Root of ``φ`` when ``poles`` is None.
+    smarg : float, optional
+        Stability margin: the zeros with real part at least ``smarg`` are moved too (reference ``smarg`` of the
+        ``glcf`` stabilisation; default ``−√ε``, only the boundary and infinite zeros).
     tol : float, default 1e-7
         Relative distance of a root to the imaginary axis counted as on it.
 
@@ -385,41 +389,15 @@ def quasi_coouter_row(A, B, C, D, *, poles: Sequence[complex] | None = None, sde
     ``nonstd = 1``).
     """
     from fdikit.design.nullspace.basis import denominator
+    from fdikit.design.nullspace.row_factors import realize_biproper, row_spectrum
 
     A, B, C, D = _abcd(A, B, C, D)
     if C.shape[0] != 1:
         raise ParameterError(f"quasi_coouter_row factors one row, got {C.shape[0]} rows")
-    n = A.shape[0]
-    d = np.poly(A) if n else np.ones(1)
-    # numerators n_i = d(s) (c (sI−A)⁻¹ b_i + d_i) = det(sI − A + b_i c) − d(s) + d_i d(s)
-    nums = [np.poly(A - B[:, [i]] @ C) - d + D[0, i] * d if n else D[0, i] * d for i in range(B.shape[1])]
-    P = np.zeros(2 * n + 1)
-    for num in nums:
-        k = len(num) - 1
-        mirror = num * (-1.0) ** (k - np.arange(k + 1))            # n(−s), highest power first
-        P[-(2 * k + 1):] += np.convolve(num, mirror)
-    scale = max(np.max(np.abs(P)), 1e-300)
-    nz = np.flatnonzero(np.abs(P) > 1e-12 * scale)
-    if not nz.size:
-        raise DesignError("the row is zero: no co-outer factor")
-    P = P[nz[0]:]
-    roots = np.roots(P) if P.size > 1 else np.zeros(0, complex)
-    mag = max(1.0, np.max(np.abs(roots), initial=0.0))
-    on_axis = np.abs(roots.real) <= tol * mag
-    stable = roots[(roots.real < 0) & ~on_axis]
-    k_gain = np.sqrt(abs(P[0]))
-    n_shift = n - stable.size
+    spec = row_spectrum(A, B, C, D, tol=tol)
+    margin = -np.sqrt(np.finfo(float).eps) if smarg is None else float(smarg)
+    stable = spec.stable[spec.stable.real < margin]
+    n_shift = A.shape[0] - stable.size
     phi = denominator(n_shift, poles, sdeg, None)
-    num_o = k_gain * np.real(np.convolve(np.poly(stable), phi)) if stable.size else k_gain * phi
-    # realise g_o = num_o / d (biproper, same degree n) in controller canonical form
-    Do = np.array([[num_o[0] / d[0]]])
-    if n == 0:
-        return CoOuterFactor((A, np.zeros((0, 1)), np.zeros((1, 0)), Do), None, None, "quasi", 0)
-    rem = (num_o - Do[0, 0] * d)[1:]                               # strictly proper numerator, degree n−1
-    Ao = np.zeros((n, n))
-    Ao[0, :] = -d[1:]
-    Ao[1:, :-1] = np.eye(n - 1)
-    Bo = np.zeros((n, 1))
-    Bo[0, 0] = 1.0
-    Co = rem.reshape(1, n)
-    return CoOuterFactor((Ao, Bo, Co, Do), None, None, "quasi", n_shift)
+    num_o = spec.gain * np.real(np.convolve(np.poly(stable), phi)) if stable.size else spec.gain * phi
+    return CoOuterFactor(realize_biproper(num_o, spec.den), None, None, "quasi", n_shift)

@@ -1,0 +1,150 @@
+"""The non-standard cases of afdsyn: Wiener–Hopf factors (reference nonstd = 3, 4, 5) and smarg, against the
+numbers of FaultDetectionTools.jl test/test_afdsyn.jl ("tests for non-standard cases") and hand computations.
+
+The reference's pole checks read ``gpole(Q.sys)`` of a column of the joint minimal realisation ``[R_f R_w Q]``, so
+they list the model's pole −2 as well; fdikit's filters are minimal, so the filter poles are checked alone and the
+reference's list against the poles of the minimal ``[R_f R_w]``.
+"""
+
+import numpy as np
+import pytest
+from varga_examples import high_pass, low_pass
+
+from fdikit.analysis.channels import hinf_norm, minimal_channel
+from fdikit.analysis.performance import fdif2ngap
+from fdikit.design.nullspace.approximate import afdsyn
+from fdikit.design.nullspace.row_factors import realize_biproper, row_spectrum, wiener_hopf_row
+from fdikit.errors import DesignError, ParameterError
+from fdikit.model import FaultModel
+
+W = np.logspace(-4, 4, 40001)          # grid of the hand-computed sup norms (peaks here are at 0 or ∞)
+
+
+def _sup(num, den):
+    """sup over the grid (and the limits 0, ∞) of |num(jω)/den(jω)|, by hand from the polynomials."""
+    s = 1j * np.concatenate([[0.0], W])
+    v = np.abs(np.polyval(num, s) / np.polyval(den, s))
+    lim = abs(num[0] / den[0]) if len(num) == len(den) else 0.0
+    return max(v.max(), lim)
+
+
+def _hand_gap(q_num, q_den, rw_num, rw_den):
+    """Gap of Q = q_num/q_den on Rf = (s+1)/(s+2) and Rw = rw_num/rw_den (β = ‖R_f‖∞, one fault)."""
+    rf = _sup(np.polymul(q_num, [1, 1]), np.polymul(q_den, [1, 2]))
+    return rf / _sup(np.polymul(q_num, rw_num), np.polymul(q_den, rw_den))
+
+
+def _check(d, filter_poles, form_poles):
+    """The reference's checks: gap = fdif2ngap, ‖Rw‖∞ = 1; and the poles."""
+    form = d.internal_form()
+    assert d.gap == pytest.approx(float(fdif2ngap(form).ratio), rel=1e-8)
+    assert hinf_norm(minimal_channel(form, list(d.model.noise)))[0] == pytest.approx(1.0, rel=1e-8)
+    np.testing.assert_allclose(np.sort(d.poles.real), np.sort(filter_poles), rtol=1e-7, atol=1e-9)
+    ch = minimal_channel(form, list(d.model.faults) + list(d.model.noise))
+    np.testing.assert_allclose(np.sort(np.linalg.eigvals(ch.A).real), np.sort(form_poles), rtol=1e-7, atol=1e-9)
+
+
+def test_low_pass_wiener_hopf():
+    # nonstd = 3: gpole(Q) ≈ gpole(sysf) = [−2]; by hand Q is constant, Rw = c/(s+2): gap = 2
+    d = afdsyn(low_pass(), nonstd="wiener-hopf")
+    assert d.factorization == "wiener-hopf" and d.shifted == 1 and d.order == 0
+    _check(d, [], [-2.0])
+    assert d.gap == pytest.approx(2.0, rel=1e-8)
+
+
+def test_low_pass_wiener_hopf_shift():
+    # nonstd = 4, sdegzer = −0.1: sort(gpole(Q)) ≈ [−2; 1/sdegzer]; by hand Q ∝ (0.2s + 3)/(0.1s + 1)
+    d = afdsyn(low_pass(), nonstd="wiener-hopf-shift", sdegzer=-0.1)
+    _check(d, [-10.0], [-2.0, -10.0])
+    assert d.gap == pytest.approx(_hand_gap([0.2, 3], [0.1, 1], [1], [1, 2]), rel=1e-6)
+
+
+def test_low_pass_wiener_hopf_regularize():
+    # nonstd = 5, epsreg = 0.3: gpole(Q) ≈ [−gap]; by hand the pole is −√(4 + 1/ε²)
+    d = afdsyn(low_pass(), nonstd="wiener-hopf-regularize", epsreg=0.3)
+    a = np.sqrt(4 + 1 / 0.09)
+    _check(d, [-a], [-a])
+    assert d.gap == pytest.approx(a, rel=1e-8)
+
+
+def test_high_pass_wiener_hopf():
+    # nonstd = 3: gpole(Q) ≈ [−2]; by hand Q is constant, Rw = s/(s+2): gap = ‖(s+1)/(s+2)‖∞ = 1
+    d = afdsyn(high_pass(), nonstd="wiener-hopf")
+    _check(d, [], [-2.0])
+    assert d.gap == pytest.approx(1.0, rel=1e-8)
+
+
+def test_high_pass_wiener_hopf_shift():
+    # nonstd = 4, sdegzer = −0.1: sort(gpole(Q)) ≈ [−2; sdegzer]; by hand Q ∝ (s + 2.1)/(s + 0.1)
+    d = afdsyn(high_pass(), nonstd="wiener-hopf-shift", sdegzer=-0.1)
+    _check(d, [-0.1], [-2.0, -0.1])
+    assert d.gap == pytest.approx(_hand_gap([1, 2.1], [1, 0.1], [1, 0], [1, 2]), rel=1e-6)
+
+
+def test_high_pass_wiener_hopf_regularize():
+    # nonstd = 5, epsreg = 0.3: gap ≈ fdif2ngap, ‖Rw‖∞ ≈ 1; by hand Q ∝ (s+2)/(s+b), b = 2ε/√(1+ε²), gap 1/b
+    d = afdsyn(high_pass(), nonstd="wiener-hopf-regularize", epsreg=0.3)
+    b = 0.6 / np.sqrt(1.09)
+    _check(d, [-b], [-b])
+    assert d.gap == pytest.approx(1 / b, rel=1e-7)
+
+
+def slow_zero():
+    """Rf = 1, Rw = (s+1)/((s+2)(s+3)): a zero at infinity and a slow stable zero at −1."""
+    return FaultModel(np.diag([-2.0, -3.0]), [[1.0, 1.0]], Bf=[[0.0], [0.0]], Df=[[1.0]], Bw=[[-1.0], [2.0]],
+                      faults=["f"])
+
+
+def test_smarg_moves_the_slow_zero_too():
+    # default smarg = −√ε: the zero at −1 stays a filter pole, the infinite one goes to sdeg;
+    # smarg = −2 (reference glcf(…; smarg)): both go to sdeg
+    d = afdsyn(slow_zero(), sdeg=-4.0)
+    assert d.shifted == 1
+    np.testing.assert_allclose(np.sort(d.poles.real), [-4.0, -1.0], rtol=1e-7)
+    e = afdsyn(slow_zero(), sdeg=-4.0, smarg=-2.0)
+    assert e.shifted == 2
+    np.testing.assert_allclose(e.poles.real, [-4.0, -4.0], rtol=1e-6)
+    assert e.gap == pytest.approx(float(fdif2ngap(e.internal_form()).ratio), rel=1e-8)
+
+
+def test_wiener_hopf_factor_by_hand():
+    # Rw = (s+1)/((s+2)(s+3)): n_s = s+1, one zero at infinity, r = s+2 (the slower pole of d):
+    # X = k (s+1)/(s+3); with δ = −0.5, R = 1/(s+2) → R(1/(1 + 0.5 s)) = (1 + 0.5s)/(3 + s)
+    (A, B, C, D), moved = wiener_hopf_row(np.diag([-2.0, -3.0]), [[-1.0], [2.0]], [[1.0, 1.0]], [[0.0]])
+    assert moved == 1
+    np.testing.assert_allclose(np.linalg.eigvals(A - B @ C / D[0, 0]).real, [-1.0], rtol=1e-9)
+    (A, B, C, D), _ = wiener_hopf_row(np.diag([-2.0, -3.0]), [[-1.0], [2.0]], [[1.0, 1.0]], [[0.0]], job="shift",
+                                      sdegzer=-0.5)
+    np.testing.assert_allclose(np.sort(np.linalg.eigvals(A - B @ C / D[0, 0]).real), [-2.0, -1.0], rtol=1e-9)
+    np.testing.assert_allclose(np.sort(np.linalg.eigvals(A).real), [-3.0, -3.0], rtol=1e-6)
+    # the standard case: F is the co-outer factor (|F(jω)| = |g(jω)|)
+    (A, B, C, D), moved = wiener_hopf_row([[-1.0]], [[1.0, 0.0]], [[1.0]], [[0.0, 1.0]])
+    assert moved == 0
+    for w in (0.0, 0.7, 3.0):
+        f = (C @ np.linalg.solve(1j * w * np.eye(1) - A, B) + D)[0, 0]
+        assert abs(f) == pytest.approx(np.sqrt(1 / (w * w + 1) + 1), rel=1e-12)
+
+
+def test_row_factor_helpers_and_bad_input():
+    spec = row_spectrum([[-2.0]], [[1.0]], [[1.0]], [[0.0]])
+    assert spec.infinite == 1 and spec.gain == pytest.approx(1.0)
+    A, B, C, D = realize_biproper([2.0, 1.0], [1.0, 3.0])
+    assert (C @ np.linalg.solve(-A, B) + D)[0, 0] == pytest.approx(1 / 3)
+    with pytest.raises(ParameterError, match="improper"):
+        realize_biproper([1.0, 0.0, 0.0], [1.0, 1.0])
+    with pytest.raises(ParameterError, match="2 rows"):
+        row_spectrum(np.eye(1), np.ones((1, 1)), np.ones((2, 1)), np.zeros((2, 1)))
+    with pytest.raises(ParameterError, match="sdegzer"):
+        afdsyn(low_pass(), nonstd="wiener-hopf-shift", sdegzer=0.1)
+    with pytest.raises(ParameterError, match="nonstd"):
+        afdsyn(low_pass(), nonstd="wiener")
+    with pytest.raises(DesignError, match="zero"):
+        row_spectrum([[-1.0]], [[0.0]], [[1.0]], [[0.0]])
+
+
+def test_discrete_non_standard_case_is_refused_clearly():
+    # zeros on the unit circle of a discrete noise row: only "regularize" is implemented
+    m = FaultModel([[0.5]], [[1.0]], Bf=[[0.0]], Df=[[1.0]], Bw=[[-0.5]], Dw=[[1.0]], faults=["f"], dt=0.1)
+    with pytest.raises(DesignError, match="continuous model only"):
+        afdsyn(m, nonstd="wiener-hopf")
+    assert afdsyn(m, nonstd="regularize").factorization == "regularized"
