@@ -125,6 +125,20 @@ def test_wiener_hopf_factor_by_hand():
         assert abs(f) == pytest.approx(np.sqrt(1 / (w * w + 1) + 1), rel=1e-12)
 
 
+def test_wiener_hopf_factor_with_complex_poles():
+    # Rw = (s+1)/(s² + 2s + 5): one zero at infinity but only a conjugate pair of poles, so r = s + 1 (the pair's
+    # real part) is not a pole of Rw: X = g_o (s + 1), and |X(jω)| = |g(jω)| |jω + 1| (|g_o| = |g| on the axis)
+    A, B, C, D = realize_biproper([1.0, 1.0], [1.0, 2.0, 5.0])
+    (Af, Bf, Cf, Df), moved = wiener_hopf_row(A, B, C, D)
+    assert moved == 1 and Af.shape == (2, 2)
+    assert np.linalg.eigvals(Af).real.max() < 0 and np.linalg.eigvals(Af - Bf @ Cf / Df[0, 0]).real.max() < 0
+    for w in (0.0, 0.5, 2.0, 10.0):
+        s = 1j * w
+        g = (s + 1) / (s * s + 2 * s + 5)
+        f = (Cf @ np.linalg.solve(s * np.eye(2) - Af, Bf) + Df)[0, 0]
+        assert abs(f) == pytest.approx(abs(g) * abs(s + 1), rel=1e-10)
+
+
 def test_row_factor_helpers_and_bad_input():
     spec = row_spectrum([[-2.0]], [[1.0]], [[1.0]], [[0.0]])
     assert spec.infinite == 1 and spec.gain == pytest.approx(1.0)

@@ -11,14 +11,18 @@ regularised factor); scale to ``‖R_w‖∞ = γ``.  When ``rdim`` exceeds ``ra
 from the rows that decouple the noise too (an exact design, scaled so that its fault gain is the first part's gap;
 reference ``scale2``).  Without noise (or ``R_w = 0``) the problem is exact and :func:`~.exact.efdsyn` solves it.
 
-``afdisyn`` builds one ``afdsyn`` filter per row of a structure matrix (Procedure AFDI).
+``afdisyn`` builds one ``afdsyn`` filter per row of a structure matrix (Procedure AFDI); a row whose strong design
+fails is designed again with its zeros as noise (the reference's weak AFDIP of ``afdsyn(sysf, SFDI)``).
+
+Plant modes that only the faults or the noise excite are moved out of the internal form by a left coprime factor
+(:mod:`~fdikit.design.nullspace.stabilization`) before the noise is factored.
 
 Differences from the reference: the basis is the least-degree polynomial basis over stable denominators
 (:mod:`~fdikit.design.nullspace.basis`), so state coordinates and the design matrices ``H`` differ, and every basis
-pole is assigned (the reference's ``smarg`` acts here only on the zeros moved in the ``"quasi"`` case); the
-non-standard cases other than ``"regularize"`` are implemented for one residual of a continuous model (several
-rows, or zeros on the unit circle, need the descriptor ``goifac``/``glcf`` reductions); the weak fallback of the
-reference's ``afdsyn(sysf, SFDI)`` (non-decoupled faults as noise) is not attempted.
+pole is assigned (the reference's ``smarg`` acts here on the stabilisation of the internal form and on the zeros
+moved in the ``"quasi"`` case); the non-standard cases other than ``"regularize"`` are implemented for one residual
+of a continuous model (several rows, or zeros on the unit circle, need the descriptor ``goifac``/``glcf``
+reductions).
 
 References
 ----------
@@ -30,6 +34,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -45,7 +50,7 @@ from fdikit.design.nullspace.factorization import (
     regularized_coouter,
     series,
 )
-from fdikit.errors import DesignError, ParameterError
+from fdikit.errors import DesignError, FdiWarning, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import FieldReport
 from fdikit.residuals import ResidualGenerator
@@ -229,6 +234,18 @@ def _noise_free(model: FaultModel) -> FaultModel:
                       dt=model.dt)
 
 
+def _nuisance_as_noise(model: FaultModel, nuisance) -> FaultModel:
+    """The model with the fault inputs ``nuisance`` moved to the noise (the weak design of a structure row)."""
+    keep = [i for i, f in enumerate(model.faults) if f not in nuisance]
+    move = [model.faults.index(f) for f in nuisance]
+    return FaultModel(model.A, model.C, Bu=model.b("u"), Du=model.d("u"), Bd=model.b("d"), Dd=model.d("d"),
+                      Bf=model.b("f")[:, keep], Df=model.d("f")[:, keep],
+                      Bw=np.hstack([model.b("w"), model.b("f")[:, move]]),
+                      Dw=np.hstack([model.d("w"), model.d("f")[:, move]]), states=model.states,
+                      outputs=model.outputs, controls=model.controls, disturbances=model.disturbances,
+                      faults=[model.faults[i] for i in keep], noise=list(model.noise) + list(nuisance), dt=model.dt)
+
+
 def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = None, minimal: bool = True,
            poles: Sequence[complex] | None = None, sdeg: float | None = None, gamma: float = 1.0,
            nonstd: str = "quasi", epsreg: float = 0.1, sdegzer: float = -0.05, smarg: float | None = None,
@@ -265,8 +282,9 @@ def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
         ``δ`` of the zero shift ("wiener-hopf-shift"): boundary zeros ``jω₀`` move to ``(jω₀ + δ)/(1 + jω₀δ)``
         (``δ`` for ``ω₀ = 0``; ``jω₀ + δ`` without infinite zeros), zeros at infinity to ``1/δ``.
     smarg : float, optional
-        Stability margin of the "quasi" case: the zeros of the noise factor with real part at least ``smarg`` are
-        moved to the poles too (default ``−√ε``: only those on the boundary and at infinity).
+        Stability margin (default ``−√ε``, discrete ``1 − √ε``): the internal form's poles beyond it are moved to
+        ``poles``/``sdeg`` by a left coprime factor, and in the "quasi" case the zeros of the noise factor with real
+        part at least ``smarg`` are moved too (by default only those on the boundary and at infinity).
     exact : bool, default False
         Solve the exact problem instead (``efdsyn`` ignoring the noise); the gap is still reported.
     selection : array_like, optional
@@ -310,6 +328,7 @@ def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
     from fdikit.analysis.channels import hinf_norm, minimal_channel
     from fdikit.analysis.performance import fdhinfminus, fdif2ngap
     from fdikit.design.labels import label_generator
+    from fdikit.design.nullspace.stabilization import stabilize_rows
     from fdikit.residuals import stack_generators
 
     gamma = validate.positive("gamma", gamma)
@@ -351,7 +370,8 @@ def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
         q1, q2 = min(q, rw), q - min(q, rw)
     used, H, (A, B, C, D) = _select(model, basis, targets, q1, minimal, poles, sdeg, fdtol, fdfreq, fdgaintol, Nw,
                                     wscale, selection)
-    g1 = _gen(A, B, C, D, model, tuple(f"r{i}" for i in range(q1)))
+    g1, _ = stabilize_rows(_gen(A, B, C, D, model, tuple(f"r{i}" for i in range(q1))), model, nuisance=nuisance,
+                           poles=poles, sdeg=sdeg, smarg=smarg)
     ch = minimal_channel(g1.internal_form(model), list(model.noise))
     fac = _factor(ch, model.dt, nonstd, epsreg, poles, sdeg, smarg, sdegzer)
     A, B, C, D = series((g1.A, g1.B, g1.C, g1.D), inverse(*fac.outer))
@@ -397,6 +417,9 @@ class ApproximateBankDesign(FieldReport):
         The order of each filter.
     gaps : numpy.ndarray
         The gap of each filter (reference ``info.gap``).
+    weak : tuple of bool
+        Rows whose strong design failed and whose filter treats the row's zeros as noise (the reference's weak
+        AFDIP).
 
     Examples
     --------
@@ -416,11 +439,13 @@ class ApproximateBankDesign(FieldReport):
     groups: tuple[tuple[str, ...], ...]
     orders: tuple[int, ...]
     gaps: np.ndarray
+    weak: tuple[bool, ...]
 
-    REPORT = ("specification", "faults", "groups", "orders", "gaps")
+    REPORT = ("specification", "faults", "groups", "orders", "gaps", "weak")
 
 
-def afdisyn(model: FaultModel, structure, *, faults=None, rdim: int | None = None, **options) -> ApproximateBankDesign:
+def afdisyn(model: FaultModel, structure, *, faults=None, rdim: int | None = None, weak_fallback: bool = True,
+            **options) -> ApproximateBankDesign:
     """A bank of approximate fault detection filters for the structure matrix ``structure`` (Procedure AFDI).
 
     Parameters
@@ -434,6 +459,10 @@ def afdisyn(model: FaultModel, structure, *, faults=None, rdim: int | None = Non
         The columns of ``S`` (default the model's fault inputs).
     rdim : int, optional
         Residuals per filter.
+    weak_fallback : bool, default True
+        When a row's strong design fails (its zeros cannot be decoupled, or a target is then not detected),
+        design it again with the row's zeros as noise, with a :class:`~fdikit.errors.FdiWarning` (as the reference
+        does; its ``R_f`` columns of those faults are then attenuated, not zero).  False: raise instead.
     **options
         ``minimal``, ``poles``, ``sdeg``, ``gamma``, ``nonstd``, ``epsreg``, ``sdegzer``, ``smarg``, ``exact``,
         ``fdtol``, ``fdgaintol``, ``fdfreq``, ``tol``: as :func:`afdsyn`, for every row.
@@ -445,7 +474,7 @@ def afdisyn(model: FaultModel, structure, *, faults=None, rdim: int | None = Non
     Raises
     ------
     DesignError
-        A row that cannot be achieved (the row and the reason).
+        A row that cannot be achieved, weakly either (the row and the reason).
     ParameterError
         A malformed ``structure`` or an unknown option.
 
@@ -468,7 +497,22 @@ def afdisyn(model: FaultModel, structure, *, faults=None, rdim: int | None = Non
     bad = sorted(set(options) - allowed)
     if bad:
         raise ParameterError(f"unknown option(s) {bad}; afdisyn takes {sorted(allowed)}")
-    S, faults, filters, gen = bank_rows(model, structure, faults,
-                                        lambda tg, nz: afdsyn(model, targets=tg, nuisance=nz, rdim=rdim, **options))
+    weak = []
+
+    def design(tg, nz):
+        try:
+            d = afdsyn(model, targets=tg, nuisance=nz, rdim=rdim, **options)
+        except DesignError as err:
+            if not (weak_fallback and nz):
+                raise
+            warnings.warn(f"afdisyn: the strong design detecting {list(tg)} failed ({err}); the faults {list(nz)} "
+                          "are treated as noise (weak design)", FdiWarning, stacklevel=4)
+            weak.append(True)
+            return afdsyn(_nuisance_as_noise(model, nz), targets=tg, rdim=rdim, **options)
+        weak.append(False)
+        return d
+
+    S, faults, filters, gen = bank_rows(model, structure, faults, design)
     return ApproximateBankDesign(gen, filters, S, faults, tuple(tuple(f.generator.residuals) for f in filters),
-                                 tuple(f.order for f in filters), np.array([f.gap for f in filters]), model=model)
+                                 tuple(f.order for f in filters), np.array([f.gap for f in filters]), tuple(weak),
+                                 model=model)

@@ -253,6 +253,7 @@ def efdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
     Varga (2017), §5.2, Procedure EFD; fdtools (``efdsyn``).
     """
     from fdikit.design.labels import label_generator
+    from fdikit.design.nullspace.stabilization import stabilize_rows
 
     targets, nuisance = split_faults(model, targets, nuisance)
     basis = left_nullspace(model, nuisance, tol=tol)
@@ -289,7 +290,9 @@ def efdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
         C, D = H @ C, H @ D
         rows = [None] * q
     names_default = tuple(f"r{i}" for i in range(q))
-    gen = _unit_fault_gain(_minimal_generator(A, B, C, D, model, names_default), model, targets, fdfreq)
+    gen, _ = stabilize_rows(_minimal_generator(A, B, C, D, model, names_default), model, nuisance=nuisance,
+                            poles=poles, sdeg=sdeg)
+    gen = _unit_fault_gain(gen, model, targets, fdfreq)
     gen = label_generator(gen, model, names, isolates)
     faults = targets + nuisance
     if minimal:

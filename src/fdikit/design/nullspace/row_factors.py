@@ -202,7 +202,7 @@ def _slowest(roots: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray, boo
             continue
         chosen.append(i)
     if len(chosen) < count:      # only conjugate pairs left for one place: a real root at the pair's real part
-        extra = [min((roots[j].real for j in order if j not in chosen), default=-1.0)]
+        extra = [next(roots[j].real for j in order if j not in chosen)]
         return np.concatenate([roots[chosen], extra]), roots, False
     return roots[chosen], np.delete(roots, chosen), True
 
