@@ -150,3 +150,22 @@ def test_filter_runs_discretised_and_compiled():
     for k in range(300):
         a, b = compiled.step(u[k], y[k]), ref.step(u[k], y[k])
         np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12 * max(1.0, np.abs(b).max()))
+
+
+def test_two_residuals_non_standard_quasi_gap_by_hand():
+    # Rf = [1; 1], Rw = diag(1/(s+2), s/(s+3)) (a zero at ∞ and one at 0), rdim = 2, sdeg = −3: by hand
+    # Q = diag((s+2)/(s+3), (s+3)/(s+3)), Rw → diag(1/(s+3), s/(s+3)) with ‖Rw‖∞ = 1, and
+    # ‖Rf‖∞ = sup √((ω²+4) + (ω²+9)) / √(ω²+9) = √2 (at ∞): gap √2
+    m = FaultModel(np.diag([-2.0, -3.0]), np.diag([1.0, -3.0]), Bf=np.zeros((2, 1)), Df=[[1.0], [1.0]],
+                   Bw=np.eye(2), Dw=np.diag([0.0, 1.0]), faults=["f"])
+    d = afdsyn(m, rdim=2, sdeg=-3.0)
+    assert d.factorization == "quasi" and d.shifted == 2 and d.generator.residuals == ("r0", "r1")
+    assert d.gap == pytest.approx(np.sqrt(2.0), rel=1e-8)
+    assert _noise_norm(d) == pytest.approx(1.0, rel=1e-8)
+    np.testing.assert_allclose(d.poles.real, [-3.0], rtol=1e-8)
+    # the same plant with its outputs rotated: the gap does not change
+    th = 0.4
+    U = np.array([[np.cos(th), -np.sin(th)], [np.sin(th), np.cos(th)]])
+    mr = FaultModel(np.diag([-2.0, -3.0]), U @ np.diag([1.0, -3.0]), Bf=np.zeros((2, 1)), Df=U @ [[1.0], [1.0]],
+                    Bw=np.eye(2), Dw=U @ np.diag([0.0, 1.0]), faults=["f"])
+    assert afdsyn(mr, rdim=2, sdeg=-3.0).gap == pytest.approx(np.sqrt(2.0), rel=1e-8)

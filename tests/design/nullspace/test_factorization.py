@@ -7,6 +7,7 @@ from fdikit.design.nullspace.factorization import (
     boundary_zeros,
     coouter_coinner,
     inverse,
+    quasi_coouter,
     quasi_coouter_row,
     regularized_coouter,
     series,
@@ -104,3 +105,48 @@ def test_series_and_inverse_cancel():
     A, B, C, D = series(G, inverse(*G))
     for w in (0.1, 2.0):
         np.testing.assert_allclose(_resp((A, B, C, D), 1j * w), np.eye(2), atol=1e-9)
+
+
+# ------------------------------------------------------------------ quasi factor of several rows (nonstd = 1)
+def _response(F, w):
+    A, B, C, D = F
+    return C @ np.linalg.solve(1j * w * np.eye(A.shape[0]) - A, B) + D if A.size else D
+
+
+@pytest.mark.parametrize("row", [([[-2.0]], [[1.0]], [[1.0]], [[0.0]]),            # 1/(s+2): a zero at ∞
+                                 ([[-2.0]], [[-2.0]], [[1.0]], [[1.0]]),           # s/(s+2): a zero at 0
+                                 (np.diag([-2.0, -3.0]), [[-1.0], [2.0]], [[1.0, 1.0]], [[0.0]])])
+def test_quasi_factor_of_rows_agrees_with_the_polynomial_one(row):
+    # two independent constructions (state-space row operations / polynomial spectral factor) of one row
+    a, b = quasi_coouter(*row, sdeg=-3.0), quasi_coouter_row(*row, sdeg=-3.0)
+    assert a.shifted == b.shifted == 1
+    for w in (0.0, 0.3, 1.0, 7.0):
+        assert abs(_response(a.outer, w)[0, 0]) == pytest.approx(abs(_response(b.outer, w)[0, 0]), rel=1e-9)
+
+
+def test_quasi_factor_of_two_rows_is_rotation_equivariant():
+    # G = diag(1/(s+2), s/(s+3)): by hand F = diag((s+1)/(s+2), (s+1)/(s+3)) for π = −1 (up to a unitary constant);
+    # for U G (rotated residuals) the new noise part F_U⁻¹ U G has the singular values of F⁻¹ G
+    A, B, C, D = np.diag([-2.0, -3.0]), np.eye(2), np.diag([1.0, -3.0]), np.diag([0.0, 1.0])
+    th = 0.7
+    U = np.array([[np.cos(th), -np.sin(th)], [np.sin(th), np.cos(th)]])
+    f, fu = quasi_coouter(A, B, C, D, sdeg=-1.0), quasi_coouter(A, B, U @ C, U @ D, sdeg=-1.0)
+    assert f.shifted == fu.shifted == 2
+    for w in (0.0, 0.5, 2.0, 20.0):
+        s = 1j * w
+        F = np.diag([(s + 1) / (s + 2), (s + 1) / (s + 3)])
+        Fh = _response(f.outer, w)
+        np.testing.assert_allclose(Fh @ Fh.conj().T, F @ F.conj().T, rtol=1e-9, atol=1e-12)
+        G = C @ np.linalg.solve(s * np.eye(2) - A, B) + D
+        sv = np.linalg.svd(np.linalg.solve(Fh, G), compute_uv=False)
+        svu = np.linalg.svd(np.linalg.solve(_response(fu.outer, w), U @ G), compute_uv=False)
+        np.testing.assert_allclose(svu, sv, rtol=1e-9, atol=1e-12)
+
+
+def test_quasi_factor_of_rows_refuses_complex_boundary_zeros():
+    # s²+1 over (s+1)²: zeros at ±j
+    A, B, C, D = np.array([[-2.0, -1.0], [1.0, 0.0]]), np.array([[1.0], [0.0]]), np.array([[-2.0, 0.0]]), [[1.0]]
+    with pytest.raises(DesignError, match="imaginary axis"):
+        quasi_coouter(np.kron(np.eye(2), A), np.kron(np.eye(2), B), np.kron(np.eye(2), C), np.eye(2), sdeg=-1.0)
+    with pytest.raises(ParameterError, match="real and negative"):
+        quasi_coouter(A, B, C, D, poles=[-1 + 1j])

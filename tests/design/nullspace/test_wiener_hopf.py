@@ -159,6 +159,6 @@ def test_row_factor_helpers_and_bad_input():
 def test_discrete_non_standard_case_is_refused_clearly():
     # zeros on the unit circle of a discrete noise row: only "regularize" is implemented
     m = FaultModel([[0.5]], [[1.0]], Bf=[[0.0]], Df=[[1.0]], Bw=[[-0.5]], Dw=[[1.0]], faults=["f"], dt=0.1)
-    with pytest.raises(DesignError, match="continuous model only"):
+    with pytest.raises(DesignError, match="continuous models only"):
         afdsyn(m, nonstd="wiener-hopf")
     assert afdsyn(m, nonstd="regularize").factorization == "regularized"

@@ -23,8 +23,11 @@ What is covered
 * **Regularised case** (:func:`regularized_coouter`): the co-outer factor of ``[G  εI]`` (Varga 2017, Remark 5.8;
   reference ``nonstd = 2``), always standard.
 
-Not covered: the quasi factorisation of several rows with zeros on the boundary or at infinity, discrete systems
-with zeros on the unit circle, and ``D Dᵀ`` singular in discrete time (use the regularised form there).
+* **Non-standard case, several rows** (:func:`quasi_coouter`): continuous, zeros at infinity and at ``s = 0``,
+  removed by row operations on the realisation (Silverman steps and a division by ``s``) and moved to the poles.
+
+Not covered: a complex pair of zeros on the imaginary axis in several rows, discrete systems with zeros on the unit
+circle, and ``D Dᵀ`` singular in discrete time (use the regularised form there).
 
 References
 ----------
@@ -42,8 +45,8 @@ import scipy.linalg as sla
 
 from fdikit.errors import DesignError, ParameterError
 
-__all__ = ["CoOuterFactor", "coouter_coinner", "regularized_coouter", "quasi_coouter_row", "boundary_zeros",
-           "series", "inverse"]
+__all__ = ["CoOuterFactor", "coouter_coinner", "regularized_coouter", "quasi_coouter_row", "quasi_coouter",
+           "boundary_zeros", "series", "inverse"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -401,3 +404,98 @@ def quasi_coouter_row(A, B, C, D, *, poles: Sequence[complex] | None = None, sde
     phi = denominator(n_shift, poles, sdeg, None)
     num_o = spec.gain * np.real(np.convolve(np.poly(stable), phi)) if stable.size else spec.gain * phi
     return CoOuterFactor(realize_biproper(num_o, spec.den), None, None, "quasi", n_shift)
+
+
+def quasi_coouter(A, B, C, D, *, poles: Sequence[complex] | None = None, sdeg: float = -0.05,
+                  tol: float = 1e-7) -> CoOuterFactor:
+    """The shifted quasi-co-outer factor of a stable continuous ``G`` with several rows (``nonstd = 1``).
+
+    ``G`` (``p × m``, full row rank) with zeros at infinity or at ``s = 0`` is reduced, on its own ``(A, B)``, to
+    ``G₁ = T(s) G`` without them: while ``D`` lacks full row rank, the rows of its left null space are multiplied by
+    ``(s − π)`` (``C_i ← C_i (A − πI)``, ``D_i ← C_i B``: a Silverman step); then, for each zero at 0, the row of its
+    left null vector ``r(s)`` (with ``r(0) = 0``) becomes ``(s − π) r(s) / s``
+    (``C_i ← −C_i (A − πI) A⁻¹``, ``D_i ← −C_i A⁻¹ B``).  ``T⁻¹`` is stable and proper, so ``T⁻¹ G₁ₒ`` is the
+    quasi-co-outer factor of ``G``; the returned factor ``F = W G₁ₒ`` (``G₁ₒ`` the standard co-outer factor of
+    ``G₁``, ``W`` the product of the orthogonal row rotations of the steps, so that ``F`` of ``U G`` is ``U F`` for
+    a constant rotation ``U``) is biproper, stable and minimum phase with the moved zeros at the poles ``π``:
+    ``F⁻¹ Q`` is stable and proper, and ``F⁻¹ G`` keeps the zeros of ``G`` on the boundary and at infinity.  For one row this is
+    :func:`quasi_coouter_row` (which also takes ``smarg``); the reference instead inverts the quasi factor and
+    stabilises with ``glcf`` — another member of the same family of left coprime factors.
+
+    Parameters
+    ----------
+    A, B, C, D : array_like
+        A stable realisation of ``G``.
+    poles : sequence of float, optional
+        The poles ``π`` of the moved zeros, in order (real); default all at ``sdeg``.
+    sdeg : float, default -0.05
+        ``π`` when ``poles`` is None.
+    tol : float, default 1e-7
+        Relative tolerance of the rank and boundary decisions.
+
+    Returns
+    -------
+    CoOuterFactor
+        ``kind = "quasi"``, ``shifted`` = number of zeros moved.
+
+    Raises
+    ------
+    DesignError
+        ``G`` without full row rank, or zeros on the imaginary axis away from 0 (complex pairs are not
+        implemented: use the regularised factor).
+    ParameterError
+        Unstable or complex ``poles``.
+
+    Examples
+    --------
+    ``diag(1/(s+2), s/(s+3))``: one zero at infinity, one at 0; ``F = diag((s+1)/(s+2), (s+1)/(s+3))`` with π = −1:
+
+    >>> f = quasi_coouter(np.diag([-2.0, -3.0]), np.eye(2), np.diag([1.0, -3.0]), np.diag([0.0, 1.0]), sdeg=-1.0)
+    >>> Ao, Bo, Co, Do = f.outer
+    >>> f.shifted, np.round(np.sort(np.linalg.eigvals(Ao - Bo @ np.linalg.solve(Do, Co)).real), 6).tolist()
+    (2, [-1.0, -1.0])
+
+    References
+    ----------
+    Varga (2017), §5.3 (the quasi-co-outer factor, ``nonstd = 1``), §7.9; Silverman (1969) row reduction of the
+    infinite zero structure as used in the book's §7.
+    """
+    A, B, C, D = _abcd(A, B, C, D)
+    n, p = A.shape[0], D.shape[0]
+    C, D = C.copy(), D.copy()
+    pis = [] if poles is None else [complex(x) for x in np.ravel(poles)]
+    if any(abs(x.imag) > 0 or not x.real < 0 for x in pis) or not sdeg < 0:
+        raise ParameterError(f"the poles of the moved zeros must be real and negative, got {pis or sdeg}")
+    moved = 0
+
+    def pole() -> float:
+        return pis[moved].real if moved < len(pis) else float(sdeg)
+
+    scale = max(1.0, np.linalg.norm(np.block([[A, B], [C, D]]), 2))
+    R = np.eye(p)                                   # the rotations: G = R (T̃ G) with T̃ the row shifts undone
+    for _ in range(n + p + 1):
+        U, sv, _ = np.linalg.svd(D)
+        r = int(np.sum(sv > tol * scale))
+        if r < p:
+            C, D, R = U.T @ C, U.T @ D, R @ U
+            D[r:] = 0.0
+            for i in range(r, p):
+                pi = pole()
+                C[i], D[i] = C[i] @ (A - pi * np.eye(n)), C[i] @ B
+                moved += 1
+            continue
+        bz = boundary_zeros(A, B, C, D, None, tol=tol)
+        if not bz.size:
+            Ao, Bo, Co, Do = coouter_coinner(A, B, C, D, None, tol=tol).outer
+            return CoOuterFactor((Ao, Bo, R @ Co, R @ Do), None, None, "quasi", moved)
+        G0 = C @ np.linalg.solve(-A, B) + D
+        W, s0, _ = np.linalg.svd(G0)
+        if s0[-1] > tol * max(1.0, s0[0]):          # G(0) has full row rank: the boundary zeros are elsewhere
+            raise DesignError(f"G has zeros on the imaginary axis at {np.round(bz, 6).tolist()}: the quasi "
+                              "factorisation of several rows moves zeros at 0 and at infinity only; use "
+                              "nonstd='regularize'")
+        C, D, R = W.T @ C, W.T @ D, R @ W           # the last row is the left null vector's: r(0) = 0
+        pi, Ai = pole(), np.linalg.inv(A)
+        C[-1], D[-1] = -C[-1] @ (A - pi * np.eye(n)) @ Ai, -C[-1] @ Ai @ B
+        moved += 1
+    raise DesignError("the zeros at infinity and at 0 could not be removed: G has no full row rank")
