@@ -418,9 +418,9 @@ def quasi_coouter(A, B, C, D, *, poles: Sequence[complex] | None = None, sdeg: f
     quasi-co-outer factor of ``G``; the returned factor ``F = W G₁ₒ`` (``G₁ₒ`` the standard co-outer factor of
     ``G₁``, ``W`` the product of the orthogonal row rotations of the steps, so that ``F`` of ``U G`` is ``U F`` for
     a constant rotation ``U``) is biproper, stable and minimum phase with the moved zeros at the poles ``π``:
-    ``F⁻¹ Q`` is stable and proper, and ``F⁻¹ G`` keeps the zeros of ``G`` on the boundary and at infinity.  For one row this is
-    :func:`quasi_coouter_row` (which also takes ``smarg``); the reference instead inverts the quasi factor and
-    stabilises with ``glcf`` — another member of the same family of left coprime factors.
+    ``F⁻¹ Q`` is stable and proper, and ``F⁻¹ G`` keeps the zeros of ``G`` on the boundary and at infinity.  For
+    one row this is :func:`quasi_coouter_row` (which also takes ``smarg``); the reference instead inverts the quasi
+    factor and stabilises with ``glcf`` — another member of the same family of left coprime factors.
 
     Parameters
     ----------
