@@ -156,9 +156,18 @@ def test_row_factor_helpers_and_bad_input():
         row_spectrum([[-1.0]], [[0.0]], [[1.0]], [[0.0]])
 
 
-def test_discrete_non_standard_case_is_refused_clearly():
-    # zeros on the unit circle of a discrete noise row: only "regularize" is implemented
-    m = FaultModel([[0.5]], [[1.0]], Bf=[[0.0]], Df=[[1.0]], Bw=[[-0.5]], Dw=[[1.0]], faults=["f"], dt=0.1)
+def test_discrete_non_standard_cases():
+    # Rw = (z−1)/(z−0.5) (a zero at 1), Rf = 1, π = 0.95: by hand Q = (z−0.5)/(z−0.95), Rw → (z−1)/(z−0.95) with
+    # ‖Rw‖∞ = 2/1.95 (at z = −1), ‖Rf‖∞ = 0.5/0.05 = 10 (at z = 1): gap 9.75
+    m = FaultModel([[0.5]], [[-0.5]], Bf=[[0.0]], Df=[[1.0]], Bw=[[1.0]], Dw=[[1.0]], faults=["f"], dt=0.1)
+    d = afdsyn(m)
+    assert d.factorization == "quasi" and d.shifted == 1
+    assert d.gap == pytest.approx(10 / (2 / 1.95), rel=1e-8)
+    np.testing.assert_allclose(d.poles.real, [0.95], rtol=1e-9)
     with pytest.raises(DesignError, match="continuous models only"):
         afdsyn(m, nonstd="wiener-hopf")
     assert afdsyn(m, nonstd="regularize").factorization == "regularized"
+    # D = 0 is standard in discrete time: Rw = 1/(z−0.5) → Rw = z⁻¹ (inner), Rf = (z−0.5)/z: gap 1.5
+    m0 = FaultModel([[0.5]], [[1.0]], Bf=[[0.0]], Df=[[1.0]], Bw=[[1.0]], faults=["f"], dt=0.1)
+    d0 = afdsyn(m0)
+    assert d0.factorization == "standard" and d0.gap == pytest.approx(1.5, rel=1e-8)

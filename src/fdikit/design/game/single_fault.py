@@ -276,6 +276,18 @@ def single_fault_game_filter(
         P = solve_game_are(A.T, -C.T @ S @ C, W, what=f"the single-fault game Riccati equation for {name!r}").X
     P = (P + P.T) / 2
     ev = np.linalg.eigvalsh(P)
+    if solver == "care" and ev.min() < -1e-8 * max(ev.max(), 1e-300):
+        # SciPy's Schur solver can return an inaccurate, indefinite solution of this badly scaled equation under
+        # one BLAS kernel (the PATH car's filter 4 under Haswell/Zen: min eigenvalue −0.05, positive under
+        # Prescott/SkylakeX); the Hamiltonian-Schur solver with its residual check decides instead
+        try:
+            P = solve_game_are(A.T, -C.T @ S @ C, W, axis_tol=1e3 * np.finfo(float).eps,
+                               what=f"the single-fault game Riccati equation for {name!r}").X
+            solver = "hamiltonian"
+        except DesignError:
+            pass
+        P = (P + P.T) / 2
+        ev = np.linalg.eigvalsh(P)
     if ev.min() < -1e-8 * max(ev.max(), 1e-300):
         raise DesignError(
             f"the single-fault game Riccati solution for {name!r} is not positive semidefinite (min eigenvalue "

@@ -20,10 +20,9 @@ Plant modes that only the faults or the noise excite are moved out of the intern
 Differences from the reference: the basis is the least-degree polynomial basis over stable denominators
 (:mod:`~fdikit.design.nullspace.basis`), so state coordinates and the design matrices ``H`` differ, and every basis
 pole is assigned (the reference's ``smarg`` acts here on the stabilisation of the internal form and on the zeros
-moved in the ``"quasi"`` case of one row); the non-standard cases other than ``"regularize"`` are implemented for
-continuous models (zeros on the unit circle need the descriptor ``goifac``/``glcf`` reductions), the Wiener–Hopf
-ones for one residual, and the quasi factor of several residuals moves zeros at infinity and at 0 only (a complex
-pair on the imaginary axis is refused).
+moved in the ``"quasi"`` case of one row); the Wiener–Hopf cases are implemented for one residual of a continuous
+model, and the quasi factor of several residuals (or of a discrete model) moves zeros at infinity, at 0 and at ±1
+only (a complex boundary pair there is refused: it needs the descriptor ``goifac``/``glcf`` reductions).
 
 References
 ----------
@@ -210,14 +209,14 @@ def _factor(ch, dt, nonstd, epsreg, poles, sdeg, smarg, sdegzer):
     except DesignError as err:
         if nonstd == "regularize":
             return regularized_coouter(ch.A, ch.B, ch.C, ch.D, dt, epsreg=epsreg)
+        if nonstd == "quasi":
+            if ch.C.shape[0] > 1 or dt is not None:
+                return quasi_coouter(ch.A, ch.B, ch.C, ch.D, dt, poles=poles, sdeg=sdeg)
+            return quasi_coouter_row(ch.A, ch.B, ch.C, ch.D, poles=poles, sdeg=-0.05 if sdeg is None else sdeg,
+                                     smarg=smarg)
         if dt is not None:
             raise DesignError(f"{err}; nonstd={nonstd!r} is implemented for continuous models only: use "
-                              "nonstd='regularize'") from err
-        s = -0.05 if sdeg is None else sdeg
-        if nonstd == "quasi":
-            if ch.C.shape[0] > 1:
-                return quasi_coouter(ch.A, ch.B, ch.C, ch.D, poles=poles, sdeg=s)
-            return quasi_coouter_row(ch.A, ch.B, ch.C, ch.D, poles=poles, sdeg=s, smarg=smarg)
+                              "nonstd='quasi' or 'regularize'") from err
         if ch.C.shape[0] != 1:
             raise DesignError(f"{err}; nonstd={nonstd!r} is implemented for one residual only: use "
                               "nonstd='quasi' or 'regularize', or rdim=1") from err
@@ -281,8 +280,8 @@ def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
         Non-standard case (``R_w`` with zeros at infinity or on the boundary), the reference's ``nonstd = 1 … 5``:
         the quasi factor with those zeros moved to the poles (1), the factor of ``[R_w εI]`` (2), and the
         Wiener–Hopf factor ``X`` of ``R_wo = X R`` (3), with ``R``'s zeros shifted by ``sdegzer`` (4) or ``R``
-        regularised by ``epsreg`` (5), :mod:`~fdikit.design.nullspace.row_factors`.  All but 2 for continuous
-        models; 3–5 for one residual; 1 with several residuals for zeros at infinity and at 0
+        regularised by ``epsreg`` (5), :mod:`~fdikit.design.nullspace.row_factors`.  3–5 for one residual of a
+        continuous model; 1 with several residuals or discrete for zeros at infinity, 0 and ±1
         (:func:`~fdikit.design.nullspace.factorization.quasi_coouter`).
     epsreg : float, default 0.1
         ``ε`` of the regularisations (``nonstd`` "regularize", "wiener-hopf-regularize").

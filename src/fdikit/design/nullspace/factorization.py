@@ -23,11 +23,11 @@ What is covered
 * **Regularised case** (:func:`regularized_coouter`): the co-outer factor of ``[G  εI]`` (Varga 2017, Remark 5.8;
   reference ``nonstd = 2``), always standard.
 
-* **Non-standard case, several rows** (:func:`quasi_coouter`): continuous, zeros at infinity and at ``s = 0``,
-  removed by row operations on the realisation (Silverman steps and a division by ``s``) and moved to the poles.
+* **Non-standard case, several rows or discrete** (:func:`quasi_coouter`): zeros at infinity and at ``s = 0``
+  (discrete ``z = ±1``), removed by row operations on the realisation (row shifts of the infinite zeros and a division by
+  ``λ − λ₀``) and moved to the poles.  Discrete ``D Dᵀ`` singular is the standard case (``R + C X Cᵀ > 0``).
 
-Not covered: a complex pair of zeros on the imaginary axis in several rows, discrete systems with zeros on the unit
-circle, and ``D Dᵀ`` singular in discrete time (use the regularised form there).
+Not covered: a complex pair of boundary zeros with several rows or in discrete time (use the regularised form).
 
 References
 ----------
@@ -263,18 +263,20 @@ def coouter_coinner(A, B, C, D, dt: float | None = None, *, tol: float = 1e-7) -
     A, B, C, D = _abcd(A, B, C, D)
     n, p, m = A.shape[0], D.shape[0], D.shape[1]
     sv = np.linalg.svd(D, compute_uv=False)
-    if p > m or not sv.size or sv[-1] <= tol * max(sv[0], 1e-300):
+    full = p <= m and sv.size and sv[-1] > tol * max(sv[0], 1e-300)
+    if not full and (dt is None or n == 0 or p > m):
         raise DesignError(f"D (singular values {np.round(sv, 9).tolist()}) does not have full row rank {p}: G has "
-                          "zeros at infinity (non-standard case); use the quasi factorisation of one row or the "
-                          "regularised factorisation")
+                          "zeros at infinity (non-standard case); use the quasi factorisation or the regularised "
+                          "factorisation")
     R = D @ D.T
     if n == 0:
         Do = _sqrtm_sym(R)
         return CoOuterFactor((A, np.zeros((0, p)), C, Do), (A, B, C, _sqrtm_sym(R, True) @ D), dt, "standard")
-    bz = boundary_zeros(A, B, C, D, dt, tol=tol)
+    # discrete with D Dᵀ singular: R + C X Cᵀ > 0 still; the unit-circle test is then on the factor's zeros below
+    bz = boundary_zeros(A, B, C, D, dt, tol=tol) if full else np.zeros(0, complex)
     if bz.size:
         raise DesignError(f"G has zeros on the stability boundary {np.round(bz, 6).tolist()} (non-standard case); "
-                          "use the quasi factorisation of one row or the regularised factorisation")
+                          "use the quasi factorisation or the regularised factorisation")
     S = B @ D.T
     try:
         if dt is None:
@@ -286,6 +288,13 @@ def coouter_coinner(A, B, C, D, dt: float | None = None, *, tol: float = 1e-7) -
     except (np.linalg.LinAlgError, ValueError) as err:
         raise DesignError(f"the filter Riccati equation of the co-outer factor has no stabilising solution: {err}"
                           ) from err
+    if not full:
+        w = np.linalg.eigvalsh((Rt + Rt.T) / 2)
+        zo = np.linalg.eigvals(A - (A @ X @ C.T + S) @ np.linalg.solve(Rt, C)) if w[0] > tol * max(w[-1], 1.0) \
+            else np.ones(1)
+        if np.max(np.abs(zo)) >= 1 - tol:
+            raise DesignError("G has zeros on the unit circle (non-standard case); use the quasi factorisation or "
+                              "the regularised factorisation")
     Rh, Rhi = _sqrtm_sym(Rt), _sqrtm_sym(Rt, True)
     if dt is None:
         K = (X @ C.T + S) @ np.linalg.inv(Rt)
@@ -406,30 +415,33 @@ def quasi_coouter_row(A, B, C, D, *, poles: Sequence[complex] | None = None, sde
     return CoOuterFactor(realize_biproper(num_o, spec.den), None, None, "quasi", n_shift)
 
 
-def quasi_coouter(A, B, C, D, *, poles: Sequence[complex] | None = None, sdeg: float = -0.05,
-                  tol: float = 1e-7) -> CoOuterFactor:
-    """The shifted quasi-co-outer factor of a stable continuous ``G`` with several rows (``nonstd = 1``).
+def quasi_coouter(A, B, C, D, dt: float | None = None, *, poles: Sequence[complex] | None = None,
+                  sdeg: float | None = None, tol: float = 1e-7) -> CoOuterFactor:
+    """The shifted quasi-co-outer factor of a stable ``G`` with zeros at infinity or at ``s = 0`` (``z = ±1``).
 
-    ``G`` (``p × m``, full row rank) with zeros at infinity or at ``s = 0`` is reduced, on its own ``(A, B)``, to
-    ``G₁ = T(s) G`` without them: while ``D`` lacks full row rank, the rows of its left null space are multiplied by
-    ``(s − π)`` (``C_i ← C_i (A − πI)``, ``D_i ← C_i B``: a Silverman step); then, for each zero at 0, the row of its
-    left null vector ``r(s)`` (with ``r(0) = 0``) becomes ``(s − π) r(s) / s``
-    (``C_i ← −C_i (A − πI) A⁻¹``, ``D_i ← −C_i A⁻¹ B``).  ``T⁻¹`` is stable and proper, so ``T⁻¹ G₁ₒ`` is the
-    quasi-co-outer factor of ``G``; the returned factor ``F = W G₁ₒ`` (``G₁ₒ`` the standard co-outer factor of
-    ``G₁``, ``W`` the product of the orthogonal row rotations of the steps, so that ``F`` of ``U G`` is ``U F`` for
-    a constant rotation ``U``) is biproper, stable and minimum phase with the moved zeros at the poles ``π``:
-    ``F⁻¹ Q`` is stable and proper, and ``F⁻¹ G`` keeps the zeros of ``G`` on the boundary and at infinity.  For
-    one row this is :func:`quasi_coouter_row` (which also takes ``smarg``); the reference instead inverts the quasi
-    factor and stabilises with ``glcf`` — another member of the same family of left coprime factors.
+    ``G`` (``p × m``, full row rank) is reduced, on its own ``(A, B)``, to ``G₁ = T(λ) G`` without those zeros.
+    Continuous: while ``D`` lacks full row rank, the rows of its left null space are multiplied by ``(s − π)``
+    (``C_i ← C_i (A − πI)``, ``D_i ← C_i B``).  Then, for each zero ``λ₀`` (0; discrete ``±1``),
+    the row of a left null vector of ``G(λ₀)``, ``r(λ)`` with ``r(λ₀) = 0``, becomes ``(λ − π) r(λ) / (λ − λ₀)``
+    (``C_i ← −C_i (A − πI)(λ₀I − A)⁻¹``, ``D_i ← −C_i (λ₀I − A)⁻¹ B``).  ``T⁻¹`` is stable and proper, so
+    ``T⁻¹ G₁ₒ`` is the quasi-co-outer factor of ``G``; the returned ``F = W G₁ₒ`` (``G₁ₒ`` the standard co-outer
+    factor of ``G₁``, ``W`` the product of the orthogonal row rotations of the steps, so that ``F`` of ``U G`` is
+    ``U F`` for a constant rotation ``U``) is biproper, stable and minimum phase with the moved zeros at the poles
+    ``π``: ``F⁻¹ Q`` is stable and proper, and ``F⁻¹ G`` keeps the zeros of ``G`` on the boundary and at infinity.
+    For one continuous row this is :func:`quasi_coouter_row` (which also takes ``smarg``); the reference instead
+    inverts the quasi factor and stabilises with ``glcf`` — another member of the same family of left coprime
+    factors.  (Discrete zeros at infinity, ``D`` singular, are standard: ``R + C X Cᵀ > 0``.)
 
     Parameters
     ----------
     A, B, C, D : array_like
         A stable realisation of ``G``.
+    dt : float or None
+        Sample time.
     poles : sequence of float, optional
-        The poles ``π`` of the moved zeros, in order (real); default all at ``sdeg``.
-    sdeg : float, default -0.05
-        ``π`` when ``poles`` is None.
+        The poles ``π`` of the moved zeros, in order (real, stable); default all at ``sdeg``.
+    sdeg : float, optional
+        ``π`` when ``poles`` is None (default −0.05, discrete 0.95).
     tol : float, default 1e-7
         Relative tolerance of the rank and boundary decisions.
 
@@ -441,8 +453,8 @@ def quasi_coouter(A, B, C, D, *, poles: Sequence[complex] | None = None, sdeg: f
     Raises
     ------
     DesignError
-        ``G`` without full row rank, or zeros on the imaginary axis away from 0 (complex pairs are not
-        implemented: use the regularised factor).
+        ``G`` without full row rank, or zeros on the boundary elsewhere (complex pairs are not implemented: use
+        the regularised factor).
     ParameterError
         Unstable or complex ``poles``.
 
@@ -457,45 +469,47 @@ def quasi_coouter(A, B, C, D, *, poles: Sequence[complex] | None = None, sdeg: f
 
     References
     ----------
-    Varga (2017), §5.3 (the quasi-co-outer factor, ``nonstd = 1``), §7.9; Silverman (1969) row reduction of the
-    infinite zero structure as used in the book's §7.
+    Varga (2017), §5.3 (the quasi-co-outer factor, ``nonstd = 1``), §7.9.
     """
+    from fdikit.design.nullspace.basis import default_sdeg
+
     A, B, C, D = _abcd(A, B, C, D)
     n, p = A.shape[0], D.shape[0]
     C, D = C.copy(), D.copy()
-    pis = [] if poles is None else [complex(x) for x in np.ravel(poles)]
-    if any(abs(x.imag) > 0 or not x.real < 0 for x in pis) or not sdeg < 0:
-        raise ParameterError(f"the poles of the moved zeros must be real and negative, got {pis or sdeg}")
+    sdeg = default_sdeg(dt) if sdeg is None else float(sdeg)
+    pis = [complex(x) for x in np.ravel(poles)] if poles is not None else []
+    stable = (lambda x: x.real < 0) if dt is None else (lambda x: abs(x) < 1)
+    if any(abs(x.imag) > 0 or not stable(x) for x in pis) or not stable(complex(sdeg)):
+        raise ParameterError(f"the poles of the moved zeros must be real and stable, got {pis or sdeg}")
     moved = 0
-
-    def pole() -> float:
-        return pis[moved].real if moved < len(pis) else float(sdeg)
-
-    scale = max(1.0, np.linalg.norm(np.block([[A, B], [C, D]]), 2))
     R = np.eye(p)                                   # the rotations: G = R (T̃ G) with T̃ the row shifts undone
+    scale = max(1.0, np.linalg.norm(np.block([[A, B], [C, D]]), 2))
     for _ in range(n + p + 1):
-        U, sv, _ = np.linalg.svd(D)
-        r = int(np.sum(sv > tol * scale))
-        if r < p:
-            C, D, R = U.T @ C, U.T @ D, R @ U
-            D[r:] = 0.0
-            for i in range(r, p):
-                pi = pole()
-                C[i], D[i] = C[i] @ (A - pi * np.eye(n)), C[i] @ B
-                moved += 1
-            continue
-        bz = boundary_zeros(A, B, C, D, None, tol=tol)
-        if not bz.size:
-            Ao, Bo, Co, Do = coouter_coinner(A, B, C, D, None, tol=tol).outer
-            return CoOuterFactor((Ao, Bo, R @ Co, R @ Do), None, None, "quasi", moved)
-        G0 = C @ np.linalg.solve(-A, B) + D
-        W, s0, _ = np.linalg.svd(G0)
-        if s0[-1] > tol * max(1.0, s0[0]):          # G(0) has full row rank: the boundary zeros are elsewhere
-            raise DesignError(f"G has zeros on the imaginary axis at {np.round(bz, 6).tolist()}: the quasi "
-                              "factorisation of several rows moves zeros at 0 and at infinity only; use "
-                              "nonstd='regularize'")
-        C, D, R = W.T @ C, W.T @ D, R @ W           # the last row is the left null vector's: r(0) = 0
-        pi, Ai = pole(), np.linalg.inv(A)
-        C[-1], D[-1] = -C[-1] @ (A - pi * np.eye(n)) @ Ai, -C[-1] @ Ai @ B
+        pi = pis[moved].real if moved < len(pis) else sdeg
+        if dt is None:
+            U, sv, _ = np.linalg.svd(D)
+            r = int(np.sum(sv > tol * scale))
+            if r < p:
+                C, D, R = U.T @ C, U.T @ D, R @ U
+                D[r:] = 0.0
+                for i in range(r, p):
+                    C[i], D[i] = C[i] @ (A - pi * np.eye(n)), C[i] @ B
+                    moved += 1
+                continue
+        try:
+            Ao, Bo, Co, Do = coouter_coinner(A, B, C, D, dt, tol=tol).outer
+            return CoOuterFactor((Ao, Bo, R @ Co, R @ Do), None, dt, "quasi", moved)
+        except DesignError as err:
+            reason = err
+        for lam in ([0.0] if dt is None else [1.0, -1.0]):
+            M = np.linalg.inv(lam * np.eye(n) - A)
+            W, s0, _ = np.linalg.svd(C @ M @ B + D)
+            if s0[-1] <= tol * max(1.0, s0[0]):     # G(λ₀) loses rank: a zero there
+                break
+        else:
+            raise DesignError(f"{reason}; the quasi factorisation moves zeros at infinity and at "
+                              f"{'0' if dt is None else '±1'} only: use nonstd='regularize'")
+        C, D, R = W.T @ C, W.T @ D, R @ W           # the last row is the left null vector's: r(λ₀) = 0
+        C[-1], D[-1] = -C[-1] @ (A - pi * np.eye(n)) @ M, -C[-1] @ M @ B
         moved += 1
-    raise DesignError("the zeros at infinity and at 0 could not be removed: G has no full row rank")
+    raise DesignError("the zeros on the boundary could not be removed: G has no full row rank")
