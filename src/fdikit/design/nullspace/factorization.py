@@ -24,8 +24,8 @@ What is covered
   reference ``nonstd = 2``), always standard.
 
 * **Non-standard case, several rows or discrete** (:func:`quasi_coouter`): zeros at infinity and at ``s = 0``
-  (discrete ``z = ±1``), removed by row operations on the realisation (row shifts of the infinite zeros and a division by
-  ``λ − λ₀``) and moved to the poles.  Discrete ``D Dᵀ`` singular is the standard case (``R + C X Cᵀ > 0``).
+  (discrete ``z = ±1``), removed by row operations on the realisation (row shifts of the infinite zeros and a
+  division by ``λ − λ₀``) and moved to the poles.  Discrete ``D Dᵀ`` singular is the standard case (``R + C X Cᵀ > 0``).
 
 Not covered: a complex pair of boundary zeros with several rows or in discrete time (use the regularised form).
 
