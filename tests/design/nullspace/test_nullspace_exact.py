@@ -195,3 +195,17 @@ def test_degrees_are_the_left_kronecker_indices(case):
     }[case]
     model = m()
     assert left_nullspace(model, nz).degrees == _kronecker_left_indices(model, nz)
+
+
+def test_rows_of_one_degree_do_not_depend_on_the_svd_rotation():
+    # the SVD returns equal-singular-value rows in a rotation rounding decides (it changes with the BLAS kernel);
+    # the canonical rows are the same for every rotation of the same space, and span it
+    from fdikit.design.nullspace.basis import _canonical
+
+    rng = np.random.default_rng(3)
+    V = np.linalg.qr(rng.standard_normal((7, 3)))[0].T                       # 3 orthonormal rows in R^7
+    Rot = np.linalg.qr(rng.standard_normal((3, 3)))[0]
+    a, b = _canonical(V), _canonical(Rot @ V)
+    np.testing.assert_allclose(a, b, atol=1e-12)
+    np.testing.assert_allclose(a @ a.T, np.eye(3), atol=1e-12)
+    np.testing.assert_allclose(a - (a @ V.T) @ V, 0.0, atol=1e-12)            # in the row space of V

@@ -318,7 +318,7 @@ def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
     Varga (2017), Example 5.6: ``Gu = [(s+1)/(s+2); (s+2)/(s+3)]``, ``Gw = [1/(s+2); 0]``,
     ``Gf = [(s+1)/(s+2) 0; 0 1]``; with ``sdeg = −3`` a first-order filter; its gap is at most the book's 3, which
     the best ``selection`` of the two basis rows reaches (``selection`` is in fdikit's basis coordinates, not the
-    reference's ``HDesign`` ones; the rows of one degree are an SVD basis, so use it with the basis at hand):
+    reference's ``HDesign`` ones, but the same on every machine):
 
     >>> m = FaultModel([[-2.0, 0, 0], [0, -3.0, 0], [0, 0, -2.0]], [[-1.0, 0, 1.0], [0, -1.0, 0]],
     ...                Bu=[[1.0], [1.0], [0.0]], Du=[[1.0], [1.0]], Bf=[[1.0, 0], [0, 0], [0, 0]],

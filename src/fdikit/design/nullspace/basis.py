@@ -240,6 +240,22 @@ def _toeplitz(C, A, B, D, k):
     return T
 
 
+def _canonical(V: np.ndarray) -> np.ndarray:
+    """A basis of the row space of the orthonormal ``V`` that does not depend on the rotation ``V`` came in.
+
+    The new rows of one degree span a unique space, but the SVD returns them in a rotation that rounding (and so the
+    BLAS kernel) decides when their singular values are equal.  Projecting fixed vectors ``Z`` onto the space and
+    orthonormalising them (QR with a positive diagonal) gives the same rows for every rotation, continuously in the
+    space, so ``selection=`` means the same filter on every machine.
+    """
+    q, L = V.shape
+    if q <= 1:
+        return V
+    Z = np.random.default_rng(20170).standard_normal((L, q))
+    Qx, Rx = np.linalg.qr(V.T @ (V @ Z))
+    return (Qx * np.sign(np.diag(Rx))).T
+
+
 def _null_rows(M: np.ndarray, tol: float) -> np.ndarray:
     """Orthonormal rows spanning the left null space of ``M`` (rank relative to ``‖M‖``)."""
     if M.shape[1] == 0:
@@ -438,7 +454,7 @@ def left_nullspace(model: FaultModel, nuisance: Sequence[str] = (), *, tol: floa
             P = P - (P @ S) @ S.T
         if P.shape[0]:
             _, s, Vt = np.linalg.svd(P, full_matrices=False)
-            new = Vt[: int(np.sum(s > 1e-6))]      # P's rows are orthonormal: s is ≈ 1 (new) or ≈ 0 (a shift)
+            new = _canonical(Vt[: int(np.sum(s > 1e-6))])  # P's rows orthonormal: s ≈ 1 (new) or ≈ 0 (a shift)
         else:
             new = P
         for v in new[: target - len(found)]:
