@@ -44,6 +44,7 @@ from fdikit.design.nullspace.basis import NullspaceBasis, denominator, left_null
 from fdikit.design.nullspace.detectability import row_structure
 from fdikit.design.nullspace.exact import bank_rows, efdsyn, split_faults
 from fdikit.design.nullspace.factorization import (
+    CoOuterFactor,
     coouter_coinner,
     inverse,
     quasi_coouter,
@@ -201,7 +202,6 @@ _NONSTD = ("quasi", "regularize", "wiener-hopf", "wiener-hopf-shift", "wiener-ho
 
 def _factor(ch, dt, nonstd, epsreg, poles, sdeg, smarg, sdegzer):
     """The noise factor ``F`` of the channel ``ch`` (``Q ← F⁻¹ Q``) and its kind (the reference's ``nonstd``)."""
-    from fdikit.design.nullspace.factorization import CoOuterFactor
     from fdikit.design.nullspace.row_factors import wiener_hopf_row
 
     try:

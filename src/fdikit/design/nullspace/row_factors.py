@@ -118,9 +118,7 @@ def row_spectrum(A, B, C, D, *, tol: float = 1e-7) -> RowSpectrum:
     nums = [np.poly(A - B[:, [i]] @ C) - d + D[0, i] * d if n else D[0, i] * d for i in range(B.shape[1])]
     P = np.zeros(2 * n + 1)
     for num in nums:
-        k = len(num) - 1
-        mirror = num * (-1.0) ** (k - np.arange(k + 1))            # n(−s), highest power first
-        P[-(2 * k + 1):] += np.convolve(num, mirror)
+        P[-(2 * len(num) - 1):] += np.convolve(num, _mirror(num))
     scale = max(np.max(np.abs(P)), 1e-300)
     nz = np.flatnonzero(np.abs(P) > 1e-12 * scale)
     if not nz.size:
