@@ -252,6 +252,12 @@ def single_fault_game_filter(
     S = (S + S.T) / 2
     W = Fhat @ Mw @ Fhat.T / g
     W = (W + W.T) / 2
+
+    def hamiltonian() -> np.ndarray:
+        """The Hamiltonian-Schur solution, axis test at 1000·eps of the scaled norm, residual-checked (≤ 1e-8)."""
+        return solve_game_are(A.T, -C.T @ S @ C, W, axis_tol=1e3 * np.finfo(float).eps,
+                              what=f"the single-fault game Riccati equation for {name!r}").X
+
     if np.linalg.eigvalsh(S).min() > 1e-12 * np.abs(S).max():
         solver = "care"
         try:
@@ -264,8 +270,7 @@ def single_fault_game_filter(
             # at 1000·eps of the scaled norm and its own residual check (≤ 1e-8) guarding the result.
             solver = "hamiltonian"
             try:
-                P = solve_game_are(A.T, -C.T @ S @ C, W, axis_tol=1e3 * np.finfo(float).eps,
-                                   what=f"the single-fault game Riccati equation for {name!r}").X
+                P = hamiltonian()
             except DesignError:
                 raise DesignError(
                     f"the single-fault game Riccati equation for {name!r} has no stabilizing solution ({exc}); "
@@ -281,8 +286,7 @@ def single_fault_game_filter(
         # one BLAS kernel (the PATH car's filter 4 under Haswell/Zen: min eigenvalue −0.05, positive under
         # Prescott/SkylakeX); the Hamiltonian-Schur solver with its residual check decides instead
         try:
-            P = solve_game_are(A.T, -C.T @ S @ C, W, axis_tol=1e3 * np.finfo(float).eps,
-                               what=f"the single-fault game Riccati equation for {name!r}").X
+            P = hamiltonian()
             solver = "hamiltonian"
         except DesignError:
             pass

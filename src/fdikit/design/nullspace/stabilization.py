@@ -63,6 +63,7 @@ def stabilize_rows(gen: ResidualGenerator, model: FaultModel, *, nuisance: Seque
         margin that these inputs do not reach are the ones the nullspace leaves in the internal form, and only
         those (where a row's minimal ``[R_f R_w]`` has them) are moved — a mode the decoupled inputs reach is
         cancelled by the basis, and rounding would only make it look present.
+    poles, sdeg : optional
         The assigned poles (first ``deg a_i`` of them) or stability degree (default −0.05, discrete 0.95), as the
         basis denominators (:func:`~fdikit.design.nullspace.basis.denominator`).
     smarg : float, optional
