@@ -164,10 +164,99 @@ def test_discrete_non_standard_cases():
     assert d.factorization == "quasi" and d.shifted == 1
     assert d.gap == pytest.approx(10 / (2 / 1.95), rel=1e-8)
     np.testing.assert_allclose(d.poles.real, [0.95], rtol=1e-9)
-    with pytest.raises(DesignError, match="continuous models only"):
-        afdsyn(m, nonstd="wiener-hopf")
+    # Wiener–Hopf: π = 0.5 (the pole of R_wo = R_w), R_woe = 1, Q constant, ‖Rw‖∞ = 2/1.5 at z = −1: gap 0.75;
+    # regularised, |R_ε|² = |R_w|² + ε² = |R_w|² + 0.09: ‖Rf‖∞ = 1/ε (z = 1, R_w = 0) and ‖Rw‖∞ = (4/3)/(41/30)
+    # (z = −1): gap 41/12
+    dw = afdsyn(m, nonstd="wiener-hopf")
+    assert dw.factorization == "wiener-hopf" and dw.shifted == 1 and dw.order == 0
+    assert dw.gap == pytest.approx(0.75, rel=1e-8)
+    assert afdsyn(m, nonstd="wiener-hopf-regularize", epsreg=0.3).gap == pytest.approx(41 / 12, rel=1e-8)
+    # shifted, δ = 0.95: R_wouz(z/δ) = (z − 0.95)/(z − 0.475), Q = (z − 0.475)/(z − 0.95): brute force on |z| = 1
+    ds = afdsyn(m, nonstd="wiener-hopf-shift", sdegzer=0.95)
+    z = np.exp(1j * np.linspace(0.0, np.pi, 200001))
+    q = np.abs((z - 0.475) / (z - 0.95))
+    assert ds.gap == pytest.approx(q.max() / (q * np.abs((z - 1) / (z - 0.5))).max(), rel=1e-6)
+    np.testing.assert_allclose(ds.poles.real, [0.95], rtol=1e-9)
+    with pytest.raises(ParameterError, match="sdegzer"):
+        afdsyn(m, nonstd="wiener-hopf-shift", sdegzer=-0.1)
     assert afdsyn(m, nonstd="regularize").factorization == "regularized"
     # D = 0 is standard in discrete time: Rw = 1/(z−0.5) → Rw = z⁻¹ (inner), Rf = (z−0.5)/z: gap 1.5
     m0 = FaultModel([[0.5]], [[1.0]], Bf=[[0.0]], Df=[[1.0]], Bw=[[1.0]], faults=["f"], dt=0.1)
     d0 = afdsyn(m0)
     assert d0.factorization == "standard" and d0.gap == pytest.approx(1.5, rel=1e-8)
+
+
+def _two_residuals(theta: float = 0.0) -> FaultModel:
+    """Rf = U [1; 1], Rw = U diag(1/(s+2), s/(s+3)) (a zero at ∞ and one at 0), U a rotation by ``theta``."""
+    U = np.array([[np.cos(theta), -np.sin(theta)], [np.sin(theta), np.cos(theta)]])
+    return FaultModel(np.diag([-2.0, -3.0]), U @ np.diag([1.0, -3.0]), Bf=np.zeros((2, 1)), Df=U @ [[1.0], [1.0]],
+                      Bw=np.eye(2), Dw=U @ np.diag([0.0, 1.0]), faults=["f"])
+
+
+@pytest.mark.parametrize("theta", [0.0, 0.4])
+def test_two_residuals_wiener_hopf_by_hand(theta):
+    # R_w is its own quasi-co-outer factor; π = −2, −3 (its poles) make R_woe = ±I: Q constant, Rw unchanged,
+    # ‖Rw‖∞ = 1 and ‖Rf‖∞ = √2: gap √2, for the rotated outputs too
+    d = afdsyn(_two_residuals(theta), rdim=2, nonstd="wiener-hopf")
+    assert d.factorization == "wiener-hopf" and d.shifted == 2 and d.order == 0
+    assert d.gap == pytest.approx(np.sqrt(2.0), rel=1e-8)
+    assert hinf_norm(minimal_channel(d.internal_form(), ["w0", "w1"]))[0] == pytest.approx(1.0, rel=1e-8)
+    assert d.gap == pytest.approx(float(fdif2ngap(d.internal_form()).ratio), rel=1e-8)
+
+
+@pytest.mark.parametrize("theta", [0.0, 0.4])
+def test_two_residuals_wiener_hopf_shift_by_brute_force(theta):
+    # δ = −0.1, both kinds of zeros: φ = (s + 0.1)/(1 + 0.1 s), R_wouz(φ) = diag((0.1s+1)/(1.2s+2.1),
+    # (s+0.1)/(1.3s+3.1)); Q = R_wouz(φ)⁻¹ (up to a rotation): Rf = [(1.2s+2.1)/(0.1s+1); (1.3s+3.1)/(s+0.1)],
+    # Rw = diag((1.2s+2.1)/((0.1s+1)(s+2)), s(1.3s+3.1)/((s+0.1)(s+3))); gap by brute force on the jω axis
+    d = afdsyn(_two_residuals(theta), rdim=2, nonstd="wiener-hopf-shift", sdegzer=-0.1)
+    s = 1j * np.concatenate([[0.0], np.logspace(-4, 5, 90001)])
+    f1, f2 = (1.2 * s + 2.1) / (0.1 * s + 1), (1.3 * s + 3.1) / (s + 0.1)
+    w1, w2 = f1 / (s + 2), f2 * s / (s + 3)
+    gap = max(np.sqrt(np.abs(f1) ** 2 + np.abs(f2) ** 2).max(), np.sqrt(12.0 ** 2 + 1.3 ** 2)) / max(
+        np.abs(w1).max(), np.abs(w2).max())
+    assert d.gap == pytest.approx(gap, rel=1e-6)
+    np.testing.assert_allclose(np.sort(d.poles.real), [-10.0, -0.1], rtol=1e-7)
+
+
+def test_two_residuals_wiener_hopf_regularize_by_brute_force():
+    # ε = 0.3: R_woe = I, R_ε = diag(ρ1, ρ2) with |ρi|² = |ui|² + ε², u = (1/(s+2), s/(s+3)):
+    # Rf = [1/ρ1; 1/ρ2], Rw = diag(u1/ρ1, u2/ρ2)
+    d = afdsyn(_two_residuals(), rdim=2, nonstd="wiener-hopf-regularize", epsreg=0.3)
+    s = 1j * np.concatenate([[0.0], np.logspace(-4, 5, 90001)])
+    u1, u2 = np.abs(1 / (s + 2)), np.abs(s / (s + 3))
+    r1, r2 = np.sqrt(u1 ** 2 + 0.09), np.sqrt(u2 ** 2 + 0.09)
+    gap = np.sqrt(1 / r1 ** 2 + 1 / r2 ** 2).max() / max((u1 / r1).max(), (u2 / r2).max())
+    assert d.gap == pytest.approx(gap, rel=1e-6)
+
+
+def test_several_rows_agree_with_the_row_form():
+    # one row through the general two-pass factor equals the one-row polynomial factor (real slowest poles)
+    from fdikit.design.nullspace.wiener_hopf import wiener_hopf
+
+    s = 0.7j
+    for sys in (([[-2.0]], [[1.0]], [[1.0]], [[0.0]]), ([[-2.0]], [[-2.0]], [[1.0]], [[1.0]])):
+        for job in ("plain", "shift", "regularize"):
+            F1, m1 = wiener_hopf_row(*sys, job=job, sdegzer=-0.1, epsreg=0.3)
+            f2 = wiener_hopf(*sys, job=job, sdegzer=-0.1, epsreg=0.3)
+            v1, v2 = (C @ np.linalg.solve(s * np.eye(len(A)) - A, B) + D if len(A) else D
+                      for A, B, C, D in (F1, f2.outer))
+            assert m1 == f2.shifted == 1
+            np.testing.assert_allclose(v2, v1, rtol=1e-9)
+
+
+def test_moebius_substitution():
+    from fdikit.design.nullspace.wiener_hopf import moebius
+
+    A, B, C, D = np.array([[-1.0, 2.0], [0.0, -3.0]]), np.array([[1.0], [1.0]]), np.array([[1.0, 0.5]]), [[0.2]]
+    a, b, c, d = 1.0, 0.1, 0.1, 1.0
+    Ab, Bb, Cb, Db = moebius(A, B, C, D, a, b, c, d)
+    for s in (0.3j, 2.0 + 1j):
+        phi = (a * s + b) / (c * s + d)
+        g = C @ np.linalg.solve(phi * np.eye(2) - A, B) + D
+        gb = Cb @ np.linalg.solve(s * np.eye(2) - Ab, Bb) + Db
+        np.testing.assert_allclose(gb, g, rtol=1e-12)
+    with pytest.raises(ParameterError, match="degenerate"):
+        moebius(A, B, C, D, 1.0, 1.0, 1.0, 1.0)
+    with pytest.raises(ParameterError, match="pole of G"):
+        moebius(A, B, C, D, -1.0, 0.0, 1.0, 1.0)

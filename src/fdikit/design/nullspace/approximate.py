@@ -20,9 +20,9 @@ Plant modes that only the faults or the noise excite are moved out of the intern
 Differences from the reference: the basis is the least-degree polynomial basis over stable denominators
 (:mod:`~fdikit.design.nullspace.basis`), so state coordinates and the design matrices ``H`` differ, and every basis
 pole is assigned (the reference's ``smarg`` acts here on the stabilisation of the internal form and on the zeros
-moved in the ``"quasi"`` case of one row); the Wiener–Hopf cases are implemented for one residual of a continuous
-model, and the quasi factor of several residuals (or of a discrete model) moves zeros at infinity, at 0 and at ±1
-only (a complex boundary pair there is refused: it needs the descriptor ``goifac``/``glcf`` reductions).
+moved in the ``"quasi"`` case of one row); with several residuals (or a discrete model) the quasi and Wiener–Hopf
+factors handle zeros at infinity, at 0 and at ±1 only (a complex boundary pair there is refused: it needs the
+descriptor ``goifac``/``glcf`` reductions; one continuous residual handles it).
 
 References
 ----------
@@ -203,10 +203,11 @@ _NONSTD = ("quasi", "regularize", "wiener-hopf", "wiener-hopf-shift", "wiener-ho
 def _factor(ch, dt, nonstd, epsreg, poles, sdeg, smarg, sdegzer):
     """The noise factor ``F`` of the channel ``ch`` (``Q ← F⁻¹ Q``) and its kind (the reference's ``nonstd``)."""
     from fdikit.design.nullspace.row_factors import wiener_hopf_row
+    from fdikit.design.nullspace.wiener_hopf import wiener_hopf
 
     try:
         return coouter_coinner(ch.A, ch.B, ch.C, ch.D, dt)
-    except DesignError as err:
+    except DesignError:
         if nonstd == "regularize":
             return regularized_coouter(ch.A, ch.B, ch.C, ch.D, dt, epsreg=epsreg)
         if nonstd == "quasi":
@@ -214,14 +215,12 @@ def _factor(ch, dt, nonstd, epsreg, poles, sdeg, smarg, sdegzer):
                 return quasi_coouter(ch.A, ch.B, ch.C, ch.D, dt, poles=poles, sdeg=sdeg)
             return quasi_coouter_row(ch.A, ch.B, ch.C, ch.D, poles=poles, sdeg=-0.05 if sdeg is None else sdeg,
                                      smarg=smarg)
-        if dt is not None:
-            raise DesignError(f"{err}; nonstd={nonstd!r} is implemented for continuous models only: use "
-                              "nonstd='quasi' or 'regularize'") from err
-        if ch.C.shape[0] != 1:
-            raise DesignError(f"{err}; nonstd={nonstd!r} is implemented for one residual only: use "
-                              "nonstd='quasi' or 'regularize', or rdim=1") from err
         job = {"wiener-hopf": "plain", "wiener-hopf-shift": "shift", "wiener-hopf-regularize": "regularize"}[nonstd]
-        F, moved = wiener_hopf_row(ch.A, ch.B, ch.C, ch.D, job=job, sdegzer=sdegzer, epsreg=epsreg)
+        if ch.C.shape[0] > 1 or dt is not None:
+            f = wiener_hopf(ch.A, ch.B, ch.C, ch.D, dt, job=job, sdeg=sdeg, sdegzer=sdegzer, epsreg=epsreg)
+            return CoOuterFactor(f.outer, None, dt, nonstd, f.shifted)
+        F, moved = wiener_hopf_row(ch.A, ch.B, ch.C, ch.D, job=job,
+                                   sdegzer=-0.05 if sdegzer is None else sdegzer, epsreg=epsreg)
         return CoOuterFactor(F, None, None, nonstd, moved)
 
 
@@ -254,7 +253,7 @@ def _nuisance_as_noise(model: FaultModel, nuisance) -> FaultModel:
 
 def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = None, minimal: bool = True,
            poles: Sequence[complex] | None = None, sdeg: float | None = None, gamma: float = 1.0,
-           nonstd: str = "quasi", epsreg: float = 0.1, sdegzer: float = -0.05, smarg: float | None = None,
+           nonstd: str = "quasi", epsreg: float = 0.1, sdegzer: float | None = None, smarg: float | None = None,
            exact: bool = False, fdtol: float = 1e-4,
            fdgaintol: float = 0.01, fdfreq=None, selection=None, tol: float = 1e-9, names=None,
            isolates=None) -> ApproximateDesign:
@@ -280,14 +279,16 @@ def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
         Non-standard case (``R_w`` with zeros at infinity or on the boundary), the reference's ``nonstd = 1 … 5``:
         the quasi factor with those zeros moved to the poles (1), the factor of ``[R_w εI]`` (2), and the
         Wiener–Hopf factor ``X`` of ``R_wo = X R`` (3), with ``R``'s zeros shifted by ``sdegzer`` (4) or ``R``
-        regularised by ``epsreg`` (5), :mod:`~fdikit.design.nullspace.row_factors`.  3–5 for one residual of a
-        continuous model; 1 with several residuals or discrete for zeros at infinity, 0 and ±1
-        (:func:`~fdikit.design.nullspace.factorization.quasi_coouter`).
+        regularised by ``epsreg`` (5): :mod:`~fdikit.design.nullspace.row_factors` for one residual of a
+        continuous model, :mod:`~fdikit.design.nullspace.wiener_hopf` for several residuals or a discrete model.
+        With several residuals or discrete, 1 and 3–5 handle zeros at infinity, 0 and ±1
+        (:func:`~fdikit.design.nullspace.factorization.quasi_coouter`); a complex boundary pair needs 2.
     epsreg : float, default 0.1
         ``ε`` of the regularisations (``nonstd`` "regularize", "wiener-hopf-regularize").
-    sdegzer : float, default -0.05
-        ``δ`` of the zero shift ("wiener-hopf-shift"): boundary zeros ``jω₀`` move to ``(jω₀ + δ)/(1 + jω₀δ)``
-        (``δ`` for ``ω₀ = 0``; ``jω₀ + δ`` without infinite zeros), zeros at infinity to ``1/δ``.
+    sdegzer : float, optional
+        ``δ`` of the zero shift ("wiener-hopf-shift"), default −0.05 (discrete 0.95): boundary zeros ``jω₀`` move
+        to ``(jω₀ + δ)/(1 + jω₀δ)`` (``δ`` for ``ω₀ = 0``; ``jω₀ + δ`` without infinite zeros), zeros at infinity
+        to ``1/δ``; discrete ``z = ±1`` to ``±δ``.
     smarg : float, optional
         Stability margin (default ``−√ε``, discrete ``1 − √ε``): the internal form's poles beyond it are moved to
         ``poles``/``sdeg`` by a left coprime factor, and in the "quasi" case the zeros of the noise factor with real

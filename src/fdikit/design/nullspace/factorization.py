@@ -25,7 +25,9 @@ What is covered
 
 * **Non-standard case, several rows or discrete** (:func:`quasi_coouter`): zeros at infinity and at ``s = 0``
   (discrete ``z = ±1``), removed by row operations on the realisation (row shifts of the infinite zeros and a
-  division by ``λ − λ₀``) and moved to the poles.  Discrete ``D Dᵀ`` singular is the standard case (``R + C X Cᵀ > 0``).
+  division by ``λ − λ₀``, :mod:`~fdikit.design.nullspace.zero_steps`) and moved to the poles; the Wiener–Hopf
+  factors of several rows are in :mod:`~fdikit.design.nullspace.wiener_hopf`.  Discrete ``D Dᵀ`` singular is the
+  standard case (``R + C X Cᵀ > 0``).
 
 Not covered: a complex pair of boundary zeros with several rows or in discrete time (use the regularised form).
 
@@ -46,7 +48,7 @@ import scipy.linalg as sla
 from fdikit.errors import DesignError, ParameterError
 
 __all__ = ["CoOuterFactor", "coouter_coinner", "regularized_coouter", "quasi_coouter_row", "quasi_coouter",
-           "boundary_zeros", "series", "inverse"]
+           "boundary_zeros", "series", "inverse", "realization"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -85,7 +87,27 @@ class CoOuterFactor:
     shifted: int = 0
 
 
-def _abcd(A, B, C, D):
+def realization(A, B, C, D) -> tuple[np.ndarray, ...]:
+    """``(A, B, C, D)`` as float arrays of consistent shapes (an empty ``A`` gives a static gain).
+
+    Parameters
+    ----------
+    A, B, C, D : array_like
+        The matrices.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+
+    Examples
+    --------
+    >>> [M.shape for M in realization([], np.zeros((0, 2)), np.zeros((1, 0)), [[1.0, 2.0]])]
+    [(0, 0), (0, 2), (1, 0), (1, 2)]
+
+    References
+    ----------
+    Varga (2017), §7.3.
+    """
     A, B, C, D = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (A, B, C, D))
     n = A.shape[0] if A.size else 0
     p, m = D.shape
@@ -121,8 +143,8 @@ def series(first, second):
     ----------
     Varga (2017), §7.3 (operations on state-space realisations).
     """
-    A1, B1, C1, D1 = _abcd(*first)
-    A2, B2, C2, D2 = _abcd(*second)
+    A1, B1, C1, D1 = realization(*first)
+    A2, B2, C2, D2 = realization(*second)
     n1, n2 = A1.shape[0], A2.shape[0]
     A = np.block([[A1, np.zeros((n1, n2))], [B2 @ C1, A2]])
     B = np.vstack([B1, B2 @ D1])
@@ -156,7 +178,7 @@ def inverse(A, B, C, D):
     ----------
     Varga (2017), §7.3 (inverse systems).
     """
-    A, B, C, D = _abcd(A, B, C, D)
+    A, B, C, D = realization(A, B, C, D)
     if D.shape[0] != D.shape[1]:
         raise DesignError(f"only a square system is inverted here, got {D.shape}")
     s = np.linalg.svd(D, compute_uv=False)
@@ -199,7 +221,7 @@ def boundary_zeros(A, B, C, D, dt: float | None = None, *, tol: float = 1e-7) ->
     ----------
     Varga (2017), §7.9 (the standard case of the factorisation); Zhou, Doyle and Glover (1996), §13.7.
     """
-    A, B, C, D = _abcd(A, B, C, D)
+    A, B, C, D = realization(A, B, C, D)
     n = A.shape[0]
     if not n:
         return np.zeros(0, complex)
@@ -260,7 +282,7 @@ def coouter_coinner(A, B, C, D, dt: float | None = None, *, tol: float = 1e-7) -
     ----------
     Varga (2017), §7.9; fdtools (``goifac``); Zhou, Doyle and Glover (1996), Thm. 13.34 (dual form).
     """
-    A, B, C, D = _abcd(A, B, C, D)
+    A, B, C, D = realization(A, B, C, D)
     n, p, m = A.shape[0], D.shape[0], D.shape[1]
     sv = np.linalg.svd(D, compute_uv=False)
     full = p <= m and sv.size and sv[-1] > tol * max(sv[0], 1e-300)
@@ -343,7 +365,7 @@ def regularized_coouter(A, B, C, D, dt: float | None = None, *, epsreg: float = 
     from fdikit import validate
 
     eps = validate.positive("epsreg", epsreg)
-    A, B, C, D = _abcd(A, B, C, D)
+    A, B, C, D = realization(A, B, C, D)
     p = D.shape[0]
     f = coouter_coinner(A, np.hstack([B, np.zeros((A.shape[0], p))]), C, np.hstack([D, eps * np.eye(p)]), dt)
     return CoOuterFactor(f.outer, None, dt, "regularized")
@@ -403,7 +425,7 @@ def quasi_coouter_row(A, B, C, D, *, poles: Sequence[complex] | None = None, sde
     from fdikit.design.nullspace.basis import denominator
     from fdikit.design.nullspace.row_factors import realize_biproper, row_spectrum
 
-    A, B, C, D = _abcd(A, B, C, D)
+    A, B, C, D = realization(A, B, C, D)
     if C.shape[0] != 1:
         raise ParameterError(f"quasi_coouter_row factors one row, got {C.shape[0]} rows")
     spec = row_spectrum(A, B, C, D, tol=tol)
@@ -471,45 +493,13 @@ def quasi_coouter(A, B, C, D, dt: float | None = None, *, poles: Sequence[comple
     ----------
     Varga (2017), §5.3 (the quasi-co-outer factor, ``nonstd = 1``), §7.9.
     """
-    from fdikit.design.nullspace.basis import default_sdeg
+    from fdikit.design.nullspace.zero_steps import remove_boundary_zeros
 
-    A, B, C, D = _abcd(A, B, C, D)
-    n, p = A.shape[0], D.shape[0]
-    C, D = C.copy(), D.copy()
-    sdeg = default_sdeg(dt) if sdeg is None else float(sdeg)
-    pis = [complex(x) for x in np.ravel(poles)] if poles is not None else []
-    stable = (lambda x: x.real < 0) if dt is None else (lambda x: abs(x) < 1)
-    if any(abs(x.imag) > 0 or not stable(x) for x in pis) or not stable(complex(sdeg)):
-        raise ParameterError(f"the poles of the moved zeros must be real and stable, got {pis or sdeg}")
-    moved = 0
-    R = np.eye(p)                                   # the rotations: G = R (T̃ G) with T̃ the row shifts undone
-    scale = max(1.0, np.linalg.norm(np.block([[A, B], [C, D]]), 2))
-    for _ in range(n + p + 1):
-        pi = pis[moved].real if moved < len(pis) else sdeg
-        if dt is None:
-            U, sv, _ = np.linalg.svd(D)
-            r = int(np.sum(sv > tol * scale))
-            if r < p:
-                C, D, R = U.T @ C, U.T @ D, R @ U
-                D[r:] = 0.0
-                for i in range(r, p):
-                    C[i], D[i] = C[i] @ (A - pi * np.eye(n)), C[i] @ B
-                    moved += 1
-                continue
-        try:
-            Ao, Bo, Co, Do = coouter_coinner(A, B, C, D, dt, tol=tol).outer
-            return CoOuterFactor((Ao, Bo, R @ Co, R @ Do), None, dt, "quasi", moved)
-        except DesignError as err:
-            reason = err
-        for lam in ([0.0] if dt is None else [1.0, -1.0]):
-            M = np.linalg.inv(lam * np.eye(n) - A)
-            W, s0, _ = np.linalg.svd(C @ M @ B + D)
-            if s0[-1] <= tol * max(1.0, s0[0]):     # G(λ₀) loses rank: a zero there
-                break
-        else:
-            raise DesignError(f"{reason}; the quasi factorisation moves zeros at infinity and at "
-                              f"{'0' if dt is None else '±1'} only: use nonstd='regularize'")
-        C, D, R = W.T @ C, W.T @ D, R @ W           # the last row is the left null vector's: r(λ₀) = 0
-        C[-1], D[-1] = -C[-1] @ (A - pi * np.eye(n)) @ M, -C[-1] @ M @ B
-        moved += 1
-    raise DesignError("the zeros on the boundary could not be removed: G has no full row rank")
+    A, B, C, D = realization(A, B, C, D)
+    C1, D1, steps = remove_boundary_zeros(A, B, C, D, dt, poles=poles, sdeg=sdeg, tol=tol)
+    W = np.eye(D.shape[0])
+    for st in steps:
+        W = W @ st.rotation
+    Ao, Bo, Co, Do = coouter_coinner(A, B, C1, D1, dt, tol=tol).outer
+    return CoOuterFactor((Ao, Bo, W @ Co, W @ Do), None, dt, "quasi", sum(len(st.rows) for st in steps))
+
