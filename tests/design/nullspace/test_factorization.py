@@ -143,10 +143,56 @@ def test_quasi_factor_of_two_rows_is_rotation_equivariant():
         np.testing.assert_allclose(svu, sv, rtol=1e-9, atol=1e-12)
 
 
-def test_quasi_factor_of_rows_refuses_complex_boundary_zeros():
-    # s²+1 over (s+1)²: zeros at ±j
+def _tf_realization(num, den, dt=None):
+    """A minimal realisation of a 2 × 2 transfer matrix (python-control)."""
+    import control
+
+    G = control.minreal(control.ss(control.tf(num, den, 0 if dt is None else dt)), verbose=False)
+    return G.A, G.B, G.C, G.D
+
+
+def test_quasi_factor_of_a_complex_boundary_pair():
+    # one row (s²+1)/(s+1)²: the row operations (a division by s²+1) and the polynomial factor agree; with two rows
+    # diag((s²+1)/(s+1)², 1/(s+3)): F = diag((s+3)²/(s+1)², (s+3)/(s+3)) at π = −3, up to a unitary constant
     A, B, C, D = np.array([[-2.0, -1.0], [1.0, 0.0]]), np.array([[1.0], [0.0]]), np.array([[-2.0, 0.0]]), [[1.0]]
-    with pytest.raises(DesignError, match="at infinity and at 0 only"):
-        quasi_coouter(np.kron(np.eye(2), A), np.kron(np.eye(2), B), np.kron(np.eye(2), C), np.eye(2), sdeg=-1.0)
+    a, b = quasi_coouter(A, B, C, D, sdeg=-3.0), quasi_coouter_row(A, B, C, D, sdeg=-3.0)
+    assert a.shifted == b.shifted == 2
+    for w in (0.0, 0.3, 1.0, 7.0):
+        assert abs(_response(a.outer, w)[0, 0]) == pytest.approx(abs(_response(b.outer, w)[0, 0]), rel=1e-9)
+    from scipy.linalg import block_diag
+
+    A2, B2, C2, D2 = block_diag(A, [[-3.0]]), block_diag(B, [[1.0]]), block_diag(C, [[1.0]]), np.diag([1.0, 0.0])
+    f = quasi_coouter(A2, B2, C2, D2, sdeg=-3.0)
+    assert f.shifted == 3
+    for w in (0.0, 0.5, 2.0, 20.0):
+        s = 1j * w
+        F = np.diag([(s + 3) ** 2 / (s + 1) ** 2, 1.0])
+        Fh = _response(f.outer, w)
+        np.testing.assert_allclose(Fh @ Fh.conj().T, F @ F.conj().T, rtol=1e-9, atol=1e-12)
     with pytest.raises(ParameterError, match="real and stable"):
         quasi_coouter(A, B, C, D, poles=[-1 + 1j])
+
+
+@pytest.mark.parametrize("dt", [None, 0.1])
+def test_zero_steps_of_a_complex_pair_on_two_rows(dt):
+    # G = [[q/((λ−a)(λ−b)), 1/(λ−c)], [0, 1/(λ−d)]] with q vanishing at λ₀, λ̄₀ on the boundary (±j; discrete e^{±j}):
+    # the left null vector at λ₀ is complex, so the pair is removed on two rows; T⁻¹ G₁ = G and G₁ is standard
+    from fdikit.design.nullspace.zero_steps import remove_boundary_zeros, zero_steps_inverse
+
+    if dt is None:
+        q, dens, pts = [1, 0, 1], ([1, 3, 2], [1, 7, 12], [1, 3]), (0.3j, 1j, 2.0, 5j)
+    else:
+        q, dens, pts = [1, -2 * np.cos(1.0), 1], ([1, -0.8, 0.15], [1, -0.2], [1, -0.4]), (np.exp(0.3j), np.exp(1j),
+                                                                                            0.9, -0.7)
+    sys = _tf_realization([[q, [1]], [[0], [1]]], [[dens[0], dens[1]], [[1], dens[2]]], dt)
+    C1, D1, steps = remove_boundary_zeros(*sys, dt, sdeg=-2.0 if dt is None else 0.5)
+    pair = [st for st in steps if st.mix is not None]
+    assert len(pair) == 1 and pair[0].rows == (0, 1) and pair[0].poles == ((-2.0, -2.0) if dt is None else (0.5, 0.5))
+    assert abs(pair[0].zero - (1j if dt is None else np.exp(1j))) < 1e-12
+    Ti = zero_steps_inverse(steps, 2, dt)
+    assert np.linalg.eigvals(Ti[0]) == pytest.approx(np.full(Ti[0].shape[0], -2.0 if dt is None else 0.5), abs=1e-6)
+    for lam in pts:
+        G = _resp(sys, lam)
+        np.testing.assert_allclose(_resp(Ti, lam) @ _resp((sys[0], sys[1], C1, D1), lam), G, rtol=0,
+                                   atol=1e-12 * np.abs(G).max())
+    assert coouter_coinner(sys[0], sys[1], C1, D1, dt).kind == "standard"

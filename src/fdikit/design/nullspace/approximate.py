@@ -21,8 +21,9 @@ Differences from the reference: the basis is the least-degree polynomial basis o
 (:mod:`~fdikit.design.nullspace.basis`), so state coordinates and the design matrices ``H`` differ, and every basis
 pole is assigned (the reference's ``smarg`` acts here on the stabilisation of the internal form and on the zeros
 moved in the ``"quasi"`` case of one row); with several residuals (or a discrete model) the quasi and Wiener–Hopf
-factors handle zeros at infinity, at 0 and at ±1 only (a complex boundary pair there is refused: it needs the
-descriptor ``goifac``/``glcf`` reductions; one continuous residual handles it).
+factors are built by row operations on the realisation (:mod:`~fdikit.design.nullspace.zero_steps`), not by the
+reference's descriptor reductions (``goifac``, ``gcrange``, ``glcf``): another member of the same family of
+factors, so the quasi gaps need not be equal.
 
 References
 ----------
@@ -281,8 +282,8 @@ def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
         Wiener–Hopf factor ``X`` of ``R_wo = X R`` (3), with ``R``'s zeros shifted by ``sdegzer`` (4) or ``R``
         regularised by ``epsreg`` (5): :mod:`~fdikit.design.nullspace.row_factors` for one residual of a
         continuous model, :mod:`~fdikit.design.nullspace.wiener_hopf` for several residuals or a discrete model.
-        With several residuals or discrete, 1 and 3–5 handle zeros at infinity, 0 and ±1
-        (:func:`~fdikit.design.nullspace.factorization.quasi_coouter`); a complex boundary pair needs 2.
+        With several residuals or discrete, 1 is
+        :func:`~fdikit.design.nullspace.factorization.quasi_coouter`.
     epsreg : float, default 0.1
         ``ε`` of the regularisations (``nonstd`` "regularize", "wiener-hopf-regularize").
     sdegzer : float, optional

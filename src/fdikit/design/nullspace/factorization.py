@@ -23,13 +23,12 @@ What is covered
 * **Regularised case** (:func:`regularized_coouter`): the co-outer factor of ``[G  εI]`` (Varga 2017, Remark 5.8;
   reference ``nonstd = 2``), always standard.
 
-* **Non-standard case, several rows or discrete** (:func:`quasi_coouter`): zeros at infinity and at ``s = 0``
-  (discrete ``z = ±1``), removed by row operations on the realisation (row shifts of the infinite zeros and a
-  division by ``λ − λ₀``, :mod:`~fdikit.design.nullspace.zero_steps`) and moved to the poles; the Wiener–Hopf
-  factors of several rows are in :mod:`~fdikit.design.nullspace.wiener_hopf`.  Discrete ``D Dᵀ`` singular is the
-  standard case (``R + C X Cᵀ > 0``).
+* **Non-standard case, several rows or discrete** (:func:`quasi_coouter`): zeros at infinity and on the
+  boundary, removed by row operations on the realisation (row shifts of the infinite zeros, divisions by
+  ``λ − λ₀`` or by ``(λ − λ₀)(λ − λ̄₀)``, :mod:`~fdikit.design.nullspace.zero_steps`) and moved to the poles;
+  the Wiener–Hopf factors of several rows are in :mod:`~fdikit.design.nullspace.wiener_hopf`.  Discrete ``D Dᵀ``
+  singular is the standard case (``R + C X Cᵀ > 0``).
 
-Not covered: a complex pair of boundary zeros with several rows or in discrete time (use the regularised form).
 
 References
 ----------
@@ -439,13 +438,12 @@ def quasi_coouter_row(A, B, C, D, *, poles: Sequence[complex] | None = None, sde
 
 def quasi_coouter(A, B, C, D, dt: float | None = None, *, poles: Sequence[complex] | None = None,
                   sdeg: float | None = None, tol: float = 1e-7) -> CoOuterFactor:
-    """The shifted quasi-co-outer factor of a stable ``G`` with zeros at infinity or at ``s = 0`` (``z = ±1``).
+    """The shifted quasi-co-outer factor of a stable ``G`` with zeros at infinity or on the stability boundary.
 
-    ``G`` (``p × m``, full row rank) is reduced, on its own ``(A, B)``, to ``G₁ = T(λ) G`` without those zeros.
-    Continuous: while ``D`` lacks full row rank, the rows of its left null space are multiplied by ``(s − π)``
-    (``C_i ← C_i (A − πI)``, ``D_i ← C_i B``).  Then, for each zero ``λ₀`` (0; discrete ``±1``),
-    the row of a left null vector of ``G(λ₀)``, ``r(λ)`` with ``r(λ₀) = 0``, becomes ``(λ − π) r(λ) / (λ − λ₀)``
-    (``C_i ← −C_i (A − πI)(λ₀I − A)⁻¹``, ``D_i ← −C_i (λ₀I − A)⁻¹ B``).  ``T⁻¹`` is stable and proper, so
+    ``G`` (``p × m``, full row rank) is reduced, on its own ``(A, B)``, to ``G₁ = T(λ) G`` without those zeros
+    (:func:`~fdikit.design.nullspace.zero_steps.remove_boundary_zeros`: row shifts for the zeros at infinity, and
+    divisions of the rows of the left null vectors by ``λ − λ₀``, or by ``(λ − λ₀)(λ − λ̄₀)`` for a complex pair,
+    with the moved zeros placed at ``π``).  ``T⁻¹`` is stable and proper, so
     ``T⁻¹ G₁ₒ`` is the quasi-co-outer factor of ``G``; the returned ``F = W G₁ₒ`` (``G₁ₒ`` the standard co-outer
     factor of ``G₁``, ``W`` the product of the orthogonal row rotations of the steps, so that ``F`` of ``U G`` is
     ``U F`` for a constant rotation ``U``) is biproper, stable and minimum phase with the moved zeros at the poles
@@ -475,8 +473,7 @@ def quasi_coouter(A, B, C, D, dt: float | None = None, *, poles: Sequence[comple
     Raises
     ------
     DesignError
-        ``G`` without full row rank, or zeros on the boundary elsewhere (complex pairs are not implemented: use
-        the regularised factor).
+        ``G`` without full row rank.
     ParameterError
         Unstable or complex ``poles``.
 
@@ -501,5 +498,5 @@ def quasi_coouter(A, B, C, D, dt: float | None = None, *, poles: Sequence[comple
     for st in steps:
         W = W @ st.rotation
     Ao, Bo, Co, Do = coouter_coinner(A, B, C1, D1, dt, tol=tol).outer
-    return CoOuterFactor((Ao, Bo, W @ Co, W @ Do), None, dt, "quasi", sum(len(st.rows) for st in steps))
+    return CoOuterFactor((Ao, Bo, W @ Co, W @ Do), None, dt, "quasi", sum(len(st.poles) for st in steps))
 

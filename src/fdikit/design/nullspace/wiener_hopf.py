@@ -16,7 +16,6 @@ of ``[R_wouz εI]`` (``nonstd = 5``).  Here, in two passes of the row operations
    row with real slowest poles the two agree (tested).
 
 The returned ``F`` is the factor to invert, ``Q ← F⁻¹ Q``: ``R_woe``, ``R_woe R_wouz(φ)`` or ``R_woe R_ε``.
-Not covered: a complex pair of boundary zeros (as for the quasi factor; the one-row form handles it).
 
 References
 ----------
@@ -115,7 +114,7 @@ def wiener_hopf(A, B, C, D, dt: float | None = None, *, job: str = "plain", pole
     Parameters
     ----------
     A, B, C, D : array_like
-        A stable realisation of ``R_w`` (full row rank), with zeros at infinity or at ``s = 0`` (``z = ±1``).
+        A stable realisation of ``R_w`` (full row rank), with zeros at infinity or on the stability boundary.
     dt : float or None
         Sample time.
     job : {"plain", "shift", "regularize"}, default "plain"
@@ -145,7 +144,7 @@ def wiener_hopf(A, B, C, D, dt: float | None = None, *, job: str = "plain", pole
     ParameterError
         Bad ``job``, ``sdegzer`` or ``epsreg``.
     DesignError
-        ``R_w`` without full row rank, or a complex pair of boundary zeros.
+        ``R_w`` without full row rank.
 
     Examples
     --------
@@ -176,7 +175,7 @@ def wiener_hopf(A, B, C, D, dt: float | None = None, *, job: str = "plain", pole
     At, Bt, Ct, Dt = _transpose(rwo)
     C2, D2, steps2 = remove_boundary_zeros(At, Bt, Ct, Dt, dt, poles=pis, sdeg=sdeg, tol=tol)
     rwoe = _transpose((At, Bt, C2, D2))
-    moved = sum(len(st.rows) for st in steps2)
+    moved = sum(len(st.poles) for st in steps2)
     if job == "plain" or not moved:
         return CoOuterFactor(rwoe, None, dt, "wiener-hopf", moved)
     rwouz = _transpose(zero_steps_inverse(steps2, p, dt))
