@@ -9,6 +9,8 @@
   equation), the quasi factor of one row, the regularised factor.
 * :mod:`fdikit.design.nullspace.row_factors` — spectral data and Wiener–Hopf factors of one noise row (the
   reference's ``nonstd = 3, 4, 5``).
+* :mod:`fdikit.design.nullspace.zero_steps` — removal of zeros at infinity and on the boundary by row operations.
+* :mod:`fdikit.design.nullspace.wiener_hopf` — Wiener–Hopf factors of several noise rows or of discrete models.
 * :mod:`fdikit.design.nullspace.approximate` — ``afdsyn`` / ``afdisyn``: the fault-to-noise gap maximised under
   ``‖R_w‖∞ = γ`` (Procedures AFD, AFDI).
 * :mod:`fdikit.design.nullspace.specs` — ``fdigenspec`` (all achievable structure matrix rows) and ``fdichkspec``
@@ -26,9 +28,11 @@ __getattr__, __dir__, __all__ = lazy.attach(
         "detectability": ["fault_response", "frequency_points", "row_structure"],
         "approximate": ["ApproximateBankDesign", "ApproximateDesign", "afdisyn", "afdsyn"],
         "factorization": [
-            "CoOuterFactor", "boundary_zeros", "coouter_coinner", "inverse", "quasi_coouter_row", "regularized_coouter",
-            "series",
+            "CoOuterFactor", "boundary_zeros", "coouter_coinner", "inverse", "quasi_coouter", "quasi_coouter_row",
+            "realization", "regularized_coouter", "series",
         ],
+        "zero_steps": ["ZeroStep", "remove_boundary_zeros", "zero_steps_inverse"],
+        "wiener_hopf": ["WIENER_HOPF_JOBS_SEVERAL", "moebius", "wiener_hopf"],
         "row_factors": ["RowSpectrum", "WIENER_HOPF_JOBS", "realize_biproper", "row_spectrum", "wiener_hopf_row"],
         "exact": ["NullspaceBankDesign", "NullspaceDesign", "bank_rows", "efdisyn", "efdsyn", "split_faults"],
         "specs": ["SpecificationCheck", "fdichkspec", "fdigenspec", "joint_order"],
