@@ -11,6 +11,9 @@
   reference's ``nonstd = 3, 4, 5``).
 * :mod:`fdikit.design.nullspace.zero_steps` — removal of zeros at infinity and on the boundary by row operations.
 * :mod:`fdikit.design.nullspace.wiener_hopf` — Wiener–Hopf factors of several noise rows or of discrete models.
+* :mod:`fdikit.design.nullspace.model_distances` — ``mddist``: ν-gap, L∞ and L2 distances between models.
+* :mod:`fdikit.design.nullspace.model_detection` — ``mdgenspec``, ``emdsyn`` (exact model detection, Procedure
+  EMD) and ``mdmatch``.
 * :mod:`fdikit.design.nullspace.approximate` — ``afdsyn`` / ``afdisyn``: the fault-to-noise gap maximised under
   ``‖R_w‖∞ = γ`` (Procedures AFD, AFDI).
 * :mod:`fdikit.design.nullspace.specs` — ``fdigenspec`` (all achievable structure matrix rows) and ``fdichkspec``
@@ -33,6 +36,8 @@ __getattr__, __dir__, __all__ = lazy.attach(
         ],
         "zero_steps": ["ZeroStep", "remove_boundary_zeros", "zero_steps_inverse"],
         "wiener_hopf": ["WIENER_HOPF_JOBS_SEVERAL", "moebius", "wiener_hopf"],
+        "model_distances": ["MODEL_DISTANCES", "ModelDistances", "check_models", "mddist", "nu_gap"],
+        "model_detection": ["ModelDetectionDesign", "difference_model", "emdsyn", "mdgenspec", "mdmatch"],
         "row_factors": ["RowSpectrum", "WIENER_HOPF_JOBS", "realize_biproper", "row_spectrum", "wiener_hopf_row"],
         "exact": ["NullspaceBankDesign", "NullspaceDesign", "bank_rows", "efdisyn", "efdsyn", "split_faults"],
         "specs": ["SpecificationCheck", "fdichkspec", "fdigenspec", "joint_order"],

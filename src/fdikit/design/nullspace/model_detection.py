@@ -1,0 +1,345 @@
+"""Exact model detection by the nullspace method: ``mdgenspec`` and ``emdsyn`` (Varga 2017, §6.2, Procedure EMD).
+
+A bank of ``N`` filters for a multiple model ``{G^(i)}`` (same outputs and controls): filter ``j`` lies in the left
+nullspace of model ``j``'s ``[G_u^(j) G_d^(j); I 0]``, so its residual vanishes when the plant behaves as model
+``j``, and it should not vanish under model ``i ≠ j``: ``R_ji = Q_j [G_u^(i) G_d^(i); I 0] ≢ 0``.  Because
+``Q_j`` decouples model ``j``'s controls, ``R_ji``'s control part is ``Q_y (G_u^(i) − G_u^(j))``, so model ``i`` is
+detected by a basis row of model ``j`` exactly when that row detects the "fault" ``G_u^(i) − G_u^(j)`` (and, with
+``emdtest``, ``G_d^(i)``): the weak and strong tests of
+:func:`~fdikit.design.nullspace.detectability.row_structure` apply unchanged to that difference model.
+
+``emdsyn`` takes, per model, the basis rows of least degree that detect every other model, one fixed generic
+combination of them over one stable denominator (the model's own poles inside ``smarg``, as the reference's proper
+basis keeps them, then ``poles``/``sdeg``), and scales the filter as the reference does:
+the smallest ``‖R_ji‖∞`` over ``i ≠ j`` is 1 (``normalize=False``), or ``‖R_j0‖ = ‖R_0j‖`` (``normalize=True``).
+``performance[j, i]`` is ``‖R_ji‖∞`` of the control channel (with ``emdtest`` of ``[u d]``), or the largest gain
+at ``mdfreq``.
+
+References
+----------
+Varga (2017), §6.1–6.2 (model detection, Procedure EMD); Varga, CDC 2009 (least order model detection);
+fdtools (``emdsyn``, ``mdgenspec``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from fdikit.errors import DesignError
+from fdikit.model import FaultModel
+from fdikit.residuals import ResidualGenerator
+
+__all__ = ["ModelDetectionDesign", "difference_model", "mdgenspec", "emdsyn", "mdmatch"]
+
+
+@dataclass(frozen=True, eq=False)
+class ModelDetectionDesign:
+    """A bank of exact model detection filters.
+
+    Attributes
+    ----------
+    generators : tuple of ResidualGenerator
+        Filter ``j`` (residual ``r<j>``), reading ``[u; y]``.
+    performance : numpy.ndarray
+        ``(N, N)``: ``performance[j, i]`` the gain of filter ``j`` under model ``i`` (reference ``MDperf``).
+    degrees : tuple of int
+        The basis degree used per filter (its order).
+    models : tuple of FaultModel
+        The multiple model.
+
+    Examples
+    --------
+    >>> m1, m2 = FaultModel([[-1.0]], [[1.0]], Bu=[[1.0]]), FaultModel([[-2.0]], [[2.0]], Bu=[[1.0]])
+    >>> d = emdsyn([m1, m2], sdeg=-3.0)
+    >>> d.degrees, np.round(d.performance, 6).tolist()
+    ((1, 1), [[0.0, 1.0], [1.0, 0.0]])
+
+    References
+    ----------
+    Varga (2017), §6.2; fdtools (``emdsyn``, ``info.MDperf``).
+    """
+
+    generators: tuple[ResidualGenerator, ...]
+    performance: np.ndarray
+    degrees: tuple[int, ...]
+    models: tuple[FaultModel, ...]
+
+    @property
+    def orders(self) -> tuple[int, ...]:
+        """The filters' state dimensions."""
+        return tuple(g.n for g in self.generators)
+
+
+def difference_model(model_j: FaultModel, model_i: FaultModel, *, emdtest: bool = False) -> FaultModel:
+    """``G_u^(i) − G_u^(j)`` (and ``G_d^(i)`` with ``emdtest``) as the fault channels of a model with ``j``'s signals.
+
+    A filter that decouples model ``j``'s controls sees model ``i`` through these "faults" only (its control inputs
+    carry nothing here: ``B_u = 0``, ``D_u = 0``).
+
+    Parameters
+    ----------
+    model_j, model_i : FaultModel
+        Models with the same outputs and controls.
+    emdtest : bool, default False
+        Include model ``i``'s disturbance channels.
+
+    Returns
+    -------
+    FaultModel
+        States ``[x_i; x_j]``; faults ``delta_<control>`` (and ``model_<disturbance>``).
+
+    Examples
+    --------
+    >>> m1, m2 = FaultModel([[-1.0]], [[1.0]], Bu=[[1.0]]), FaultModel([[-2.0]], [[2.0]], Bu=[[1.0]])
+    >>> difference_model(m1, m2).faults
+    ('delta_u0',)
+
+    References
+    ----------
+    Varga (2017), §6.1 (model detectability).
+    """
+    from scipy.linalg import block_diag
+
+    mu, kd = len(model_i.controls), len(model_i.disturbances) if emdtest else 0
+    Bi, Di = model_i.B[:, : mu + kd], model_i.D[:, : mu + kd]
+    Bj = np.hstack([model_j.B[:, :mu], np.zeros((model_j.n, kd))])
+    Dj = np.hstack([model_j.D[:, :mu], np.zeros((model_j.D.shape[0], kd))])
+    n = model_i.n + model_j.n
+    faults = [f"delta_{c}" for c in model_i.controls] + [f"model_{d}" for d in model_i.disturbances[:kd]]
+    return FaultModel(block_diag(model_i.A, model_j.A), np.hstack([model_i.C, -model_j.C]),
+                      Bu=np.zeros((n, mu)), Du=np.zeros((model_i.C.shape[0], mu)), Bf=np.vstack([Bi, Bj]),
+                      Df=Di - Dj, controls=model_j.controls, outputs=model_j.outputs, faults=faults, dt=model_j.dt)
+
+
+def _row_tests(models, j, basis, dens, mdtol, mdfreq, mdgaintol, emdtest) -> np.ndarray:
+    """``(rows, N)``: which basis rows of model ``j`` detect each model (False on the diagonal)."""
+    from fdikit.design.nullspace.detectability import row_structure
+
+    out = np.zeros((len(basis.rows), len(models)), dtype=bool)
+    for i, mi in enumerate(models):
+        if i == j:
+            continue
+        dm = difference_model(models[j], mi, emdtest=emdtest)
+        # weak, or strong at some frequency of mdfreq (reference: detected at one of them suffices)
+        freqs = [None] if mdfreq is None else list(np.atleast_1d(np.asarray(mdfreq, dtype=float)))
+        for f in freqs:
+            S = row_structure(dm, basis, dm.faults, fdtol=mdtol, fdfreq=f, fdgaintol=mdgaintol, dens=dens)
+            out[:, i] |= S.any(axis=1)         # some channel of model i
+    return out
+
+
+def mdgenspec(models: Sequence[FaultModel], *, mdtol: float = 1e-4, mdfreq=None, mdgaintol: float = 0.01,
+              emdtest: bool = False) -> np.ndarray:
+    """The achievable model detection structure: ``S[j, i]`` — can a filter of model ``j`` detect model ``i``?
+
+    Parameters
+    ----------
+    models : sequence of FaultModel
+        The multiple model (:func:`~fdikit.design.nullspace.model_distances.check_models`).
+    mdtol : float, default 1e-4
+        Relative threshold of weak detectability (reference ``MDtol``).
+    mdfreq : float or sequence of float, optional
+        Frequencies (rad/s) of strong detectability (reference ``MDfreq``): model ``i`` counts as detected when the
+        gain exceeds ``mdgaintol`` at one of them.
+    mdgaintol : float, default 0.01
+        Gain threshold of strong detectability, on the basis rows over the default denominators (``MDGainTol``).
+    emdtest : bool, default False
+        Test the disturbance channels of model ``i`` too.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(N, N)`` booleans, False on the diagonal.
+
+    Raises
+    ------
+    ParameterError
+        Bad models.
+
+    Examples
+    --------
+    >>> m1, m2 = FaultModel([[-1.0]], [[1.0]], Bu=[[1.0]]), FaultModel([[-2.0]], [[2.0]], Bu=[[1.0]])
+    >>> mdgenspec([m1, m2]).tolist(), mdgenspec([m1, m2], mdfreq=0).tolist()   # equal DC gains
+    ([[False, True], [True, False]], [[False, False], [False, False]])
+
+    References
+    ----------
+    Varga (2017), §6.1; fdtools (``mdgenspec``).
+    """
+    from fdikit.design.nullspace.basis import denominator, left_nullspace
+    from fdikit.design.nullspace.model_distances import check_models
+
+    models = check_models(models)
+    S = np.zeros((len(models), len(models)), dtype=bool)
+    for j, mj in enumerate(models):
+        basis = left_nullspace(mj)
+        if not basis.rows:
+            continue
+        dens = [denominator(nu, None, None, mj.dt) for nu in basis.degrees]
+        S[j] = _row_tests(models, j, basis, dens, mdtol, mdfreq, mdgaintol, emdtest).any(axis=0)
+    return S
+
+
+def _gain(gen: ResidualGenerator, dm: FaultModel, mdfreq) -> float:
+    from fdikit.analysis.channels import frequency_response, hinf_norm, minimal_channel
+
+    ch = minimal_channel(gen.internal_form(dm), list(dm.faults))
+    if mdfreq is None:
+        return float(hinf_norm(ch)[0])
+    G = frequency_response(ch, np.atleast_1d(np.asarray(mdfreq, dtype=float)))
+    return float(max(np.linalg.norm(g, 2) for g in G))
+
+
+def _filter_poles(model: FaultModel, degree: int, poles, sdeg, smarg) -> list[complex]:
+    """The ``degree`` filter poles: the model's own poles inside the margin (slowest first, conjugate pairs kept
+    together), as the reference's proper basis keeps them and moves only the others, then ``poles``, then ``sdeg``."""
+    from fdikit.design.nullspace.basis import default_sdeg, minimal_realization
+
+    cols = list(range(len(model.controls) + len(model.disturbances)))
+    A = minimal_realization(model.A, model.B[:, cols], model.C, model.D[:, cols])[0] if model.n else np.zeros((0, 0))
+    ev = np.linalg.eigvals(A) if A.size else np.zeros(0, complex)
+    if model.dt is None:
+        margin = -np.sqrt(np.finfo(float).eps) if smarg is None else float(smarg)
+        inside, slow = ev[ev.real < margin], lambda x: -x.real
+    else:
+        margin = 1 - np.sqrt(np.finfo(float).eps) if smarg is None else float(smarg)
+        inside, slow = ev[np.abs(ev) < margin], lambda x: -abs(x)
+    chosen: list[complex] = []
+    for x in sorted((x for x in inside if x.imag >= 0), key=slow):
+        k = 1 if x.imag == 0 else 2
+        if len(chosen) + k <= degree:
+            chosen += [complex(x)] if k == 1 else [complex(x), complex(np.conj(x))]
+    fill = list(poles) if poles is not None else []
+    s0 = default_sdeg(model.dt) if sdeg is None else float(sdeg)
+    return (chosen + fill + [s0] * degree)[:degree]
+
+
+def emdsyn(models: Sequence[FaultModel], *, poles: Sequence[complex] | None = None, sdeg: float | None = None,
+           smarg: float | None = None, mdtol: float = 1e-4, mdfreq=None, mdgaintol: float = 0.01,
+           emdtest: bool = False, normalize: bool = False) -> ModelDetectionDesign:
+    """Exact model detection filters of least order, one per model (Procedure EMD; reference ``emdsyn``).
+
+    Parameters
+    ----------
+    models : sequence of FaultModel
+        The multiple model: same outputs, controls and sample time; disturbances may differ.
+    poles : sequence of complex, optional
+        Filter poles for the places the model's own poles do not fill (see ``smarg``); then ``sdeg``.
+    sdeg : float, optional
+        Stability degree of the remaining poles (default −0.05, discrete 0.95).
+    smarg : float, optional
+        Stability margin (default ``−√ε``, discrete ``1 − √ε``): the model's poles inside it are the filter's first
+        poles (slowest first), as the reference's proper basis keeps its poles there and moves only the others.
+    mdtol, mdfreq, mdgaintol, emdtest
+        As :func:`mdgenspec`; ``mdfreq`` also sets where ``performance`` is evaluated.
+    normalize : bool, default False
+        False: each filter's smallest off-diagonal gain is 1.  True: filter 0 so, and filter ``j`` such that
+        ``performance[j, 0] = performance[0, j]``.
+
+    Returns
+    -------
+    ModelDetectionDesign
+
+    Raises
+    ------
+    DesignError
+        A model that no filter of another model can tell apart (``mdgenspec`` shows which).
+    ParameterError
+        Bad models or options.
+
+    Examples
+    --------
+    >>> m1, m2 = FaultModel([[-1.0]], [[1.0]], Bu=[[1.0]]), FaultModel([[-2.0]], [[2.0]], Bu=[[1.0]])
+    >>> d = emdsyn([m1, m2])       # each filter keeps its model's pole: Q_j = [−G_j  1] on [u; y], up to scale
+    >>> d.orders, [np.round(np.linalg.eigvals(g.A).real, 6).tolist() for g in d.generators]
+    ((1, 1), [[-1.0], [-2.0]])
+    >>> [np.round(np.linalg.eigvals(g.A).real, 6).tolist() for g in emdsyn([m1, m2], smarg=-5.0).generators]
+    [[-0.05], [-0.05]]
+
+    References
+    ----------
+    Varga (2017), §6.2, Procedure EMD; fdtools (``emdsyn``).
+    """
+    from fdikit.design.nullspace.basis import denominator, left_nullspace, minimal_realization, realize_rows
+    from fdikit.design.nullspace.model_distances import check_models
+
+    models = check_models(models)
+    N = len(models)
+    gens, degs = [], []
+    for j, mj in enumerate(models):
+        others = [i for i in range(N) if i != j]
+        basis = left_nullspace(mj)
+        if not basis.rows:
+            raise DesignError(f"model {j}: its disturbances use up the outputs; no residual decouples it")
+        chk = [denominator(nu, None, None, mj.dt) for nu in basis.degrees]
+        T = _row_tests(models, j, basis, chk, mdtol, mdfreq, mdgaintol, emdtest)
+        missing = [i for i in others if not T[:, i].any()]
+        if missing:
+            raise DesignError(f"models {missing} cannot be told apart from model {j} by a filter that decouples "
+                              f"model {j}{' at the frequencies ' + str(mdfreq) if mdfreq is not None else ''} "
+                              "(see mdgenspec)")
+        for d in sorted(set(basis.degrees)):
+            used = [k for k, nu in enumerate(basis.degrees) if nu <= d]
+            if all(T[used, i].any() for i in others):
+                break
+        h = np.random.default_rng(20170).standard_normal((1, len(used)))
+        rows = basis.combined(h / np.linalg.norm(h), used)
+        den = denominator(d, _filter_poles(mj, d, poles, sdeg, smarg), None, mj.dt)
+        A, B, C, D = minimal_realization(*realize_rows(rows, [den], basis.scale))
+        gens.append(ResidualGenerator(A, B, C, D, controls=mj.controls, outputs=mj.outputs, residuals=(f"r{j}",),
+                                      dt=mj.dt))
+        degs.append(d)
+    P = np.array([[_gain(gens[j], difference_model(models[j], models[i], emdtest=emdtest), mdfreq)
+                   for i in range(N)] for j in range(N)])
+    if N > 1 and np.any(P[~np.eye(N, dtype=bool)] <= 0):
+        raise DesignError("a combination of basis rows lost a model; this should not happen with the generic choice")
+    for j in range(N if N > 1 else 0):
+        sc = P[0, j] / P[j, 0] if normalize and j > 0 else 1.0 / np.delete(P[j], j).min()
+        P[j] *= sc
+        gens[j] = dataclasses.replace(gens[j], C=sc * gens[j].C, D=sc * gens[j].D)
+    return ModelDetectionDesign(tuple(gens), P, tuple(degs), models)
+
+
+def mdmatch(design: ModelDetectionDesign, model: FaultModel, *, mdfreq=None,
+            emdtest: bool = False) -> tuple[np.ndarray, int]:
+    """The gains of the bank on a plant model and the model it matches best (reference ``mdmatch``).
+
+    Parameters
+    ----------
+    design : ModelDetectionDesign
+        The bank.
+    model : FaultModel
+        The plant (same outputs and controls as the bank's models).
+    mdfreq : float or sequence of float, optional
+        Evaluate at these frequencies (largest pointwise gain) instead of the H∞ norm.
+    emdtest : bool, default False
+        Include the plant's disturbance channels.
+
+    Returns
+    -------
+    gains : numpy.ndarray
+        ``‖Q_j [G_u G_d; I 0]‖`` per filter ``j``.
+    index : int
+        ``argmin`` of the gains: the matching model.
+
+    Examples
+    --------
+    >>> m1, m2 = FaultModel([[-1.0]], [[1.0]], Bu=[[1.0]]), FaultModel([[-2.0]], [[2.0]], Bu=[[1.0]])
+    >>> gains, k = mdmatch(emdsyn([m1, m2]), m2)
+    >>> k, bool(gains[1] < 1e-9)
+    (1, True)
+
+    References
+    ----------
+    Varga (2017), §6.1; fdtools (``mdmatch``).
+    """
+    from fdikit.design.nullspace.model_distances import check_models
+
+    check_models(list(design.models) + [model])
+    g = np.array([_gain(gen, difference_model(mj, model, emdtest=emdtest), mdfreq)
+                  for gen, mj in zip(design.generators, design.models)])
+    return g, int(np.argmin(g))

@@ -1,0 +1,135 @@
+"""Model distances and exact model detection (mddist, mdgenspec, emdsyn, mdmatch) against FaultDetectionTools.jl's
+test/test_emdsyn.jl ("Actuator faults": four first-order actuators k/(s+k)) and hand computations."""
+
+import numpy as np
+import pytest
+
+from fdikit.design.nullspace.model_detection import difference_model, emdsyn, mdgenspec, mdmatch
+from fdikit.design.nullspace.model_distances import check_models, mddist, nu_gap
+from fdikit.errors import DesignError, ParameterError
+from fdikit.model import FaultModel
+
+K = 14.0
+GAINS = (1.0, 0.5, 10.0, 0.01)          # nominal, 50 % loss of efficiency, disconnected, stall load
+W = np.concatenate([[0.0], np.logspace(-5, 5, 200001)])
+
+
+def _actuators():
+    return [FaultModel([[-a * K]], [[a * K]], Bu=[[1.0]]) for a in GAINS]
+
+
+def _g(a, w):
+    return a * K / (1j * w + a * K)
+
+
+def test_distances_of_the_actuator_models_by_brute_force():
+    ms = _actuators()
+    nug, inf, two = (mddist(ms, distance=d) for d in ("nugap", "inf", "2"))
+    for d in (nug, inf, two):
+        assert np.allclose(d.values, d.values.T) and np.all(np.diag(d.values) == 0)
+    for i, a in enumerate(GAINS):
+        for j, b in enumerate(GAINS):
+            if i == j:
+                continue
+            g1, g2 = _g(a, W), _g(b, W)
+            kappa = np.abs(g1 - g2) / np.sqrt((1 + np.abs(g1) ** 2) * (1 + np.abs(g2) ** 2))
+            # stable first-order lags: 1 + G_j~ G_i has a positive real part, so the winding condition holds
+            assert nug.values[i, j] == pytest.approx(kappa.max(), rel=1e-7)
+            assert inf.values[i, j] == pytest.approx(np.abs(g1 - g2).max(), rel=1e-7)
+            # ‖a/(s+a) − b/(s+b)‖₂² = a/2 + b/2 − 2ab/(a+b) (a, b the poles' magnitudes)
+            ka, kb = a * K, b * K
+            assert two.values[i, j] == pytest.approx(np.sqrt(ka / 2 + kb / 2 - 2 * ka * kb / (ka + kb)), rel=1e-9)
+    # MDfreq = 1: the pointwise chordal distance at ω = 1
+    d1 = mddist(ms, mdfreq=1.0)
+    g1, g2 = _g(1.0, 1.0), _g(0.5, 1.0)
+    assert d1.values[0, 1] == pytest.approx(abs(g1 - g2) / np.sqrt((1 + abs(g1) ** 2) * (1 + abs(g2) ** 2)),
+                                            rel=1e-12)
+    assert np.all(d1.peak[~np.eye(4, dtype=bool)] == 1.0)
+
+
+def test_nu_gap_winding_condition():
+    # 2/(s−1) vs 2/(s+1): det(1 + P₂~P₁) = (s−3)(s+1)/(s−1)², wno = 2 − 1, η₁ − η₂ = 1: the ν-gap is 1, although
+    # the chordal distance 4/(ω²+5) peaks at 0.8
+    assert nu_gap(([[1.0]], [[1.0]], [[2.0]], [[0.0]]), ([[-1.0]], [[1.0]], [[2.0]], [[0.0]]))[0] == 1.0
+    # 1/(s−1) vs 1.1/(s−1): the condition holds (wno = 1 − 1, η₁ = η₂); chordal 0.1√x/√((x+1)(x+1.21)),
+    # x = ω² + 1, largest at x = 1.1: δ = 1/21 at ω = √0.1
+    d, w = nu_gap(([[1.0]], [[1.0]], [[1.0]], [[0.0]]), ([[1.0]], [[1.0]], [[1.1]], [[0.0]]))
+    assert d == pytest.approx(1 / 21, rel=1e-9) and w == pytest.approx(np.sqrt(0.1), rel=1e-4)
+    with pytest.raises(ParameterError, match="imaginary axis"):
+        nu_gap(([[0.0]], [[1.0]], [[1.0]], [[0.0]]), ([[-1.0]], [[1.0]], [[1.0]], [[0.0]]))
+    with pytest.raises(ParameterError, match="shapes"):
+        nu_gap(([[-1.0]], [[1.0]], [[1.0]], [[0.0]]), ([[-1.0]], [[1.0, 1.0]], [[1.0]], [[0.0, 0.0]]))
+
+
+def test_achievable_model_detection_structure():
+    # test_emdsyn.jl: S = ones − I; at MDfreq = 0 nothing (all DC gains are 1); MDfreq = [0, 1] gives S again
+    ms = _actuators()
+    S = mdgenspec(ms)
+    assert np.array_equal(S, ~np.eye(4, dtype=bool))
+    assert not mdgenspec(ms, mdfreq=0).any()
+    assert np.array_equal(mdgenspec(ms, mdfreq=[0.0, 1.0]), S)
+
+
+def test_emdsyn_on_the_actuator_models():
+    # test_emdsyn.jl: emdsyn(sdeg = −15, poles = [−20]); each row of MDperf is ordered as the row of the ν-gaps
+    ms = _actuators()
+    nug, nug1 = mddist(ms), mddist(ms, mdfreq=1.0)
+    d = emdsyn(ms, sdeg=-15.0, poles=[-20.0])
+    assert d.orders == (1, 1, 1, 1) and d.degrees == (1, 1, 1, 1)
+    # the models are stable: each filter keeps its model's pole −k_j (poles/sdeg would move only poles beyond smarg)
+    for g, a in zip(d.generators, GAINS):
+        np.testing.assert_allclose(np.linalg.eigvals(g.A).real, [-a * K], rtol=1e-12)
+    P = d.performance
+    assert np.all(np.diag(P) < 1e-9)
+    for j in range(4):
+        assert np.argsort(nug.values[j]).tolist() == np.argsort(P[j]).tolist()
+        assert np.delete(P[j], j).min() == pytest.approx(1.0, rel=1e-12)
+    # by hand: Q_j ∝ [−G_j  1] on [u; y], so R_ji ∝ G_i − G_j and row j of MDperf is the row of the L∞ distances
+    # scaled to a smallest off-diagonal entry of 1
+    dinf = mddist(ms, distance="inf").values
+    for j in range(4):
+        np.testing.assert_allclose(P[j], dinf[j] / np.delete(dinf[j], j).min(), rtol=1e-8, atol=1e-9)
+    # with smarg = −200 every model pole is moved: all filter poles at −20, R_ji = (s+k_j)/(s+20) (G_i − G_j)
+    d20 = emdsyn(ms, sdeg=-15.0, poles=[-20.0], smarg=-200.0)
+    for j, a in enumerate(GAINS):
+        np.testing.assert_allclose(np.linalg.eigvals(d20.generators[j].A).real, [-20.0], rtol=1e-12)
+        raw = [np.abs((1j * W + a * K) / (1j * W + 20) * (_g(b, W) - _g(a, W))).max() for b in GAINS]
+        np.testing.assert_allclose(d20.performance[j], np.array(raw) / min(r for i, r in enumerate(raw) if i != j),
+                                   rtol=1e-6, atol=1e-9)
+    d1 = emdsyn(ms, sdeg=-15.0, poles=[-20.0], mdfreq=1.0)
+    for j in range(4):
+        assert np.argsort(nug1.values[j]).tolist() == np.argsort(d1.performance[j]).tolist()
+    dn = emdsyn(ms, sdeg=-15.0, poles=[-20.0], normalize=True)
+    np.testing.assert_allclose(dn.performance[0], dn.performance[:, 0], rtol=1e-12)
+    # mdmatch: the bank on the 50 % loss model picks filter 1
+    gains, k = mdmatch(d, ms[1])
+    assert k == 1 and gains[1] < 1e-9 and np.argmin(gains) == 1
+
+
+def test_model_with_disturbances_is_decoupled():
+    # model 0 has a disturbance on output 1; its filter decouples it, and with emdtest model 1's disturbance counts
+    m0 = FaultModel([[-1.0]], [[1.0], [1.0]], Bu=[[1.0]], Dd=[[1.0], [0.0]])
+    m1 = FaultModel([[-3.0]], [[3.0], [1.0]], Bu=[[1.0]], Dd=[[0.0], [1.0]])
+    d = emdsyn([m0, m1], sdeg=-2.0, emdtest=True)
+    R = d.generators[0].internal_form(m0)
+    from fdikit.analysis.channels import hinf_norm, minimal_channel
+
+    assert hinf_norm(minimal_channel(R, list(m0.controls) + list(m0.disturbances)))[0] < 1e-9
+    assert d.performance[0, 1] == pytest.approx(1.0) and d.performance[1, 0] == pytest.approx(1.0)
+    assert difference_model(m0, m1, emdtest=True).faults == ("delta_u0", "model_d0")
+
+
+def test_bad_input():
+    m = FaultModel([[-1.0]], [[1.0]], Bu=[[1.0]])
+    with pytest.raises(ParameterError, match="outputs, controls or sample time"):
+        check_models([m, FaultModel([[-1.0]], [[1.0]], Bu=[[1.0]], dt=0.1)])
+    with pytest.raises(ParameterError, match="non-empty"):
+        mddist([])
+    with pytest.raises(ParameterError, match="distance"):
+        mddist([m, m], distance="hinf")
+    with pytest.raises(ParameterError, match="discrete"):
+        mddist([FaultModel([[0.5]], [[1.0]], Bu=[[1.0]], dt=0.1)] * 2)
+    with pytest.raises(ParameterError, match="mdfreq"):
+        mddist([m, m], distance="2", mdfreq=1.0)
+    with pytest.raises(DesignError, match="cannot be told apart"):
+        emdsyn([m, m])
