@@ -133,3 +133,19 @@ def test_bad_input():
         mddist([m, m], distance="2", mdfreq=1.0)
     with pytest.raises(DesignError, match="cannot be told apart"):
         emdsyn([m, m])
+
+
+def test_example_6_1c_lateral_aircraft_loss_of_efficiency():
+    # Ex6_1c.jl: nine LOE models G_u Γ_i of a lateral aircraft model, emdsyn(sdeg = −1, poles = [−1]):
+    # @test all(diag(MDperf) .< 1e-7) && all(MDperf + eps + I .>= 1); every model detectable from every other
+    A = np.array([[-.4492, 0.046, .0053, -.9926], [0, 0, 1, 0.0067], [-50.8436, 0, -5.2184, .722],
+                  [16.4148, 0, .0026, -.6627]])
+    Bu = np.array([[0.0004, 0.0011], [0, 0], [-1.4161, .2621], [-0.0633, -0.1205]])
+    gamma = 1 - np.array([[0, 0, 0, .5, .5, .5, 1, 1, 1], [0, .5, 1, 0, .5, 1, 0, .5, 1]]).T
+    ms = [FaultModel(A, np.eye(4), Bu=Bu @ np.diag(g)) for g in gamma]
+    assert np.array_equal(mdgenspec(ms), ~np.eye(9, dtype=bool))
+    d = emdsyn(ms, sdeg=-1.0, poles=[-1.0])
+    P = d.performance
+    assert np.all(np.diag(P) < 1e-7) and np.all(P + np.finfo(float).eps + np.eye(9) >= 1)
+    # the last model has lost both inputs (G_u = 0): its filter is static (y itself, a degree-0 row)
+    assert d.orders[-1] == 0 and all(o == 1 for o in d.orders[:-1])
