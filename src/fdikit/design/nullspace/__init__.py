@@ -32,7 +32,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
         "approximate": ["ApproximateBankDesign", "ApproximateDesign", "afdisyn", "afdsyn"],
         "factorization": [
             "CoOuterFactor", "boundary_zeros", "coouter_coinner", "inverse", "quasi_coouter", "quasi_coouter_row",
-            "realization", "regularized_coouter", "series",
+            "NONSTD_OPTIONS", "noise_factor", "realization", "regularized_coouter", "series",
         ],
         "zero_steps": ["ZeroStep", "remove_boundary_zeros", "zero_steps_inverse"],
         "wiener_hopf": ["WIENER_HOPF_JOBS_SEVERAL", "moebius", "wiener_hopf"],

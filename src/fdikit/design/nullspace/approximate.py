@@ -44,15 +44,7 @@ import numpy as np
 from fdikit.design.nullspace.basis import NullspaceBasis, denominator, left_nullspace, minimal_realization, realize_rows
 from fdikit.design.nullspace.detectability import row_structure
 from fdikit.design.nullspace.exact import bank_rows, efdsyn, split_faults
-from fdikit.design.nullspace.factorization import (
-    CoOuterFactor,
-    coouter_coinner,
-    inverse,
-    quasi_coouter,
-    quasi_coouter_row,
-    regularized_coouter,
-    series,
-)
+from fdikit.design.nullspace.factorization import NONSTD_OPTIONS, inverse, noise_factor, series
 from fdikit.errors import DesignError, FdiWarning, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import FieldReport
@@ -198,33 +190,6 @@ def _select(model, basis, targets, q, minimal, poles, sdeg, fdtol, fdfreq, fdgai
                       f"rank {q}; lower rdim or check fdigenspec")
 
 
-_NONSTD = ("quasi", "regularize", "wiener-hopf", "wiener-hopf-shift", "wiener-hopf-regularize")   # reference 1 … 5
-
-
-def _factor(ch, dt, nonstd, epsreg, poles, sdeg, smarg, sdegzer):
-    """The noise factor ``F`` of the channel ``ch`` (``Q ← F⁻¹ Q``) and its kind (the reference's ``nonstd``)."""
-    from fdikit.design.nullspace.row_factors import wiener_hopf_row
-    from fdikit.design.nullspace.wiener_hopf import wiener_hopf
-
-    try:
-        return coouter_coinner(ch.A, ch.B, ch.C, ch.D, dt)
-    except DesignError:
-        if nonstd == "regularize":
-            return regularized_coouter(ch.A, ch.B, ch.C, ch.D, dt, epsreg=epsreg)
-        if nonstd == "quasi":
-            if ch.C.shape[0] > 1 or dt is not None:
-                return quasi_coouter(ch.A, ch.B, ch.C, ch.D, dt, poles=poles, sdeg=sdeg)
-            return quasi_coouter_row(ch.A, ch.B, ch.C, ch.D, poles=poles, sdeg=-0.05 if sdeg is None else sdeg,
-                                     smarg=smarg)
-        job = {"wiener-hopf": "plain", "wiener-hopf-shift": "shift", "wiener-hopf-regularize": "regularize"}[nonstd]
-        if ch.C.shape[0] > 1 or dt is not None:
-            f = wiener_hopf(ch.A, ch.B, ch.C, ch.D, dt, job=job, sdeg=sdeg, sdegzer=sdegzer, epsreg=epsreg)
-            return CoOuterFactor(f.outer, None, dt, nonstd, f.shifted)
-        F, moved = wiener_hopf_row(ch.A, ch.B, ch.C, ch.D, job=job,
-                                   sdegzer=-0.05 if sdegzer is None else sdegzer, epsreg=epsreg)
-        return CoOuterFactor(F, None, None, nonstd, moved)
-
-
 def _gen(A, B, C, D, model, names) -> ResidualGenerator:
     A, B, C, D = minimal_realization(A, B, C, D)
     return ResidualGenerator(A, B, C, D, controls=model.controls, outputs=model.outputs, residuals=names,
@@ -341,7 +306,7 @@ def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
     from fdikit.residuals import stack_generators
 
     gamma = validate.positive("gamma", gamma)
-    nonstd = validate.choice("nonstd", nonstd, _NONSTD)
+    nonstd = validate.choice("nonstd", nonstd, NONSTD_OPTIONS)
     targets, nuisance = split_faults(model, targets, nuisance)
     basis = left_nullspace(model, nuisance, tol=tol)
     k = len(basis.rows)
@@ -382,7 +347,8 @@ def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
     g1, _ = stabilize_rows(_gen(A, B, C, D, model, tuple(f"r{i}" for i in range(q1))), model, nuisance=nuisance,
                            poles=poles, sdeg=sdeg, smarg=smarg)
     ch = minimal_channel(g1.internal_form(model), list(model.noise))
-    fac = _factor(ch, model.dt, nonstd, epsreg, poles, sdeg, smarg, sdegzer)
+    fac = noise_factor(ch.A, ch.B, ch.C, ch.D, model.dt, nonstd=nonstd, epsreg=epsreg, poles=poles, sdeg=sdeg,
+                       smarg=smarg, sdegzer=sdegzer)
     A, B, C, D = series((g1.A, g1.B, g1.C, g1.D), inverse(*fac.outer))
     g1 = _gen(A, B, C, D, model, g1.residuals)
     wn = hinf_norm(minimal_channel(g1.internal_form(model), list(model.noise)))[0]
