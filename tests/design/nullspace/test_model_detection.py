@@ -4,7 +4,7 @@ test/test_emdsyn.jl ("Actuator faults": four first-order actuators k/(s+k)) and 
 import numpy as np
 import pytest
 
-from fdikit.design.nullspace.model_detection import difference_model, emdsyn, mdgenspec, mdmatch
+from fdikit.design.nullspace.model_detection import amdsyn, difference_model, emdsyn, mdgenspec, mdmatch
 from fdikit.design.nullspace.model_distances import check_models, mddist, nu_gap
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
@@ -149,3 +149,65 @@ def test_example_6_1c_lateral_aircraft_loss_of_efficiency():
     assert np.all(np.diag(P) < 1e-7) and np.all(P + np.finfo(float).eps + np.eye(9) >= 1)
     # the last model has lost both inputs (G_u = 0): its filter is static (y itself, a degree-0 row)
     assert d.orders[-1] == 0 and all(o == 1 for o in d.orders[:-1])
+
+
+def _lateral(noise: str = "both"):
+    """Ex6_2c.jl: the lateral aircraft with nine LOE models, C = 180/π [I₂ 0], noise on the states (and sensors)."""
+    A = np.array([[-.4492, 0.046, .0053, -.9926], [0, 0, 1, 0.0067], [-50.8436, 0, -5.2184, .722],
+                  [16.4148, 0, .0026, -.6627]])
+    Bu = np.array([[0.0004, 0.0011], [0, 0], [-1.4161, .2621], [-0.0633, -0.1205]])
+    gamma = 1 - np.array([[0, 0, 0, .5, .5, .5, 1, 1, 1], [0, .5, 1, 0, .5, 1, 0, .5, 1]]).T
+    C = 180 / np.pi * np.eye(2, 4)
+    Bw, Dw = np.eye(4, 6), np.hstack([np.zeros((2, 4)), np.eye(2)])
+    if noise == "states":
+        Bw, Dw = np.eye(4), np.zeros((2, 4))
+    return [FaultModel(A, C, Bu=Bu @ np.diag(g), Bw=Bw, Dw=Dw) for g in gamma]
+
+
+def test_amdsyn_without_noise_is_emdsyn():
+    ms = _actuators()
+    a = amdsyn(ms, sdeg=-15.0, poles=[-20.0])
+    e = emdsyn(ms, sdeg=-15.0, poles=[-20.0])
+    np.testing.assert_allclose(a.performance, e.performance, rtol=1e-12, atol=1e-14)
+    assert np.all(np.isinf(a.gaps)) and a.factorizations == ("none",) * 4
+    nug = mddist(ms)
+    for j in range(4):                                   # test_amdsyn.jl: rows ordered as the ν-gap rows
+        assert np.argsort(nug.values[j]).tolist() == np.argsort(a.performance[j]).tolist()
+    assert mdmatch(a, ms[1])[1] == 1
+
+
+def test_amdsyn_output_noise_gap_is_the_distance():
+    # y = G_j u + w: Q_j ∝ [−G_j 1] has a constant noise part (standard, already co-inner up to scale), so the gap of
+    # filter j is its smallest L∞ distance to another model
+    ms = [FaultModel([[-a * K]], [[a * K]], Bu=[[1.0]], Dw=[[1.0]]) for a in GAINS]
+    d = amdsyn(ms)
+    dinf = mddist(ms, distance="inf").values
+    assert d.factorizations == ("standard",) * 4
+    for j in range(4):
+        assert d.gaps[j] == pytest.approx(np.delete(dinf[j], j).min(), rel=1e-8)
+
+
+@pytest.mark.parametrize("noise, nonstd", [("both", "quasi"), ("states", "quasi"), ("states", "regularize"),
+                                           ("states", "wiener-hopf"), ("states", "wiener-hopf-shift"),
+                                           ("states", "wiener-hopf-regularize")])
+def test_example_6_2c_amdsyn(noise, nonstd):
+    # Ex6_2c.jl: @test all(diag(MDperf) .< 1e-7) && all(MDperf + eps + I .>= 1); MDgap = mdgap(R); Q stable.
+    # "states": noise on the states only (D_w = 0: zeros at infinity, the non-standard options of test_amdsyn.jl)
+    from fdikit.analysis.channels import frequency_response, hinf_norm, minimal_channel
+    ms = _lateral(noise)
+    d = amdsyn(ms, sdeg=-1.0, poles=[-1.0], nonstd=nonstd)
+    P = d.performance
+    assert np.all(np.diag(P) < 1e-7) and np.all(P + np.finfo(float).eps + np.eye(9) >= 1)
+    assert all(g.n == 0 or np.linalg.eigvals(g.A).real.max() < 0 for g in d.generators)
+    for j, (g, m) in enumerate(zip(d.generators, ms)):
+        ch = minimal_channel(g.internal_form(m), list(m.noise))
+        assert d.gaps[j] == pytest.approx(np.delete(P[j], j).min() / hinf_norm(ch)[0], rel=1e-8)
+        if d.factorizations[j] == "standard":
+            # the noise channel is co-inner up to the final scale: flat gain over frequency
+            sv = np.abs(frequency_response(ch, np.logspace(-3, 3, 25))[:, 0, :])
+            rows = np.sqrt((sv ** 2).sum(axis=1))
+            np.testing.assert_allclose(rows, rows[0], rtol=1e-8)
+    if noise == "both":
+        assert d.factorizations == ("standard",) * 9
+    else:
+        assert all(k == nonstd or (nonstd == "regularize" and k == "regularized") for k in d.factorizations)

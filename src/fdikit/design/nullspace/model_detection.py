@@ -33,7 +33,7 @@ from fdikit.errors import DesignError
 from fdikit.model import FaultModel
 from fdikit.residuals import ResidualGenerator
 
-__all__ = ["ModelDetectionDesign", "difference_model", "mdgenspec", "emdsyn", "mdmatch"]
+__all__ = ["ModelDetectionDesign", "difference_model", "mdgenspec", "emdsyn", "amdsyn", "mdmatch"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -50,6 +50,11 @@ class ModelDetectionDesign:
         The basis degree used per filter (its order).
     models : tuple of FaultModel
         The multiple model.
+    gaps : numpy.ndarray or None
+        :func:`amdsyn`: per filter ``j``, ``min_{i≠j} performance[j, i] / ‖R_w^(jj)‖∞`` (``inf`` without noise;
+        reference ``MDgap``).
+    factorizations : tuple of str or None
+        :func:`amdsyn`: the kind of noise factor per filter ("standard", "quasi", …; "none" without noise).
 
     Examples
     --------
@@ -67,6 +72,8 @@ class ModelDetectionDesign:
     performance: np.ndarray
     degrees: tuple[int, ...]
     models: tuple[FaultModel, ...]
+    gaps: np.ndarray | None = None
+    factorizations: tuple[str, ...] | None = None
 
     @property
     def orders(self) -> tuple[int, ...]:
@@ -264,35 +271,47 @@ def emdsyn(models: Sequence[FaultModel], *, poles: Sequence[complex] | None = No
     ----------
     Varga (2017), §6.2, Procedure EMD; fdtools (``emdsyn``).
     """
-    from fdikit.design.nullspace.basis import denominator, left_nullspace, minimal_realization, realize_rows
     from fdikit.design.nullspace.model_distances import check_models
 
     models = check_models(models)
+    pairs = [_exact_filter(models, j, poles, sdeg, smarg, mdtol, mdfreq, mdgaintol, emdtest)
+             for j in range(len(models))]
+    gens, P = _scaled([g for g, _ in pairs], models, emdtest, mdfreq, normalize)
+    return ModelDetectionDesign(gens, P, tuple(d for _, d in pairs), models)
+
+
+def _exact_filter(models, j, poles, sdeg, smarg, mdtol, mdfreq, mdgaintol, emdtest):
+    """Filter ``j`` of Procedure EMD (unscaled) and its degree."""
+    from fdikit.design.nullspace.basis import denominator, left_nullspace, minimal_realization, realize_rows
+
+    mj = models[j]
+    others = [i for i in range(len(models)) if i != j]
+    basis = left_nullspace(mj)
+    if not basis.rows:
+        raise DesignError(f"model {j}: its disturbances use up the outputs; no residual decouples it")
+    chk = [denominator(nu, None, None, mj.dt) for nu in basis.degrees]
+    T = _row_tests(models, j, basis, chk, mdtol, mdfreq, mdgaintol, emdtest)
+    missing = [i for i in others if not T[:, i].any()]
+    if missing:
+        raise DesignError(f"models {missing} cannot be told apart from model {j} by a filter that decouples "
+                          f"model {j}{' at the frequencies ' + str(mdfreq) if mdfreq is not None else ''} "
+                          "(see mdgenspec)")
+    for d in sorted(set(basis.degrees)):
+        used = [k for k, nu in enumerate(basis.degrees) if nu <= d]
+        if all(T[used, i].any() for i in others):
+            break
+    h = np.random.default_rng(20170).standard_normal((1, len(used)))
+    rows = basis.combined(h / np.linalg.norm(h), used)
+    den = denominator(d, _filter_poles(mj, d, poles, sdeg, smarg), None, mj.dt)
+    A, B, C, D = minimal_realization(*realize_rows(rows, [den], basis.scale))
+    return ResidualGenerator(A, B, C, D, controls=mj.controls, outputs=mj.outputs, residuals=(f"r{j}",),
+                             dt=mj.dt), d
+
+
+def _scaled(gens, models, emdtest, mdfreq, normalize):
+    """The performance matrix and the filters scaled as the reference scales them (see :func:`emdsyn`)."""
     N = len(models)
-    gens, degs = [], []
-    for j, mj in enumerate(models):
-        others = [i for i in range(N) if i != j]
-        basis = left_nullspace(mj)
-        if not basis.rows:
-            raise DesignError(f"model {j}: its disturbances use up the outputs; no residual decouples it")
-        chk = [denominator(nu, None, None, mj.dt) for nu in basis.degrees]
-        T = _row_tests(models, j, basis, chk, mdtol, mdfreq, mdgaintol, emdtest)
-        missing = [i for i in others if not T[:, i].any()]
-        if missing:
-            raise DesignError(f"models {missing} cannot be told apart from model {j} by a filter that decouples "
-                              f"model {j}{' at the frequencies ' + str(mdfreq) if mdfreq is not None else ''} "
-                              "(see mdgenspec)")
-        for d in sorted(set(basis.degrees)):
-            used = [k for k, nu in enumerate(basis.degrees) if nu <= d]
-            if all(T[used, i].any() for i in others):
-                break
-        h = np.random.default_rng(20170).standard_normal((1, len(used)))
-        rows = basis.combined(h / np.linalg.norm(h), used)
-        den = denominator(d, _filter_poles(mj, d, poles, sdeg, smarg), None, mj.dt)
-        A, B, C, D = minimal_realization(*realize_rows(rows, [den], basis.scale))
-        gens.append(ResidualGenerator(A, B, C, D, controls=mj.controls, outputs=mj.outputs, residuals=(f"r{j}",),
-                                      dt=mj.dt))
-        degs.append(d)
+    gens = list(gens)
     P = np.array([[_gain(gens[j], difference_model(models[j], models[i], emdtest=emdtest), mdfreq)
                    for i in range(N)] for j in range(N)])
     if N > 1 and np.any(P[~np.eye(N, dtype=bool)] <= 0):
@@ -301,7 +320,7 @@ def emdsyn(models: Sequence[FaultModel], *, poles: Sequence[complex] | None = No
         sc = P[0, j] / P[j, 0] if normalize and j > 0 else 1.0 / np.delete(P[j], j).min()
         P[j] *= sc
         gens[j] = dataclasses.replace(gens[j], C=sc * gens[j].C, D=sc * gens[j].D)
-    return ModelDetectionDesign(tuple(gens), P, tuple(degs), models)
+    return tuple(gens), P
 
 
 def mdmatch(design: ModelDetectionDesign, model: FaultModel, *, mdfreq=None,
@@ -343,3 +362,78 @@ def mdmatch(design: ModelDetectionDesign, model: FaultModel, *, mdfreq=None,
     g = np.array([_gain(gen, difference_model(mj, model, emdtest=emdtest), mdfreq)
                   for gen, mj in zip(design.generators, design.models)])
     return g, int(np.argmin(g))
+
+
+def amdsyn(models: Sequence[FaultModel], *, poles: Sequence[complex] | None = None, sdeg: float | None = None,
+           smarg: float | None = None, mdtol: float = 1e-4, mdfreq=None, mdgaintol: float = 0.01,
+           emdtest: bool = False, normalize: bool = False, nonstd: str = "quasi", epsreg: float = 0.1,
+           sdegzer: float | None = None) -> ModelDetectionDesign:
+    """Approximate model detection filters: ``emdsyn``'s filters with their own-model noise made co-inner
+    (Procedure AMD; reference ``amdsyn``).
+
+    Filter ``j`` of :func:`emdsyn` is multiplied by ``F⁻¹``, ``F`` the (co-outer, or non-standard) factor of its noise
+    channel on model ``j``, ``R_w^(jj) = Q_j [G_w^(j); 0]``
+    (:func:`~fdikit.design.nullspace.factorization.noise_factor`), which maximises the gap ``β_j / ‖R_w^(jj)‖∞``
+    (``β_j`` its smallest gain on another model); then the filters are scaled as in :func:`emdsyn`.
+
+    Parameters
+    ----------
+    models : sequence of FaultModel
+        The multiple model; each model's noise inputs (group ``w``) are attenuated.
+    poles, sdeg, smarg, mdtol, mdfreq, mdgaintol, emdtest, normalize
+        As :func:`emdsyn`.
+    nonstd, epsreg, sdegzer
+        The non-standard noise factor, as :func:`~fdikit.design.nullspace.approximate.afdsyn`.
+
+    Returns
+    -------
+    ModelDetectionDesign
+        With ``gaps`` and ``factorizations``.
+
+    Raises
+    ------
+    DesignError, ParameterError
+        As :func:`emdsyn`.
+
+    Examples
+    --------
+    Output noise ``y = G_j u + w``: the noise part of ``Q_j ∝ [−G_j 1]`` is constant, so the gap is the L∞ distance
+    to the other model, ``‖1/(s+1) − 2/(s+2)‖∞ = ‖s/((s+1)(s+2))‖∞ = 1/3`` (at ω = √2):
+
+    >>> m1 = FaultModel([[-1.0]], [[1.0]], Bu=[[1.0]], Dw=[[1.0]])
+    >>> m2 = FaultModel([[-2.0]], [[2.0]], Bu=[[1.0]], Dw=[[1.0]])
+    >>> d = amdsyn([m1, m2])
+    >>> d.factorizations, np.round(d.gaps, 6).tolist()
+    (('standard', 'standard'), [0.333333, 0.333333])
+
+    References
+    ----------
+    Varga (2017), §6.3, Procedure AMD; fdtools (``amdsyn``, ``info.MDgap``).
+    """
+    from fdikit.analysis.channels import hinf_norm, minimal_channel
+    from fdikit.design.nullspace.basis import minimal_realization
+    from fdikit.design.nullspace.factorization import inverse, noise_factor, series
+    from fdikit.design.nullspace.model_distances import check_models
+
+    models = check_models(models)
+    gens, kinds, degs = [], [], []
+    for j, mj in enumerate(models):
+        g, d = _exact_filter(models, j, poles, sdeg, smarg, mdtol, mdfreq, mdgaintol, emdtest)
+        degs.append(d)
+        ch = minimal_channel(g.internal_form(mj), list(mj.noise)) if mj.noise else None
+        if ch is None or hinf_norm(ch)[0] <= 1e-12 * max(1.0, float(np.abs(g.D).max(initial=0.0))):
+            gens.append(g)
+            kinds.append("none")
+            continue
+        fac = noise_factor(ch.A, ch.B, ch.C, ch.D, mj.dt, nonstd=nonstd, epsreg=epsreg, poles=poles, sdeg=sdeg,
+                           smarg=smarg, sdegzer=sdegzer)
+        A, B, C, D = minimal_realization(*series((g.A, g.B, g.C, g.D), inverse(*fac.outer)))
+        gens.append(dataclasses.replace(g, A=A, B=B, C=C, D=D))
+        kinds.append(fac.kind)
+    gens, P = _scaled(gens, models, emdtest, mdfreq, normalize)
+    gaps = np.full(len(models), np.inf)
+    for j, (g, mj) in enumerate(zip(gens, models)):
+        if kinds[j] != "none":
+            wn = hinf_norm(minimal_channel(g.internal_form(mj), list(mj.noise)))[0]
+            gaps[j] = np.delete(P[j], j).min() / wn if len(models) > 1 else np.inf
+    return ModelDetectionDesign(gens, P, tuple(degs), models, gaps, tuple(kinds))
