@@ -203,14 +203,11 @@ class NarendraEvaluator:
             Fewer than ``10 g/α`` valid fault-free samples (the quantile is not resolved), or a group whose
             ``θ`` is zero on the data.
         """
-        from fdikit.decision.threshold import alpha_from_rate
+        from fdikit.decision.threshold import calibration_alpha
 
-        if (false_alarm_prob is None) == (false_alarms_per_hour is None):
-            raise ParameterError("give exactly one of false_alarm_prob and false_alarms_per_hour")
+        calibration_alpha(false_alarm_prob, false_alarms_per_hour, 1.0)     # check the targets before the data
         runs = calibration_runs(residuals)
-        alpha = alpha_from_rate(false_alarms_per_hour, runs.dt) if false_alarm_prob is None else float(false_alarm_prob)
-        if not 0 < alpha < 1:
-            raise ParameterError(f"false-alarm probability must be in (0, 1), got {alpha}")
+        alpha = calibration_alpha(false_alarm_prob, false_alarms_per_hour, runs.dt)
         M, order = self._layout(len(runs.names), runs.names)
         thetas = []
         for run in runs.runs:

@@ -36,7 +36,7 @@ from fdikit.diagnosis import Alarm, Diagnosis, StepDecision
 from fdikit.errors import DataError, ParameterError
 from fdikit.residuals import Residuals
 
-__all__ = ["ThresholdEvaluator", "alpha_from_rate"]
+__all__ = ["ThresholdEvaluator", "alpha_from_rate", "calibration_alpha"]
 
 _COMPILED_RUN = 1 << 16  # residual entries from which run() uses the compiled pass (numba loaded on first use)
 
@@ -77,6 +77,45 @@ def alpha_from_rate(false_alarms_per_hour: float, dt: float) -> float:
     if not false_alarms_per_hour > 0 or not dt > 0:
         raise ParameterError(f"need a positive rate and sample time, got {false_alarms_per_hour}/h and dt={dt}")
     return min(1.0, false_alarms_per_hour * dt / 3600.0)
+
+
+def calibration_alpha(false_alarm_prob: float | None, false_alarms_per_hour: float | None, dt: float) -> float:
+    """The per-sample false-alarm probability of a calibration: given, or from a rate (exactly one of the two).
+
+    Parameters
+    ----------
+    false_alarm_prob : float or None
+        ``α`` in (0, 1).
+    false_alarms_per_hour : float or None
+        A rate instead (:func:`alpha_from_rate`).
+    dt : float
+        The residuals' sample time.
+
+    Returns
+    -------
+    float
+        ``α`` in (0, 1).
+
+    Raises
+    ------
+    ParameterError
+        Neither or both targets, or ``α`` outside (0, 1).
+
+    References
+    ----------
+    Douglas et al. 1996, Ch. 1.
+
+    Examples
+    --------
+    >>> calibration_alpha(None, 36.0, 0.1), calibration_alpha(0.01, None, 0.1)
+    (0.001, 0.01)
+    """
+    if (false_alarm_prob is None) == (false_alarms_per_hour is None):
+        raise ParameterError("give exactly one of false_alarm_prob and false_alarms_per_hour")
+    alpha = alpha_from_rate(false_alarms_per_hour, dt) if false_alarm_prob is None else float(false_alarm_prob)
+    if not 0 < alpha < 1:
+        raise ParameterError(f"false-alarm probability must be in (0, 1), got {alpha}")
+    return alpha
 
 
 class ThresholdEvaluator:
@@ -186,17 +225,11 @@ class ThresholdEvaluator:
         DataError
             When there are too few samples, or a residual is constant on the data.
         """
-        if (false_alarm_prob is None) == (false_alarms_per_hour is None):
-            raise ParameterError("give exactly one of false_alarm_prob and false_alarms_per_hour")
+        calibration_alpha(false_alarm_prob, false_alarms_per_hour, 1.0)     # check the targets before the data
         runs = calibration_runs(residuals)
         r = runs.rows
         q = r.shape[1]
-        if false_alarms_per_hour is not None:
-            alpha = alpha_from_rate(false_alarms_per_hour, runs.dt)
-        else:
-            alpha = float(false_alarm_prob)
-        if not 0 < alpha < 1:
-            raise ParameterError(f"false-alarm probability must be in (0, 1), got {alpha}")
+        alpha = calibration_alpha(false_alarm_prob, false_alarms_per_hour, runs.dt)
         a_i = alpha / q
         center = r.mean(axis=0)
         if method == "gaussian":

@@ -17,7 +17,7 @@ at ``mdfreq``.
 
 References
 ----------
-Varga (2017), §6.1–6.2 (model detection, Procedure EMD); Varga, CDC 2009 (least order model detection);
+Varga (2017), §6.1–6.2 (model detection, Procedure EMD); Varga (2009) (least order model detection);
 fdtools (``emdsyn``, ``mdgenspec``).
 """
 
