@@ -168,3 +168,16 @@ def test_cs1_bank_decouples_to_rounding_on_the_open_loop(cs1):
             Q = g.C @ np.linalg.solve(Mq, g.B) + g.D
             rel = np.linalg.norm(Q @ Ge, 2) / (np.linalg.norm(Q, 2) * np.linalg.norm(Ge, 2))
             assert rel < 100 * n * eps * (np.linalg.cond(Ms) + np.linalg.cond(Mq)), (f.targets, w, rel)
+
+
+def test_cs1_bank_with_the_plant_poles_as_filter_poles(cs1):
+    # the plant's poles inside −0.2, fastest first, as the filter poles: the unit-gain scaling at ω = 0 met the
+    # plant's integrator (pole 1e-16) left, cancelled, in the realisation of R_f and raised "a pole of the channel";
+    # it now takes the finite limit just off it.  The bank still decouples the nominal loop to rounding
+    nom = cs1.models[NOMINAL]
+    ev = np.linalg.eigvals(nom.A)
+    poles = [complex(x) for x in sorted(ev[ev.real < -0.2], key=lambda x: (x.real, -x.imag))]
+    bank = efdisyn(nom, CS1_SFDI, fdtol=1e-5, fdgaintol=1e-3, fdfreq=0, rdim=1, sdeg=-5.0, poles=poles)
+    assert [f.order for f in bank.filters] == [6, 6, 6, 5, 4, 4]
+    T = closed_loop_norms(cs1, bank.generator)
+    assert (T[NOMINAL] < 1e-8 * np.delete(T, NOMINAL, axis=0).min(axis=0)).all()
