@@ -11,6 +11,7 @@
   reference's ``nonstd = 3, 4, 5``).
 * :mod:`fdikit.design.nullspace.zero_steps` — removal of zeros at infinity and on the boundary by row operations.
 * :mod:`fdikit.design.nullspace.wiener_hopf` — Wiener–Hopf factors of several noise rows or of discrete models.
+* :mod:`fdikit.design.nullspace.noise_factors` — the noise factor to invert, standard or non-standard (``nonstd``).
 * :mod:`fdikit.design.nullspace.model_distances` — ``mddist``: ν-gap, L∞ and L2 distances between models.
 * :mod:`fdikit.design.nullspace.model_detection` — ``mdgenspec``, ``emdsyn`` (exact model detection, Procedure
   EMD) and ``mdmatch``.
@@ -32,9 +33,10 @@ __getattr__, __dir__, __all__ = lazy.attach(
         "approximate": ["ApproximateBankDesign", "ApproximateDesign", "afdisyn", "afdsyn"],
         "factorization": [
             "CoOuterFactor", "boundary_zeros", "coouter_coinner", "inverse", "quasi_coouter", "quasi_coouter_row",
-            "NONSTD_OPTIONS", "noise_factor", "realization", "regularized_coouter", "series",
+            "canonical_factor", "realization", "regularized_coouter", "series",
         ],
         "zero_steps": ["ZeroStep", "remove_boundary_zeros", "zero_steps_inverse"],
+        "noise_factors": ["NONSTD_OPTIONS", "noise_factor"],
         "wiener_hopf": ["WIENER_HOPF_JOBS_SEVERAL", "moebius", "wiener_hopf"],
         "model_distances": ["MODEL_DISTANCES", "ModelDistances", "check_models", "mddist", "nu_gap"],
         "model_detection": ["ModelDetectionDesign", "difference_model", "emdsyn", "mdgenspec", "mdmatch"],

@@ -44,7 +44,8 @@ import numpy as np
 from fdikit.design.nullspace.basis import NullspaceBasis, denominator, left_nullspace, minimal_realization, realize_rows
 from fdikit.design.nullspace.detectability import row_structure
 from fdikit.design.nullspace.exact import bank_rows, efdsyn, split_faults
-from fdikit.design.nullspace.factorization import NONSTD_OPTIONS, inverse, noise_factor, series
+from fdikit.design.nullspace.factorization import inverse, series
+from fdikit.design.nullspace.noise_factors import NONSTD_OPTIONS, noise_factor
 from fdikit.errors import DesignError, FdiWarning, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import FieldReport

@@ -48,10 +48,7 @@ from fdikit.errors import DesignError, ParameterError
 
 __all__ = ["CoOuterFactor", "coouter_coinner", "regularized_coouter", "quasi_coouter_row", "quasi_coouter",
            "boundary_zeros", "series", "inverse", "realization",
-           "noise_factor", "NONSTD_OPTIONS"]
-
-
-NONSTD_OPTIONS = ("quasi", "regularize", "wiener-hopf", "wiener-hopf-shift", "wiener-hopf-regularize")  # reference 1…5
+           "canonical_factor"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -121,6 +118,39 @@ def _sqrtm_sym(R: np.ndarray, inverse_: bool = False) -> np.ndarray:
     w, V = np.linalg.eigh((R + R.T) / 2)
     s = np.sqrt(w) if not inverse_ else 1.0 / np.sqrt(w)
     return (V * s) @ V.T
+
+
+def canonical_factor(A, B, C, D) -> tuple[np.ndarray, ...]:
+    """``F U_rᵀ`` with ``U_r`` the orthogonal polar factor of ``D = P U_r``: the same ``F F~``, ``D`` symmetric
+    positive definite.
+
+    A factor to invert is defined up to a constant orthogonal factor on the right; the rotations of the row
+    operations that build it (SVD bases whose signs and, for repeated singular values, directions rounding decides)
+    leave it there.  This choice removes them, so the filter does not depend on the BLAS kernel.
+
+    Parameters
+    ----------
+    A, B, C, D : array_like
+        A realisation of a square ``F`` with ``D`` invertible.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+
+    Examples
+    --------
+    >>> A, B, C, D = canonical_factor([[-1.0]], [[1.0]], [[1.0]], [[-2.0]])
+    >>> B.tolist(), D.tolist()
+    ([[-1.0]], [[2.0]])
+
+    References
+    ----------
+    Varga (2017), §7.9 (co-outer factors are unique up to a constant orthogonal factor).
+    """
+    A, B, C, D = realization(A, B, C, D)
+    U, _, Vt = np.linalg.svd(D)
+    Ur = U @ Vt
+    return A, B @ Ur.T, C, D @ Ur.T
 
 
 def series(first, second):
@@ -450,8 +480,9 @@ def quasi_coouter(A, B, C, D, dt: float | None = None, *, poles: Sequence[comple
     with the moved zeros placed at ``π``).  ``T⁻¹`` is stable and proper, so
     ``T⁻¹ G₁ₒ`` is the quasi-co-outer factor of ``G``; the returned ``F = W G₁ₒ`` (``G₁ₒ`` the standard co-outer
     factor of ``G₁``, ``W`` the product of the orthogonal row rotations of the steps, so that ``F`` of ``U G`` is
-    ``U F`` for a constant rotation ``U``) is biproper, stable and minimum phase with the moved zeros at the poles
-    ``π``: ``F⁻¹ Q`` is stable and proper, and ``F⁻¹ G`` keeps the zeros of ``G`` on the boundary and at infinity.
+    ``U F`` up to a constant orthogonal factor on the right, removed by :func:`canonical_factor`: ``D`` symmetric
+    positive definite) is biproper, stable and minimum phase with the moved zeros at the poles ``π``: ``F⁻¹ Q`` is
+    stable and proper, and ``F⁻¹ G`` keeps the zeros of ``G`` on the boundary and at infinity.
     For one continuous row this is :func:`quasi_coouter_row` (which also takes ``smarg``); the reference instead
     inverts the quasi factor and stabilises with ``glcf`` — another member of the same family of left coprime
     factors.  (Discrete zeros at infinity, ``D`` singular, are standard: ``R + C X Cᵀ > 0``.)
@@ -502,74 +533,6 @@ def quasi_coouter(A, B, C, D, dt: float | None = None, *, poles: Sequence[comple
     for st in steps:
         W = W @ st.rotation
     Ao, Bo, Co, Do = coouter_coinner(A, B, C1, D1, dt, tol=tol).outer
-    return CoOuterFactor((Ao, Bo, W @ Co, W @ Do), None, dt, "quasi", sum(len(st.poles) for st in steps))
+    return CoOuterFactor(canonical_factor(Ao, Bo, W @ Co, W @ Do), None, dt, "quasi",
+                         sum(len(st.poles) for st in steps))
 
-
-def noise_factor(A, B, C, D, dt: float | None = None, *, nonstd: str = "quasi", epsreg: float = 0.1,
-                 poles: Sequence[complex] | None = None, sdeg: float | None = None, smarg: float | None = None,
-                 sdegzer: float | None = None) -> CoOuterFactor:
-    """The factor ``F`` of a noise channel ``R_w`` to invert (``Q ← F⁻¹ Q``): co-outer, or the chosen non-standard one.
-
-    The standard co-outer factor when it exists (:func:`coouter_coinner`); otherwise, by the reference's
-    ``nonstd = 1 … 5``: the quasi factor (:func:`quasi_coouter_row` for one continuous row, with ``smarg``;
-    :func:`quasi_coouter` otherwise), the regularised factor, or a Wiener–Hopf factor
-    (:func:`~fdikit.design.nullspace.row_factors.wiener_hopf_row` for one continuous row,
-    :func:`~fdikit.design.nullspace.wiener_hopf.wiener_hopf` otherwise).
-
-    Parameters
-    ----------
-    A, B, C, D : array_like
-        A stable minimal realisation of ``R_w`` (full row rank).
-    dt : float or None
-        Sample time.
-    nonstd : {"quasi", "regularize", "wiener-hopf", "wiener-hopf-shift", "wiener-hopf-regularize"}, default "quasi"
-        The non-standard option.
-    epsreg, poles, sdeg, smarg, sdegzer
-        As :func:`~fdikit.design.nullspace.approximate.afdsyn`.
-
-    Returns
-    -------
-    CoOuterFactor
-        ``kind`` "standard", "quasi", "regularized" or the Wiener–Hopf option's name.
-
-    Raises
-    ------
-    DesignError
-        ``R_w`` without full row rank.
-    ParameterError
-        Bad options.
-
-    Examples
-    --------
-    ``s/(s+2)`` has a zero at 0: non-standard; the quasi factor moves it to −0.05:
-
-    >>> noise_factor([[-2.0]], [[-2.0]], [[1.0]], [[1.0]]).kind
-    'quasi'
-
-    References
-    ----------
-    Varga (2017), §5.3 (Procedure AFD), Remark 5.8; fdtools (``afdredsyn``, ``nonstd``).
-    """
-    from fdikit import validate
-    from fdikit.design.nullspace.row_factors import wiener_hopf_row
-    from fdikit.design.nullspace.wiener_hopf import wiener_hopf
-
-    nonstd = validate.choice("nonstd", nonstd, NONSTD_OPTIONS)
-    A, B, C, D = realization(A, B, C, D)
-    try:
-        return coouter_coinner(A, B, C, D, dt)
-    except DesignError:
-        if nonstd == "regularize":
-            return regularized_coouter(A, B, C, D, dt, epsreg=epsreg)
-        several = C.shape[0] > 1 or dt is not None
-        if nonstd == "quasi":
-            if several:
-                return quasi_coouter(A, B, C, D, dt, poles=poles, sdeg=sdeg)
-            return quasi_coouter_row(A, B, C, D, poles=poles, sdeg=-0.05 if sdeg is None else sdeg, smarg=smarg)
-        job = {"wiener-hopf": "plain", "wiener-hopf-shift": "shift", "wiener-hopf-regularize": "regularize"}[nonstd]
-        if several:
-            f = wiener_hopf(A, B, C, D, dt, job=job, sdeg=sdeg, sdegzer=sdegzer, epsreg=epsreg)
-            return CoOuterFactor(f.outer, None, dt, nonstd, f.shifted)
-        F, moved = wiener_hopf_row(A, B, C, D, job=job, sdegzer=-0.05 if sdegzer is None else sdegzer,
-                                   epsreg=epsreg)
-        return CoOuterFactor(F, None, None, nonstd, moved)

@@ -373,7 +373,7 @@ def amdsyn(models: Sequence[FaultModel], *, poles: Sequence[complex] | None = No
 
     Filter ``j`` of :func:`emdsyn` is multiplied by ``F⁻¹``, ``F`` the (co-outer, or non-standard) factor of its noise
     channel on model ``j``, ``R_w^(jj) = Q_j [G_w^(j); 0]``
-    (:func:`~fdikit.design.nullspace.factorization.noise_factor`), which maximises the gap ``β_j / ‖R_w^(jj)‖∞``
+    (:func:`~fdikit.design.nullspace.noise_factors.noise_factor`), which maximises the gap ``β_j / ‖R_w^(jj)‖∞``
     (``β_j`` its smallest gain on another model); then the filters are scaled as in :func:`emdsyn`.
 
     Parameters
@@ -412,8 +412,9 @@ def amdsyn(models: Sequence[FaultModel], *, poles: Sequence[complex] | None = No
     """
     from fdikit.analysis.channels import hinf_norm, minimal_channel
     from fdikit.design.nullspace.basis import minimal_realization
-    from fdikit.design.nullspace.factorization import inverse, noise_factor, series
+    from fdikit.design.nullspace.factorization import inverse, series
     from fdikit.design.nullspace.model_distances import check_models
+    from fdikit.design.nullspace.noise_factors import noise_factor
 
     models = check_models(models)
     gens, kinds, degs = [], [], []

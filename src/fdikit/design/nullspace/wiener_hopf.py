@@ -31,6 +31,7 @@ import numpy as np
 
 from fdikit.design.nullspace.factorization import (
     CoOuterFactor,
+    canonical_factor,
     coouter_coinner,
     realization,
     regularized_coouter,
@@ -177,13 +178,13 @@ def wiener_hopf(A, B, C, D, dt: float | None = None, *, job: str = "plain", pole
     rwoe = _transpose((At, Bt, C2, D2))
     moved = sum(len(st.poles) for st in steps2)
     if job == "plain" or not moved:
-        return CoOuterFactor(rwoe, None, dt, "wiener-hopf", moved)
+        return CoOuterFactor(canonical_factor(*rwoe), None, dt, "wiener-hopf", moved)
     rwouz = _transpose(zero_steps_inverse(steps2, p, dt))
     if job == "regularize":
         right = regularized_coouter(*rwouz, dt, epsreg=epsreg).outer
     else:
         right = moebius(*rwouz, *_shift_map(steps2, dt, sdegzer))
-    return CoOuterFactor(_minimal(series(right, rwoe)), None, dt, "wiener-hopf", moved)
+    return CoOuterFactor(canonical_factor(*_minimal(series(right, rwoe))), None, dt, "wiener-hopf", moved)
 
 
 def _shift_map(steps, dt, sdegzer) -> tuple[float, float, float, float]:
