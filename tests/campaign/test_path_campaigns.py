@@ -179,3 +179,25 @@ def test_shipped_specs_load():
     assert [p.params["road"] for p in nonlinear.plants] == ["smooth", "rough"]
     assert [d.kind for d in nonlinear.designs] == ["beard-jones", "game", "kalman"]
     assert len(plan_runs(nonlinear)) == 2 * (180 + 15) and nonlinear.healthy * nonlinear.duration == 3600.0
+
+
+def test_linear_campaign_runs_the_nullspace_bank():
+    # the efdisyn bank as a design kind: the set-up's generator is path_nullspace_bank's for the plant's noise
+    from fdikit.studies.path1996.nullspace_bank import path_nullspace_bank
+
+    spec = load_campaign({**LINEAR, "designs": [{"name": "ns", "kind": "nullspace"}],
+                          "evaluators": [{"name": "glr", "kind": "glr", "params": {"calibration": 60.0}}]})
+    study = get_study("path-linear")
+    assert study.check(spec) == []
+    setup = study.setup(spec)
+    plant = setup["plants"]["report"]
+    gen, groups = plant.designs["ns"]
+    from fdikit.plants.path_vehicle import path_vehicle_12, path_vehicle_14
+
+    std = dict(zip(plant.model.outputs, plant.noise))
+    ref = path_nullspace_bank((path_vehicle_12("midpoint"), path_vehicle_14("midpoint")), setup["nominal"],
+                              noise_std=std, dt=0.01)
+    assert gen.residuals == ref.generator.residuals and groups == ref.groups
+    np.testing.assert_allclose(gen.D, ref.generator.discretize(0.01).D, rtol=1e-12, atol=1e-12)
+    rows = study.run_chunk(setup, spec, plan_runs(spec), sweep_levels(spec.sweep))
+    assert len(rows) == 2 and all(r["design"] == "ns" for r in rows)

@@ -23,7 +23,9 @@ multiple of the fault's nominal size, :func:`~fdikit.studies.path1996.bank.nomin
 Design kinds: ``beard-jones`` (the four-filter bank, :func:`~fdikit.studies.path1996.bank.path_bank`),
 ``kalman`` (one steady-state Kalman filter, :func:`~fdikit.studies.path1996.kalman_bank.path_kalman_bank`,
 designed for the plant's noise), ``game`` (the game-theoretic bank,
-:func:`~fdikit.studies.path1996.game_bank.path_game_bank`, weights in ``params``: ``gamma``, ``M``, ``Q``).
+:func:`~fdikit.studies.path1996.game_bank.path_game_bank`, weights in ``params``: ``gamma``, ``M``, ``Q``),
+``nullspace`` (the exact ``efdisyn`` bank, :func:`~fdikit.studies.path1996.nullspace_bank.path_nullspace_bank`; with
+``noise_weighted`` (default true) its basis rows are combined for the plant's noise).
 Evaluators: every kind of :mod:`fdikit.campaign.evaluation` but ``mhsprt-whitened`` (fitted on runs with the
 fault from 2 s, the nonlinear study's); ``glr`` … ``bnn`` are those of ``fdikit compare-evaluators``
 (:mod:`fdikit.studies.path1996.compare`, Douglas et al. 1996, Ch. 6–7), fitted exactly as it fits them.
@@ -45,7 +47,8 @@ import numpy as np
 __all__ = ["PathLinearStudy", "PATH_LINEAR", "DESIGN_KINDS", "FAULT_KINDS", "NOISE_PRESETS", "EVALUATORS"]
 
 #: Design kind → its parameters and defaults.
-DESIGN_KINDS = {"beard-jones": {}, "kalman": {}, "game": {"gamma": 1e-6, "M": 0.01, "Q": 1e-6}}
+DESIGN_KINDS = {"beard-jones": {}, "kalman": {}, "game": {"gamma": 1e-6, "M": 0.01, "Q": 1e-6},
+                "nullspace": {"noise_weighted": True}}
 #: Fault kinds.
 FAULT_KINDS = ("bias", "drift")
 #: Named noise levels of the plant's ``noise`` parameter.
@@ -144,13 +147,16 @@ class PathLinearStudy:
         """Per plant: the discrete model, the noise, every design's generator and the calibrated evaluators."""
         from fdikit.campaign.evaluation import calibration_seconds, fit_evaluator, needs_training
         from fdikit.campaign.plan import RunPlan
+        from fdikit.plants.path_vehicle import path_vehicle_12, path_vehicle_14
         from fdikit.simulate import simulate
         from fdikit.studies.path1996.bank import nominal_fault_sizes, path_bank, path_fault_model
         from fdikit.studies.path1996.game_bank import path_game_bank
         from fdikit.studies.path1996.kalman_bank import path_kalman_bank
+        from fdikit.studies.path1996.nullspace_bank import path_nullspace_bank
 
         nominal = nominal_fault_sizes()
         models = (path_fault_model(12), path_fault_model(14))
+        plain = (path_vehicle_12("midpoint"), path_vehicle_14("midpoint"))
         plants = {}
         beard_jones = None
         for k, plant in enumerate(spec.plants):
@@ -165,6 +171,9 @@ class PathLinearStudy:
                     bank = beard_jones = beard_jones or path_bank()
                 elif kind == "kalman":
                     bank = path_kalman_bank(models[1], std, dt=dt)
+                elif kind == "nullspace":       # designed on the fault-free App. D models, as the study does
+                    weighted = {**DESIGN_KINDS["nullspace"], **d.params}["noise_weighted"]
+                    bank = path_nullspace_bank(plain, nominal, noise_std=std if weighted else None, dt=dt)
                 else:
                     bank = path_game_bank(models, nominal, std, dt=dt, **{**DESIGN_KINDS["game"], **d.params})
                 gen = bank.generator if bank.generator.dt == dt else bank.generator.discretize(dt)
