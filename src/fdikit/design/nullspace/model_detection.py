@@ -1,4 +1,5 @@
-"""Exact model detection by the nullspace method: ``mdgenspec`` and ``emdsyn`` (Varga 2017, §6.2, Procedure EMD).
+"""Model detection by the nullspace method: ``mdgenspec``, ``emdsyn`` (Procedure EMD), ``amdsyn`` (Procedure AMD)
+and ``mdmatch`` (Varga 2017, §6.1–6.3).
 
 A bank of ``N`` filters for a multiple model ``{G^(i)}`` (same outputs and controls): filter ``j`` lies in the left
 nullspace of model ``j``'s ``[G_u^(j) G_d^(j); I 0]``, so its residual vanishes when the plant behaves as model
@@ -17,8 +18,8 @@ at ``mdfreq``.
 
 References
 ----------
-Varga (2017), §6.1–6.2 (model detection, Procedure EMD); Varga (2009) (least order model detection);
-fdtools (``emdsyn``, ``mdgenspec``).
+Varga (2017), §6.1–6.3 (model detection, Procedures EMD and AMD); Varga (2009) (least order model detection);
+fdtools (``emdsyn``, ``amdsyn``, ``mdgenspec``, ``mdmatch``).
 """
 
 from __future__ import annotations
