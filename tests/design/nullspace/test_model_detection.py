@@ -211,3 +211,38 @@ def test_example_6_2c_amdsyn(noise, nonstd):
         assert d.factorizations == ("standard",) * 9
     else:
         assert all(k == nonstd or (nonstd == "regularize" and k == "regularized") for k in d.factorizations)
+
+
+def test_rdim_and_selection():
+    # Ex6_1c with two residuals per filter: still decoupled and every model detected (MDperf + ε + I ≥ 1)
+    A = np.array([[-.4492, 0.046, .0053, -.9926], [0, 0, 1, 0.0067], [-50.8436, 0, -5.2184, .722],
+                  [16.4148, 0, .0026, -.6627]])
+    Bu = np.array([[0.0004, 0.0011], [0, 0], [-1.4161, .2621], [-0.0633, -0.1205]])
+    gamma = 1 - np.array([[0, 0, 0, .5, .5, .5, 1, 1, 1], [0, .5, 1, 0, .5, 1, 0, .5, 1]]).T
+    ms = [FaultModel(A, np.eye(4), Bu=Bu @ np.diag(g)) for g in gamma]
+    d = emdsyn(ms, rdim=2, sdeg=-1.0, poles=[-1.0])
+    P = d.performance
+    assert all(g.residuals == (f"r{j}_0", f"r{j}_1") for j, g in enumerate(d.generators))
+    assert np.all(np.diag(P) < 1e-7) and np.all(P + np.finfo(float).eps + np.eye(9) >= 1)
+    # a given selection: any scale of the one actuator row gives the same scaled performance
+    act = _actuators()
+    np.testing.assert_allclose(emdsyn(act, selection=[[[3.0]]] * 4).performance, emdsyn(act).performance,
+                               rtol=1e-12, atol=1e-14)
+    with pytest.raises(ParameterError, match="selection"):
+        emdsyn(act, selection=[[[1.0, 2.0]]] * 4)
+    with pytest.raises(ParameterError, match="one entry"):
+        emdsyn(act, selection=[None])
+    with pytest.raises(ParameterError, match="rdim"):
+        emdsyn(act, rdim=0)
+    with pytest.raises(DesignError, match="rdim=2"):
+        emdsyn(act, rdim=2)
+    # amdsyn with both rows of the two-output aircraft: a two-row noise factor, the gaps as defined
+    from fdikit.analysis.channels import hinf_norm, minimal_channel
+
+    lat = _lateral("both")
+    a = amdsyn(lat, rdim=2, sdeg=-1.0, poles=[-1.0])
+    for j, (g, m) in enumerate(zip(a.generators, lat)):
+        assert len(g.residuals) == 2
+        wn = hinf_norm(minimal_channel(g.internal_form(m), list(m.noise)))[0]
+        assert a.gaps[j] == pytest.approx(np.delete(a.performance[j], j).min() / wn, rel=1e-8)
+    assert np.all(np.diag(a.performance) < 1e-7)

@@ -44,7 +44,7 @@ class ModelDetectionDesign:
     Attributes
     ----------
     generators : tuple of ResidualGenerator
-        Filter ``j`` (residual ``r<j>``), reading ``[u; y]``.
+        Filter ``j`` (residual ``r<j>``, or ``r<j>_<k>`` with ``rdim > 1``), reading ``[u; y]``.
     performance : numpy.ndarray
         ``(N, N)``: ``performance[j, i]`` the gain of filter ``j`` under model ``i`` (reference ``MDperf``).
     degrees : tuple of int
@@ -226,15 +226,32 @@ def _filter_poles(model: FaultModel, degree: int, poles, sdeg, smarg) -> list[co
     return (chosen + fill + [s0] * degree)[:degree]
 
 
-def emdsyn(models: Sequence[FaultModel], *, poles: Sequence[complex] | None = None, sdeg: float | None = None,
-           smarg: float | None = None, mdtol: float = 1e-4, mdfreq=None, mdgaintol: float = 0.01,
-           emdtest: bool = False, normalize: bool = False) -> ModelDetectionDesign:
+def _options(models, rdim, selection, **kw) -> dict:
+    from fdikit.errors import ParameterError
+
+    if isinstance(rdim, bool) or not isinstance(rdim, int | np.integer) or rdim < 1:
+        raise ParameterError(f"rdim must be an integer >= 1, got {rdim!r}")
+    if selection is not None and len(selection) != len(models):
+        raise ParameterError(f"selection needs one entry (a matrix or None) per model: {len(models)}, got "
+                             f"{len(selection)}")
+    return {"rdim": int(rdim), "selection": selection, **kw}
+
+
+def emdsyn(models: Sequence[FaultModel], *, rdim: int = 1, selection=None, poles: Sequence[complex] | None = None,
+           sdeg: float | None = None, smarg: float | None = None, mdtol: float = 1e-4, mdfreq=None,
+           mdgaintol: float = 0.01, emdtest: bool = False, normalize: bool = False) -> ModelDetectionDesign:
     """Exact model detection filters of least order, one per model (Procedure EMD; reference ``emdsyn``).
 
     Parameters
     ----------
     models : sequence of FaultModel
         The multiple model: same outputs, controls and sample time; disturbances may differ.
+    rdim : int, default 1
+        Residuals per filter (reference ``rdim``): the least degree ``d`` with at least ``rdim`` basis rows of
+        degree ``≤ d`` that together detect every other model.
+    selection : sequence of array_like or None, optional
+        Per filter, the ``(rdim, k)`` combination of those ``k`` rows (reference ``HDesign``, in fdikit's basis
+        coordinates), or None for the default: the identity when ``k = rdim``, else a fixed generic one.
     poles : sequence of complex, optional
         Filter poles for the places the model's own poles do not fill (see ``smarg``); then ``sdeg``.
     sdeg : float, optional
@@ -275,23 +292,42 @@ def emdsyn(models: Sequence[FaultModel], *, poles: Sequence[complex] | None = No
     from fdikit.design.nullspace.model_distances import check_models
 
     models = check_models(models)
-    pairs = [_exact_filter(models, j, poles, sdeg, smarg, mdtol, mdfreq, mdgaintol, emdtest)
-             for j in range(len(models))]
+    opts = _options(models, rdim, selection, poles=poles, sdeg=sdeg, smarg=smarg, mdtol=mdtol, mdfreq=mdfreq,
+                    mdgaintol=mdgaintol, emdtest=emdtest)
+    pairs = [_exact_filter(models, j, opts) for j in range(len(models))]
     gens, P = _scaled([g for g, _ in pairs], models, emdtest, mdfreq, normalize)
     return ModelDetectionDesign(gens, P, tuple(d for _, d in pairs), models)
 
 
-def _exact_filter(models, j, poles, sdeg, smarg, mdtol, mdfreq, mdgaintol, emdtest):
+def _combination(selection, j: int, q: int, k: int) -> np.ndarray:
+    """The ``(q, k)`` combination of filter ``j``'s rows: ``selection[j]`` (checked) or a fixed generic one."""
+    from fdikit.errors import ParameterError
+
+    H = None if selection is None else selection[j]
+    if H is None:
+        if q == k:
+            return np.eye(k)
+        return np.linalg.qr(np.random.default_rng(20170).standard_normal((k, q)))[0].T
+    H = np.atleast_2d(np.asarray(H, dtype=float))
+    if H.shape != (q, k) or not np.all(np.isfinite(H)) or np.linalg.matrix_rank(H) < q:
+        raise ParameterError(f"selection[{j}] must be a finite ({q}, {k}) matrix of full row rank (filter {j} "
+                             f"combines its {k} least-degree basis rows into {q} residuals), got shape {H.shape}")
+    return H
+
+
+def _exact_filter(models, j, opts):
     """Filter ``j`` of Procedure EMD (unscaled) and its degree."""
     from fdikit.design.nullspace.basis import denominator, left_nullspace, minimal_realization, realize_rows
 
-    mj = models[j]
+    mj, q, mdfreq = models[j], opts["rdim"], opts["mdfreq"]
     others = [i for i in range(len(models)) if i != j]
     basis = left_nullspace(mj)
     if not basis.rows:
         raise DesignError(f"model {j}: its disturbances use up the outputs; no residual decouples it")
+    if q > len(basis.rows):
+        raise DesignError(f"rdim={q}: the nullspace basis of model {j} has {len(basis.rows)} rows")
     chk = [denominator(nu, None, None, mj.dt) for nu in basis.degrees]
-    T = _row_tests(models, j, basis, chk, mdtol, mdfreq, mdgaintol, emdtest)
+    T = _row_tests(models, j, basis, chk, opts["mdtol"], mdfreq, opts["mdgaintol"], opts["emdtest"])
     missing = [i for i in others if not T[:, i].any()]
     if missing:
         raise DesignError(f"models {missing} cannot be told apart from model {j} by a filter that decouples "
@@ -299,14 +335,14 @@ def _exact_filter(models, j, poles, sdeg, smarg, mdtol, mdfreq, mdgaintol, emdte
                           "(see mdgenspec)")
     for d in sorted(set(basis.degrees)):
         used = [k for k, nu in enumerate(basis.degrees) if nu <= d]
-        if all(T[used, i].any() for i in others):
+        if len(used) >= q and all(T[used, i].any() for i in others):
             break
-    h = np.random.default_rng(20170).standard_normal((1, len(used)))
-    rows = basis.combined(h / np.linalg.norm(h), used)
-    den = denominator(d, _filter_poles(mj, d, poles, sdeg, smarg), None, mj.dt)
-    A, B, C, D = minimal_realization(*realize_rows(rows, [den], basis.scale))
-    return ResidualGenerator(A, B, C, D, controls=mj.controls, outputs=mj.outputs, residuals=(f"r{j}",),
-                             dt=mj.dt), d
+    H = _combination(opts["selection"], j, q, len(used))
+    rows = basis.combined(H, used)
+    den = denominator(d, _filter_poles(mj, d, opts["poles"], opts["sdeg"], opts["smarg"]), None, mj.dt)
+    A, B, C, D = minimal_realization(*realize_rows(rows, [den] * q, basis.scale))
+    names = (f"r{j}",) if q == 1 else tuple(f"r{j}_{k}" for k in range(q))
+    return ResidualGenerator(A, B, C, D, controls=mj.controls, outputs=mj.outputs, residuals=names, dt=mj.dt), d
 
 
 def _scaled(gens, models, emdtest, mdfreq, normalize):
@@ -365,10 +401,10 @@ def mdmatch(design: ModelDetectionDesign, model: FaultModel, *, mdfreq=None,
     return g, int(np.argmin(g))
 
 
-def amdsyn(models: Sequence[FaultModel], *, poles: Sequence[complex] | None = None, sdeg: float | None = None,
-           smarg: float | None = None, mdtol: float = 1e-4, mdfreq=None, mdgaintol: float = 0.01,
-           emdtest: bool = False, normalize: bool = False, nonstd: str = "quasi", epsreg: float = 0.1,
-           sdegzer: float | None = None) -> ModelDetectionDesign:
+def amdsyn(models: Sequence[FaultModel], *, rdim: int = 1, selection=None, poles: Sequence[complex] | None = None,
+           sdeg: float | None = None, smarg: float | None = None, mdtol: float = 1e-4, mdfreq=None,
+           mdgaintol: float = 0.01, emdtest: bool = False, normalize: bool = False, nonstd: str = "quasi",
+           epsreg: float = 0.1, sdegzer: float | None = None) -> ModelDetectionDesign:
     """Approximate model detection filters: ``emdsyn``'s filters with their own-model noise made co-inner
     (Procedure AMD; reference ``amdsyn``).
 
@@ -381,7 +417,7 @@ def amdsyn(models: Sequence[FaultModel], *, poles: Sequence[complex] | None = No
     ----------
     models : sequence of FaultModel
         The multiple model; each model's noise inputs (group ``w``) are attenuated.
-    poles, sdeg, smarg, mdtol, mdfreq, mdgaintol, emdtest, normalize
+    rdim, selection, poles, sdeg, smarg, mdtol, mdfreq, mdgaintol, emdtest, normalize
         As :func:`emdsyn`.
     nonstd, epsreg, sdegzer
         The non-standard noise factor, as :func:`~fdikit.design.nullspace.approximate.afdsyn`.
@@ -418,9 +454,11 @@ def amdsyn(models: Sequence[FaultModel], *, poles: Sequence[complex] | None = No
     from fdikit.design.nullspace.noise_factors import noise_factor
 
     models = check_models(models)
+    opts = _options(models, rdim, selection, poles=poles, sdeg=sdeg, smarg=smarg, mdtol=mdtol, mdfreq=mdfreq,
+                    mdgaintol=mdgaintol, emdtest=emdtest)
     gens, kinds, degs = [], [], []
     for j, mj in enumerate(models):
-        g, d = _exact_filter(models, j, poles, sdeg, smarg, mdtol, mdfreq, mdgaintol, emdtest)
+        g, d = _exact_filter(models, j, opts)
         degs.append(d)
         ch = minimal_channel(g.internal_form(mj), list(mj.noise)) if mj.noise else None
         if ch is None or hinf_norm(ch)[0] <= 1e-12 * max(1.0, float(np.abs(g.D).max(initial=0.0))):
