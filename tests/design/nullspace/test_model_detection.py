@@ -138,11 +138,7 @@ def test_bad_input():
 def test_example_6_1c_lateral_aircraft_loss_of_efficiency():
     # Ex6_1c.jl: nine LOE models G_u Γ_i of a lateral aircraft model, emdsyn(sdeg = −1, poles = [−1]):
     # @test all(diag(MDperf) .< 1e-7) && all(MDperf + eps + I .>= 1); every model detectable from every other
-    A = np.array([[-.4492, 0.046, .0053, -.9926], [0, 0, 1, 0.0067], [-50.8436, 0, -5.2184, .722],
-                  [16.4148, 0, .0026, -.6627]])
-    Bu = np.array([[0.0004, 0.0011], [0, 0], [-1.4161, .2621], [-0.0633, -0.1205]])
-    gamma = 1 - np.array([[0, 0, 0, .5, .5, .5, 1, 1, 1], [0, .5, 1, 0, .5, 1, 0, .5, 1]]).T
-    ms = [FaultModel(A, np.eye(4), Bu=Bu @ np.diag(g)) for g in gamma]
+    ms = _lateral(None)
     assert np.array_equal(mdgenspec(ms), ~np.eye(9, dtype=bool))
     d = emdsyn(ms, sdeg=-1.0, poles=[-1.0])
     P = d.performance
@@ -151,12 +147,15 @@ def test_example_6_1c_lateral_aircraft_loss_of_efficiency():
     assert d.orders[-1] == 0 and all(o == 1 for o in d.orders[:-1])
 
 
-def _lateral(noise: str = "both"):
-    """Ex6_2c.jl: the lateral aircraft with nine LOE models, C = 180/π [I₂ 0], noise on the states (and sensors)."""
+def _lateral(noise: str | None = "both"):
+    """The lateral aircraft with nine LOE models G_u Γ_i: Ex6_1c.jl (``noise=None``: C = I, no noise) or Ex6_2c.jl
+    (C = 180/π [I₂ 0], noise on the states and sensors, or with ``"states"`` on the states only)."""
     A = np.array([[-.4492, 0.046, .0053, -.9926], [0, 0, 1, 0.0067], [-50.8436, 0, -5.2184, .722],
                   [16.4148, 0, .0026, -.6627]])
     Bu = np.array([[0.0004, 0.0011], [0, 0], [-1.4161, .2621], [-0.0633, -0.1205]])
     gamma = 1 - np.array([[0, 0, 0, .5, .5, .5, 1, 1, 1], [0, .5, 1, 0, .5, 1, 0, .5, 1]]).T
+    if noise is None:
+        return [FaultModel(A, np.eye(4), Bu=Bu @ np.diag(g)) for g in gamma]
     C = 180 / np.pi * np.eye(2, 4)
     Bw, Dw = np.eye(4, 6), np.hstack([np.zeros((2, 4)), np.eye(2)])
     if noise == "states":
@@ -215,11 +214,7 @@ def test_example_6_2c_amdsyn(noise, nonstd):
 
 def test_rdim_and_selection():
     # Ex6_1c with two residuals per filter: still decoupled and every model detected (MDperf + ε + I ≥ 1)
-    A = np.array([[-.4492, 0.046, .0053, -.9926], [0, 0, 1, 0.0067], [-50.8436, 0, -5.2184, .722],
-                  [16.4148, 0, .0026, -.6627]])
-    Bu = np.array([[0.0004, 0.0011], [0, 0], [-1.4161, .2621], [-0.0633, -0.1205]])
-    gamma = 1 - np.array([[0, 0, 0, .5, .5, .5, 1, 1, 1], [0, .5, 1, 0, .5, 1, 0, .5, 1]]).T
-    ms = [FaultModel(A, np.eye(4), Bu=Bu @ np.diag(g)) for g in gamma]
+    ms = _lateral(None)
     d = emdsyn(ms, rdim=2, sdeg=-1.0, poles=[-1.0])
     P = d.performance
     assert all(g.residuals == (f"r{j}_0", f"r{j}_1") for j, g in enumerate(d.generators))
