@@ -185,7 +185,7 @@ def test_zero_steps_of_a_complex_pair_on_two_rows(dt):
         q, dens, pts = [1, -2 * np.cos(1.0), 1], ([1, -0.8, 0.15], [1, -0.2], [1, -0.4]), (np.exp(0.3j), np.exp(1j),
                                                                                             0.9, -0.7)
     sys = _tf_realization([[q, [1]], [[0], [1]]], [[dens[0], dens[1]], [[1], dens[2]]], dt)
-    C1, D1, steps = remove_boundary_zeros(*sys, dt, sdeg=-2.0 if dt is None else 0.5)
+    C1, D1, steps, g1 = remove_boundary_zeros(*sys, dt, sdeg=-2.0 if dt is None else 0.5)
     pair = [st for st in steps if st.mix is not None]
     assert len(pair) == 1 and pair[0].rows == (0, 1) and pair[0].poles == ((-2.0, -2.0) if dt is None else (0.5, 0.5))
     assert abs(pair[0].zero - (1j if dt is None else np.exp(1j))) < 1e-12
@@ -195,4 +195,4 @@ def test_zero_steps_of_a_complex_pair_on_two_rows(dt):
         G = _resp(sys, lam)
         np.testing.assert_allclose(_resp(Ti, lam) @ _resp((sys[0], sys[1], C1, D1), lam), G, rtol=0,
                                    atol=1e-12 * np.abs(G).max())
-    assert coouter_coinner(sys[0], sys[1], C1, D1, dt).kind == "standard"
+    assert coouter_coinner(sys[0], sys[1], C1, D1, dt).kind == g1.kind == "standard"

@@ -528,11 +528,11 @@ def quasi_coouter(A, B, C, D, dt: float | None = None, *, poles: Sequence[comple
     from fdikit.design.nullspace.zero_steps import remove_boundary_zeros
 
     A, B, C, D = realization(A, B, C, D)
-    C1, D1, steps = remove_boundary_zeros(A, B, C, D, dt, poles=poles, sdeg=sdeg, tol=tol)
+    _, _, steps, g1 = remove_boundary_zeros(A, B, C, D, dt, poles=poles, sdeg=sdeg, tol=tol)
     W = np.eye(D.shape[0])
     for st in steps:
         W = W @ st.rotation
-    Ao, Bo, Co, Do = coouter_coinner(A, B, C1, D1, dt, tol=tol).outer
+    Ao, Bo, Co, Do = g1.outer
     return CoOuterFactor(canonical_factor(Ao, Bo, W @ Co, W @ Do), None, dt, "quasi",
                          sum(len(st.poles) for st in steps))
 

@@ -32,7 +32,6 @@ import numpy as np
 from fdikit.design.nullspace.factorization import (
     CoOuterFactor,
     canonical_factor,
-    coouter_coinner,
     realization,
     regularized_coouter,
     series,
@@ -169,12 +168,12 @@ def wiener_hopf(A, B, C, D, dt: float | None = None, *, job: str = "plain", pole
     A, B, C, D = realization(A, B, C, D)
     p = D.shape[0]
     # pass 1: R_w = T⁻¹ G₁, G₁ = G₁ₒ G₁ᵢ, so R_wo = T⁻¹ G₁ₒ (T's poles cancel the zeros it gave G₁ₒ)
-    C1, D1, steps1 = remove_boundary_zeros(A, B, C, D, dt, poles=None, sdeg=sdeg, tol=tol)
-    rwo = _minimal(series(coouter_coinner(A, B, C1, D1, dt, tol=tol).outer, zero_steps_inverse(steps1, p, dt)))
+    _, _, steps1, g1 = remove_boundary_zeros(A, B, C, D, dt, poles=None, sdeg=sdeg, tol=tol)
+    rwo = _minimal(series(g1.outer, zero_steps_inverse(steps1, p, dt)))
     # pass 2 on R_woᵀ: T̂ R_woᵀ = Ĝ₁, so R_wo = Ĝ₁ᵀ T̂⁻ᵀ = R_woe R_wouz
     pis = list(poles) if poles is not None else _slow_real_poles(rwo[0], dt)
     At, Bt, Ct, Dt = _transpose(rwo)
-    C2, D2, steps2 = remove_boundary_zeros(At, Bt, Ct, Dt, dt, poles=pis, sdeg=sdeg, tol=tol)
+    C2, D2, steps2, _ = remove_boundary_zeros(At, Bt, Ct, Dt, dt, poles=pis, sdeg=sdeg, tol=tol)
     rwoe = _transpose((At, Bt, C2, D2))
     moved = sum(len(st.poles) for st in steps2)
     if job == "plain" or not moved:

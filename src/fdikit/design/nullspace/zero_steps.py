@@ -101,6 +101,8 @@ def remove_boundary_zeros(A, B, C, D, dt: float | None = None, *, poles: Sequenc
     C1, D1 : numpy.ndarray
         ``G₁ = (A, B, C1, D1)``.
     steps : list of ZeroStep
+    factor : CoOuterFactor
+        The standard co-outer–co-inner factorisation of ``G₁`` (solved to decide that no zero is left).
 
     Raises
     ------
@@ -113,7 +115,7 @@ def remove_boundary_zeros(A, B, C, D, dt: float | None = None, *, poles: Sequenc
     --------
     ``s/(s+3)`` (a zero at 0) with π = −1 becomes ``(s+1)/(s+3)``:
 
-    >>> C1, D1, steps = remove_boundary_zeros([[-3.0]], [[1.0]], [[-3.0]], [[1.0]], sdeg=-1.0)
+    >>> C1, D1, steps, _ = remove_boundary_zeros([[-3.0]], [[1.0]], [[-3.0]], [[1.0]], sdeg=-1.0)
     >>> np.round(C1 * D1, 6).tolist(), steps[0].zero
     ([[-2.0]], 0.0)
 
@@ -151,8 +153,7 @@ def remove_boundary_zeros(A, B, C, D, dt: float | None = None, *, poles: Sequenc
                 steps.append(ZeroStep(U, tuple(range(r, p)), tuple(used), None))
                 continue
         try:
-            coouter_coinner(A, B, C, D, dt, tol=tol)
-            return C, D, steps
+            return C, D, steps, coouter_coinner(A, B, C, D, dt, tol=tol)
         except DesignError as err:
             reason = err
         lam, W, g = _boundary_zero(A, B, C, D, dt, tol)
