@@ -272,9 +272,8 @@ def mddist(models: Sequence[FaultModel], *, distance: str = "nugap", mdfreq: Seq
     ----------
     Varga (2017), §3.6; fdtools (``mddist``).
     """
-    import control
-
     from fdikit import validate
+    from fdikit.analysis.channels import check_freqs
 
     models = check_models(models)
     distance = validate.choice("distance", distance, MODEL_DISTANCES)
@@ -283,9 +282,11 @@ def mddist(models: Sequence[FaultModel], *, distance: str = "nugap", mdfreq: Seq
         raise ParameterError("the ν-gap of discrete models is not covered; use distance='inf' or '2'")
     if distance == "2" and mdfreq is not None:
         raise ParameterError("mdfreq applies to distance='nugap' or 'inf', not to '2'")
-    freqs = None if mdfreq is None else np.atleast_1d(np.asarray(mdfreq, dtype=float))
-    if freqs is not None and (freqs.size == 0 or np.any(freqs < 0) or np.any(np.isnan(freqs))):
-        raise ParameterError(f"mdfreq must be non-negative frequencies in rad/s, got {mdfreq}")
+    freqs = None
+    if mdfreq is not None:
+        freqs = check_freqs(mdfreq, dt)
+        if np.any(freqs < 0):
+            raise ParameterError(f"mdfreq must be non-negative frequencies in rad/s, got {mdfreq}")
     md = max(len(m.disturbances) for m in models)
     chans = [_channel(m, cdinp, md) for m in models]
     N = len(models)
@@ -293,34 +294,37 @@ def mddist(models: Sequence[FaultModel], *, distance: str = "nugap", mdfreq: Seq
     np.fill_diagonal(peak, 0.0)
     for i in range(N):
         for j in range(i + 1, N):
-            (A1, B1, C1, D1), (A2, B2, C2, D2) = chans[i], chans[j]
             if distance == "nugap":
                 v, w = nu_gap(chans[i], chans[j], freqs=freqs)
             else:
-                from scipy.linalg import block_diag
-
-                diff = (block_diag(A1, A2), np.vstack([B1, B2]), np.hstack([C1, -C2]), D1 - D2)
-                if freqs is not None:
-                    pts = [1j * x if dt is None else np.exp(1j * x * dt) for x in freqs]
-                    g = [np.linalg.norm(_response(diff, s), 2) if np.isfinite(s) else np.linalg.norm(diff[3], 2)
-                         for s in pts]
-                    k = int(np.argmax(g))
-                    v, w = float(g[k]), float(freqs[k])
-                elif diff[0].shape[0] == 0:
-                    v, w = (float(np.linalg.norm(diff[3], 2)), 0.0) if distance == "inf" else (
-                        0.0 if not np.any(diff[3]) or dt is not None else float("inf"), float("nan"))
-                else:
-                    sys = control.ss(*diff, 0 if dt is None else dt)
-                    if distance == "inf":
-                        g, w = control.linfnorm(sys)
-                        v, w = float(g), float(w)
-                    else:
-                        red = control.minreal(sys, verbose=False)
-                        ev = np.linalg.eigvals(np.asarray(red.A)) if red.nstates else np.zeros(0)
-                        stable = np.all(ev.real < 0) if dt is None else np.all(np.abs(ev) < 1)
-                        proper = dt is not None or not np.any(diff[3])
-                        v = float(control.norm(red, p=2)) if stable and proper else float("inf")
-                        w = float("nan")
+                v, w = _difference_norm(chans[i], chans[j], distance, freqs, dt)
             vals[i, j] = vals[j, i] = v
             peak[i, j] = peak[j, i] = w
     return ModelDistances(distance, vals, peak)
+
+
+def _difference_norm(sys1, sys2, distance: str, freqs, dt) -> tuple[float, float]:
+    """``‖G₁ − G₂‖`` (``"inf"``: L∞, or the largest σ_max at ``freqs``; ``"2"``: L2) and the peak frequency."""
+    import control
+    from scipy.linalg import block_diag
+
+    (A1, B1, C1, D1), (A2, B2, C2, D2) = sys1, sys2
+    diff = (block_diag(A1, A2), np.vstack([B1, B2]), np.hstack([C1, -C2]), D1 - D2)
+    if freqs is not None:
+        pts = [1j * x if dt is None else np.exp(1j * x * dt) for x in freqs]
+        g = [np.linalg.norm(_response(diff, s), 2) if np.isfinite(s) else np.linalg.norm(diff[3], 2) for s in pts]
+        k = int(np.argmax(g))
+        return float(g[k]), float(freqs[k])
+    if diff[0].shape[0] == 0:
+        if distance == "inf":
+            return float(np.linalg.norm(diff[3], 2)), 0.0
+        return (0.0 if not np.any(diff[3]) or dt is not None else float("inf")), float("nan")
+    sys = control.ss(*diff, 0 if dt is None else dt)
+    if distance == "inf":
+        g, w = control.linfnorm(sys)
+        return float(g), float(w)
+    red = control.minreal(sys, verbose=False)
+    ev = np.linalg.eigvals(np.asarray(red.A)) if red.nstates else np.zeros(0)
+    stable = np.all(ev.real < 0) if dt is None else np.all(np.abs(ev) < 1)
+    proper = dt is not None or not np.any(diff[3])
+    return (float(control.norm(red, p=2)) if stable and proper else float("inf")), float("nan")
