@@ -44,8 +44,7 @@ import numpy as np
 from fdikit.design.nullspace.basis import NullspaceBasis, denominator, left_nullspace, minimal_realization, realize_rows
 from fdikit.design.nullspace.detectability import row_structure
 from fdikit.design.nullspace.exact import bank_rows, efdsyn, split_faults
-from fdikit.design.nullspace.factorization import inverse, series
-from fdikit.design.nullspace.noise_factors import NONSTD_OPTIONS, noise_factor
+from fdikit.design.nullspace.noise_factors import NONSTD_OPTIONS, attenuate_noise
 from fdikit.errors import DesignError, FdiWarning, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import FieldReport
@@ -347,11 +346,8 @@ def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
                                     wscale, selection)
     g1, _ = stabilize_rows(_gen(A, B, C, D, model, tuple(f"r{i}" for i in range(q1))), model, nuisance=nuisance,
                            poles=poles, sdeg=sdeg, smarg=smarg)
-    ch = minimal_channel(g1.internal_form(model), list(model.noise))
-    fac = noise_factor(ch.A, ch.B, ch.C, ch.D, model.dt, nonstd=nonstd, epsreg=epsreg, poles=poles, sdeg=sdeg,
-                       smarg=smarg, sdegzer=sdegzer)
-    A, B, C, D = series((g1.A, g1.B, g1.C, g1.D), inverse(*fac.outer))
-    g1 = _gen(A, B, C, D, model, g1.residuals)
+    g1, fac = attenuate_noise(g1, model, nonstd=nonstd, epsreg=epsreg, poles=poles, sdeg=sdeg, smarg=smarg,
+                              sdegzer=sdegzer)
     wn = hinf_norm(minimal_channel(g1.internal_form(model), list(model.noise)))[0]
     if not (np.isfinite(wn) and wn > 0):
         raise DesignError(f"‖R_w‖∞ = {wn} after the factorisation; the filter is unstable or the noise vanished")

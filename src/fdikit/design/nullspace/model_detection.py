@@ -448,10 +448,8 @@ def amdsyn(models: Sequence[FaultModel], *, rdim: int = 1, selection=None, poles
     Varga (2017), §6.3, Procedure AMD; fdtools (``amdsyn``, ``info.MDgap``).
     """
     from fdikit.analysis.channels import hinf_norm, minimal_channel
-    from fdikit.design.nullspace.basis import minimal_realization
-    from fdikit.design.nullspace.factorization import inverse, series
     from fdikit.design.nullspace.model_distances import check_models
-    from fdikit.design.nullspace.noise_factors import noise_factor
+    from fdikit.design.nullspace.noise_factors import attenuate_noise
 
     models = check_models(models)
     opts = _options(models, rdim, selection, poles=poles, sdeg=sdeg, smarg=smarg, mdtol=mdtol, mdfreq=mdfreq,
@@ -465,10 +463,9 @@ def amdsyn(models: Sequence[FaultModel], *, rdim: int = 1, selection=None, poles
             gens.append(g)
             kinds.append("none")
             continue
-        fac = noise_factor(ch.A, ch.B, ch.C, ch.D, mj.dt, nonstd=nonstd, epsreg=epsreg, poles=poles, sdeg=sdeg,
-                           smarg=smarg, sdegzer=sdegzer)
-        A, B, C, D = minimal_realization(*series((g.A, g.B, g.C, g.D), inverse(*fac.outer)))
-        gens.append(dataclasses.replace(g, A=A, B=B, C=C, D=D))
+        g, fac = attenuate_noise(g, mj, channel=ch, nonstd=nonstd, epsreg=epsreg, poles=poles, sdeg=sdeg,
+                                 smarg=smarg, sdegzer=sdegzer)
+        gens.append(g)
         kinds.append(fac.kind)
     gens, P = _scaled(gens, models, emdtest, mdfreq, normalize)
     gaps = np.full(len(models), np.inf)

@@ -8,6 +8,7 @@ Varga (2017), §5.3, §6.3, Remark 5.8; fdtools (``afdredsyn``, ``amdsyn``, ``no
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 
 from fdikit.design.nullspace.factorization import (
@@ -20,7 +21,7 @@ from fdikit.design.nullspace.factorization import (
 )
 from fdikit.errors import DesignError
 
-__all__ = ["NONSTD_OPTIONS", "noise_factor"]
+__all__ = ["NONSTD_OPTIONS", "noise_factor", "attenuate_noise"]
 
 #: The non-standard options, the reference's ``nonstd = 1 … 5``.
 NONSTD_OPTIONS = ("quasi", "regularize", "wiener-hopf", "wiener-hopf-shift", "wiener-hopf-regularize")
@@ -94,3 +95,57 @@ def noise_factor(A, B, C, D, dt: float | None = None, *, nonstd: str = "quasi", 
         F, moved = wiener_hopf_row(A, B, C, D, job=job, sdegzer=-0.05 if sdegzer is None else sdegzer,
                                    epsreg=epsreg)
         return CoOuterFactor(F, None, None, nonstd, moved)
+
+
+def attenuate_noise(gen, model, *, channel=None, **options):
+    """``F⁻¹ Q``: the filter ``gen`` times the inverse of the factor of its noise channel on ``model``.
+
+    Parameters
+    ----------
+    gen : ResidualGenerator
+        The filter ``Q``.
+    model : FaultModel
+        The plant with its noise inputs.
+    channel : Channel, optional
+        The minimal noise channel of ``gen`` on ``model``, when the caller has it already.
+    **options
+        ``nonstd``, ``epsreg``, ``poles``, ``sdeg``, ``smarg``, ``sdegzer`` of :func:`noise_factor`.
+
+    Returns
+    -------
+    ResidualGenerator
+        The new filter (minimal), with ``gen``'s signals and labels.
+    CoOuterFactor
+        The factor ``F``.
+
+    Raises
+    ------
+    DesignError, ParameterError
+        As :func:`noise_factor`.
+
+    Examples
+    --------
+    A filter reading ``y`` of ``y = w`` with ``w`` through ``s/(s+2)`` gets ``F⁻¹`` of the quasi factor:
+
+    >>> import numpy as np
+    >>> from fdikit.model import FaultModel
+    >>> from fdikit.residuals import ResidualGenerator
+    >>> m = FaultModel([[-2.0]], [[-2.0]], Bw=[[1.0]], Dw=[[1.0]])
+    >>> g = ResidualGenerator(np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), [[1.0]], controls=(),
+    ...                       outputs=m.outputs, residuals=("r",))
+    >>> g2, fac = attenuate_noise(g, m)
+    >>> fac.kind, g2.n
+    ('quasi', 1)
+
+    References
+    ----------
+    Varga (2017), §5.3 (Procedure AFD: ``Q ← R_wo⁻¹ Q``), §6.3 (Procedure AMD).
+    """
+    from fdikit.analysis.channels import minimal_channel
+    from fdikit.design.nullspace.basis import minimal_realization
+    from fdikit.design.nullspace.factorization import inverse, series
+
+    ch = minimal_channel(gen.internal_form(model), list(model.noise)) if channel is None else channel
+    fac = noise_factor(ch.A, ch.B, ch.C, ch.D, model.dt, **options)
+    A, B, C, D = minimal_realization(*series((gen.A, gen.B, gen.C, gen.D), inverse(*fac.outer)))
+    return dataclasses.replace(gen, A=A, B=B, C=C, D=D), fac
