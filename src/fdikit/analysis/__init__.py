@@ -26,6 +26,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
         ],
         "performance": [
             "ColumnNorm", "NormRatio", "fdhinfminus", "fdhinfmax", "fdiscond", "fdif2ngap", "fdimmperf", "as_spec",
+            "static_reference",
         ],
         "hminus": ["hminus_index"],
         "structure": ["StructureMatrix", "fditspec", "fdisspec"],

@@ -64,7 +64,8 @@ from fdikit.analysis.channels import (
 from fdikit.errors import ModelError, ParameterError
 from fdikit.model import GROUPS, FaultModel
 
-__all__ = ["ColumnNorm", "NormRatio", "fdhinfminus", "fdhinfmax", "fdiscond", "fdif2ngap", "fdimmperf", "as_spec"]
+__all__ = ["ColumnNorm", "NormRatio", "fdhinfminus", "fdhinfmax", "fdiscond", "fdif2ngap", "fdimmperf", "as_spec",
+           "static_reference"]
 
 _EPS = np.finfo(float).eps
 
@@ -471,17 +472,51 @@ def _difference(form: FaultModel, ref: FaultModel, name: str):
     return minimal_channel(diff)
 
 
-def _static_ref(form: FaultModel, gains: Mapping) -> FaultModel:
-    """A static ``M_r`` as an internal form (one uncontrollable state: fdikit's models need ``n >= 1`` here)."""
+def static_reference(gains: Mapping, like: FaultModel, *, p: int | None = None) -> FaultModel:
+    """A static reference model ``M_r`` as an internal form: ``{group: matrix}`` with ``like``'s input groups.
+
+    fdikit's models need a state, so the result has one uncontrollable, unobservable state at −1.
+
+    Parameters
+    ----------
+    gains : mapping
+        ``{group: matrix}`` with groups among ``'u', 'd', 'f', 'w'``; a group left out is zero.
+    like : FaultModel
+        Gives the input names of each group and the sample time (a plant or an internal form).
+    p : int, optional
+        The number of outputs (default ``like.p``).
+
+    Returns
+    -------
+    FaultModel
+
+    Raises
+    ------
+    ParameterError
+        An unknown group or a matrix of the wrong shape.
+
+    Examples
+    --------
+    >>> like = FaultModel([[-1.0]], [[1.0], [1.0]], Bf=[[1.0, 2.0]])
+    >>> static_reference({"f": np.eye(2)}, like).d("f").tolist()
+    [[1.0, 0.0], [0.0, 1.0]]
+
+    References
+    ----------
+    Varga (2017), §5.6 (the reference model of fault estimation, ``M_r = I``); fdtools (``fdimmperf``).
+    """
     from fdikit import validate
 
+    p = like.p if p is None else int(p)
     kw: dict = {}
     for g, M in gains.items():
         if g not in GROUPS:
-            raise ParameterError(f"a static ref maps input groups {GROUPS} to matrices, got key {g!r}")
-        M = validate.as_matrix(f"ref[{g!r}]", M, (form.p, len(form.inputs[g])))
+            raise ParameterError(f"a static reference maps input groups {GROUPS} to matrices, got key {g!r}")
+        M = validate.as_matrix(f"gains[{g!r}]", M, (p, len(like.inputs[g])))
         kw[f"B{g}"], kw[f"D{g}"] = np.zeros((1, M.shape[1])), M
-    return FaultModel([[-1.0]], np.zeros((form.p, 1)), dt=form.dt, **kw)
+        names = {"u": "controls", "d": "disturbances", "f": "faults", "w": "noise"}[g]
+        kw[names] = like.inputs[g]
+    return FaultModel([[-1.0]], np.zeros((p, 1)), dt=like.dt, **kw)
 
 
 def fdimmperf(sysr, spec=None, *, ref=None, norm="inf", groups=None) -> float | np.ndarray:
@@ -543,9 +578,9 @@ def fdimmperf(sysr, spec=None, *, ref=None, norm="inf", groups=None) -> float | 
     bank = internal_forms(sysr, groups)
     if ref is not None:
         if isinstance(ref, Mapping) and all(k in GROUPS for k in ref):
-            ref = _static_ref(bank.forms[0], ref)
+            ref = static_reference(ref, bank.forms[0])
         elif isinstance(ref, (list, tuple)):
-            ref = [_static_ref(f, r) if isinstance(r, Mapping) else r for f, r in zip(bank.forms, ref)]
+            ref = [static_reference(r, f) if isinstance(r, Mapping) else r for f, r in zip(bank.forms, ref)]
         refs = internal_forms(ref)
         if len(refs.forms) != len(bank.forms) or refs.bank != bank.bank:
             raise ParameterError(f"ref has {len(refs.forms)} filter(s), sysr {len(bank.forms)}; give one reference "

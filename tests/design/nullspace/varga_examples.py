@@ -105,3 +105,24 @@ def low_pass():
 def high_pass():
     """Rf = (s+1)/(s+2), Rw = s/(s+2) (zero of Rw at 0)."""
     return FaultModel([[-2.0]], [[1.0]], Bf=[[-1.0]], Df=[[1.0]], Bw=[[-2.0]], Dw=[[1.0]], faults=["f"])
+
+
+def xiong_saif_2():
+    """Xiong and Saif (2000), Example 2 (test_emmsyn.jl): n = 5, three controls, two disturbances, two faults."""
+    a = np.array([[0, 0, -0.0034, 0, 0], [0, -0.041, 0.0013, 0, 0], [0, 0, -1.1471, 0, 0], [0, 0, -0.0036, 0, 0],
+                  [0, 0.094, 0.0057, 0, -0.051]])
+    bu = np.array([[-1.0, 0, 0], [0, 0, 0], [0, 0, 0.948], [0.916, -1, 0], [-0.598, 0, 0]])
+    bd = np.array([[0, 1.0], [0.062, -0.132], [0, -7.189], [0, 0], [0, 0]])
+    c = np.array([[1.0, 0, 0, 0, 0], [0, 0, 1, 0, 0], [0, 0, 0, 1, 0]])
+    return FaultModel(a, c, Bu=bu, Bd=bd, Bf=bu[:, :2])
+
+
+def example_5_13():
+    """Varga (2017), Example 5.13: Gu = [s/(s²+3s+2) 1/(s+2); s/(s+1) 0; 0 1/(s+2)], actuator faults Gf = Gu."""
+    # states: x1 = 1/(s+1), x2 = 1/(s+2) of input 1; x3 = 1/(s+2) of input 2
+    # s/((s+1)(s+2)) = 2/(s+2) − 1/(s+1); s/(s+1) = 1 − 1/(s+1)
+    A = np.diag([-1.0, -2.0, -2.0])
+    B = np.array([[1.0, 0], [1.0, 0], [0, 1.0]])
+    C = np.array([[-1.0, 2.0, 1.0], [-1.0, 0, 0], [0, 0, 1.0]])
+    D = np.array([[0, 0], [1.0, 0], [0, 0]])
+    return FaultModel(A, C, Bu=B, Du=D, Bf=B, Df=D)
