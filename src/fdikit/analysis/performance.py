@@ -473,9 +473,7 @@ def _difference(form: FaultModel, ref: FaultModel, name: str):
 
 
 def static_reference(gains: Mapping, like: FaultModel, *, p: int | None = None) -> FaultModel:
-    """A static reference model ``M_r`` as an internal form: ``{group: matrix}`` with ``like``'s input groups.
-
-    fdikit's models need a state, so the result has one uncontrollable, unobservable state at −1.
+    """A static ``M_r`` as an internal form with ``like``'s input groups (one hidden state at −1, discrete 0).
 
     Parameters
     ----------
@@ -514,9 +512,8 @@ def static_reference(gains: Mapping, like: FaultModel, *, p: int | None = None) 
             raise ParameterError(f"a static reference maps input groups {GROUPS} to matrices, got key {g!r}")
         M = validate.as_matrix(f"gains[{g!r}]", M, (p, len(like.inputs[g])))
         kw[f"B{g}"], kw[f"D{g}"] = np.zeros((1, M.shape[1])), M
-        names = {"u": "controls", "d": "disturbances", "f": "faults", "w": "noise"}[g]
-        kw[names] = like.inputs[g]
-    return FaultModel([[-1.0]], np.zeros((p, 1)), dt=like.dt, **kw)
+        kw[{"u": "controls", "d": "disturbances", "f": "faults", "w": "noise"}[g]] = like.inputs[g]
+    return FaultModel([[-1.0 if like.dt is None else 0.0]], np.zeros((p, 1)), dt=like.dt, **kw)
 
 
 def fdimmperf(sysr, spec=None, *, ref=None, norm="inf", groups=None) -> float | np.ndarray:

@@ -15,6 +15,10 @@
 * :mod:`fdikit.design.nullspace.model_distances` — ``mddist``: ν-gap, L∞ and L2 distances between models.
 * :mod:`fdikit.design.nullspace.model_detection` — ``mdgenspec``, ``emdsyn`` (exact model detection, Procedure
   EMD) and ``mdmatch``.
+* :mod:`fdikit.design.nullspace.model_matching` — ``emmsyn``: exact model matching of least order (Procedures
+  EMM, EMMS), by the left nullspace of the plant with the reference appended.
+* :mod:`fdikit.design.nullspace.approximate_matching` — ``ammsyn``: H∞/H2 model matching (Procedure AMMS), the
+  least-distance problem by SLICOT.
 * :mod:`fdikit.design.nullspace.approximate` — ``afdsyn`` / ``afdisyn``: the fault-to-noise gap maximised under
   ``‖R_w‖∞ = γ`` (Procedures AFD, AFDI).
 * :mod:`fdikit.design.nullspace.specs` — ``fdigenspec`` (all achievable structure matrix rows) and ``fdichkspec``
@@ -40,7 +44,11 @@ __getattr__, __dir__, __all__ = lazy.attach(
         "wiener_hopf": ["WIENER_HOPF_JOBS_SEVERAL", "moebius", "wiener_hopf"],
         "model_distances": ["MODEL_DISTANCES", "ModelDistances", "check_models", "mddist", "nu_gap"],
         "model_detection": ["ModelDetectionDesign", "difference_model", "emdsyn", "mdgenspec", "mdmatch"],
-        "model_matching": ["ModelMatchingBankDesign", "ModelMatchingDesign", "NORMALIZE_OPTIONS", "emmsyn"],
+        "model_matching": [
+            "ModelMatchingBankDesign", "ModelMatchingDesign", "NORMALIZE_OPTIONS", "emmsyn", "reference_columns",
+            "reference_model", "updated_reference",
+        ],
+        "approximate_matching": ["ApproximateMatchingDesign", "ammsyn", "least_distance"],
         "row_factors": ["RowSpectrum", "WIENER_HOPF_JOBS", "realize_biproper", "row_spectrum", "wiener_hopf_row"],
         "exact": ["NullspaceBankDesign", "NullspaceDesign", "bank_rows", "efdisyn", "efdsyn", "split_faults"],
         "specs": ["SpecificationCheck", "fdichkspec", "fdigenspec", "joint_order"],

@@ -7,7 +7,7 @@ equals an updated reference model:
                                           [ I  0  0  0 ]
 
 with ``M`` diagonal, proper, stable and invertible, of least degree, chosen so that ``Q`` is proper and stable
-(Varga 2017, §5.6, eq. (5.78)–(5.80)).  With ``M_r = I`` from the faults this is fault estimation.  Groups the
+(Varga 2017, §5.6).  With ``M_r = I`` from the faults this is fault estimation.  Groups the
 reference lacks are matched to zero (controls, disturbances, faults: decoupled), except the noise, which is left
 free when ``M_r`` has no noise group (its channel ``Q [Gw; 0]`` is then part of the internal form).
 
@@ -51,7 +51,8 @@ from fdikit.model import GROUPS, FaultModel
 from fdikit.protocols import FieldReport
 from fdikit.residuals import ResidualGenerator
 
-__all__ = ["ModelMatchingDesign", "ModelMatchingBankDesign", "emmsyn", "NORMALIZE_OPTIONS"]
+__all__ = ["ModelMatchingDesign", "ModelMatchingBankDesign", "emmsyn", "NORMALIZE_OPTIONS", "reference_model",
+           "updated_reference", "reference_columns"]
 
 NORMALIZE_OPTIONS = ("gain", "dcgain", "infnorm")
 _GROUP_KW = {"u": "controls", "d": "disturbances", "f": "faults", "w": "noise"}
@@ -138,8 +139,37 @@ class ModelMatchingBankDesign(FieldReport):
     REPORT = ("groups", "orders")
 
 
-def _reference(model: FaultModel, ref, names: Sequence[str] | None) -> FaultModel:
-    """``ref`` as a FaultModel checked against ``model`` (groups absent or in full, same ``dt``)."""
+def reference_model(model: FaultModel, ref, names: Sequence[str] | None = None) -> FaultModel:
+    """A reference model ``M_r`` as a FaultModel checked against ``model``: groups absent or in full, same ``dt``.
+
+    Parameters
+    ----------
+    model : FaultModel
+        The plant.
+    ref : FaultModel or mapping
+        An internal form, or a static ``{group: matrix}`` (:func:`~fdikit.analysis.performance.static_reference`).
+    names : sequence of str, optional
+        Residual names, checked against the number of outputs.
+
+    Returns
+    -------
+    FaultModel
+
+    Raises
+    ------
+    ParameterError, ModelError
+        A reference that is neither, group sizes or a sample time that do not fit the model.
+
+    Examples
+    --------
+    >>> m = FaultModel([[-1.0]], [[1.0], [1.0]], Bu=[[1.0]], Df=np.eye(2))
+    >>> reference_model(m, {"f": [[1.0, 0.0]]}).p
+    1
+
+    References
+    ----------
+    Varga (2017), §5.6 (the reference model); fdtools (``emmsyn``, ``ammsyn``: the input groups of ``sysr``).
+    """
     from fdikit.analysis.performance import static_reference
 
     if isinstance(ref, Mapping):
@@ -164,6 +194,43 @@ def _reference(model: FaultModel, ref, names: Sequence[str] | None) -> FaultMode
     return ref
 
 
+def reference_columns(ref: FaultModel, model: FaultModel, groups: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
+    """``(B, D)`` of the reference for the model's input ``groups``: zero columns for a group the reference lacks.
+
+    Parameters
+    ----------
+    ref : FaultModel
+        ``M_r`` (:func:`reference_model`).
+    model : FaultModel
+        The plant (the group sizes).
+    groups : sequence of str
+        Groups among ``'u', 'd', 'f', 'w'``, in order.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+
+    Examples
+    --------
+    >>> m = FaultModel([[-1.0]], [[1.0], [1.0]], Bu=[[1.0]], Df=np.eye(2))
+    >>> B, D = reference_columns(reference_model(m, {"f": [[1.0, 0.0]]}), m, ("u", "f"))
+    >>> D.tolist()
+    [[0.0, 1.0, 0.0]]
+
+    References
+    ----------
+    Varga (2017), §5.6; fdtools (``emmsyn``: "if any of the above vectors is void, the corresponding transfer
+    function matrix is considered null").
+    """
+    Bs, Ds = [], []
+    for g in groups:
+        k = len(model.inputs[g])
+        has = bool(len(ref.inputs[g]))
+        Bs.append(ref.b(g) if has else np.zeros((ref.n, k)))
+        Ds.append(ref.d(g) if has else np.zeros((ref.p, k)))
+    return np.hstack(Bs).reshape(ref.n, -1), np.hstack(Ds).reshape(ref.p, -1)
+
+
 def _augmented(model: FaultModel, ref: FaultModel, row: int, match_noise: bool) -> FaultModel:
     """The plant with reference row ``row`` appended as the last output; the matched inputs as faults."""
     import scipy.linalg
@@ -172,10 +239,8 @@ def _augmented(model: FaultModel, ref: FaultModel, row: int, match_noise: bool) 
     C = scipy.linalg.block_diag(model.C, ref.C[row:row + 1])
     kw: dict = {}
     for g in GROUPS:
-        k = len(model.inputs[g])
-        Br = ref.b(g) if len(ref.inputs[g]) else np.zeros((ref.n, k))
-        Dr = ref.d(g)[row:row + 1] if len(ref.inputs[g]) else np.zeros((1, k))
-        kw[g] = (np.vstack([model.b(g), Br]), np.vstack([model.d(g), Dr]))
+        Br, Dr = reference_columns(ref, model, (g,))
+        kw[g] = (np.vstack([model.b(g), Br]), np.vstack([model.d(g), Dr[row:row + 1]]))
     fault_groups = ("f", "w") if match_noise else ("f",)
     Bf = np.hstack([kw[g][0] for g in fault_groups])
     Df = np.hstack([kw[g][1] for g in fault_groups])
@@ -258,13 +323,36 @@ def _siso(num: np.ndarray, den: np.ndarray):
     return A, B, C, D
 
 
-def _target(ref: FaultModel, Ms) -> FaultModel:
-    """``diag(M_i) M_r`` in the reference's groups."""
+def updated_reference(ref: FaultModel, updating) -> FaultModel:
+    """The updated reference ``diag(M_i) M_r`` in the reference's groups.
+
+    Parameters
+    ----------
+    ref : FaultModel
+        ``M_r``.
+    updating : sequence of (numpy.ndarray, numpy.ndarray)
+        ``M_i = num / den`` per output, proper, coefficients highest power first.
+
+    Returns
+    -------
+    FaultModel
+
+    Examples
+    --------
+    >>> ref = FaultModel([[-1.0]], [[0.0]], Df=[[2.0]])
+    >>> T = updated_reference(ref, [(np.array([1.0]), np.array([1.0, 3.0]))])     # 2/(s+3)
+    >>> round(float((T.C @ np.linalg.solve(-T.A, T.b("f")) + T.d("f"))[0, 0]), 9)
+    0.666666667
+
+    References
+    ----------
+    Varga (2017), §5.6 (the updating factor ``M``); fdtools (``info.M * sysr``).
+    """
     import scipy.linalg
 
     from fdikit.design.nullspace.factorization import series
 
-    blocks = [_siso(num, den) for num, den in Ms]
+    blocks = [_siso(num, den) for num, den in updating]
     M = (scipy.linalg.block_diag(*[b[0] for b in blocks]), scipy.linalg.block_diag(*[b[1] for b in blocks]),
          scipy.linalg.block_diag(*[b[2] for b in blocks]), scipy.linalg.block_diag(*[b[3] for b in blocks]))
     n_m = M[0].shape[0]
@@ -302,7 +390,7 @@ def _single(model: FaultModel, ref: FaultModel, names, poles, sdeg, smarg, norma
     gen = ResidualGenerator(A, B, C, D, controls=model.controls, outputs=model.outputs,
                             residuals=tuple(ref.outputs if names is None else names), dt=model.dt)
     matched = ("u", "d", "f", "w") if match_noise else ("u", "d", "f")
-    return ModelMatchingDesign(gen, _target(ref, Ms), tuple(Ms), tuple(orders), ref, matched,
+    return ModelMatchingDesign(gen, updated_reference(ref, Ms), tuple(Ms), tuple(orders), ref, matched,
                                np.linalg.eigvals(A) if A.size else np.zeros(0), model=model)
 
 
@@ -372,7 +460,7 @@ def emmsyn(model: FaultModel, reference, *, names: Sequence[str] | None = None,
             raise ParameterError("names is for one reference; a bank names residual i of filter j r<j>_<i>")
         if not reference:
             raise ParameterError("the bank of references is empty")
-        refs = [_reference(model, r, None) for r in reference]
+        refs = [reference_model(model, r) for r in reference]
         filters = []
         for j, r in enumerate(refs):
             nm = (f"r{j}",) if r.p == 1 else tuple(f"r{j}_{i}" for i in range(r.p))
@@ -382,7 +470,7 @@ def emmsyn(model: FaultModel, reference, *, names: Sequence[str] | None = None,
         gen = stack_generators([f.generator for f in filters])
         return ModelMatchingBankDesign(gen, tuple(filters), tuple(tuple(f.generator.residuals) for f in filters),
                                        tuple(f.generator.n for f in filters), model=model)
-    ref = _reference(model, reference, names)
+    ref = reference_model(model, reference, names)
     if names is None and isinstance(reference, Mapping):
         names = tuple(f"r{i}" for i in range(ref.p))
     return _single(model, ref, names, **opts)

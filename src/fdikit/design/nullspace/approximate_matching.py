@@ -1,0 +1,426 @@
+"""Approximate model matching by the nullspace method: ``ammsyn`` (Varga 2017, §5.6, Procedure AMMS).
+
+The approximate model-matching problem (AMMP) asks for a proper stable ``Q`` on ``[u; y]`` that decouples the
+controls and disturbances exactly and makes the faults-and-noise part of its internal form close to an updated
+reference, in the H∞ or the H2 norm:
+
+    Q [Gu Gd; I 0] = 0,     γ = ‖Q [Gf Gw; 0 0] − M [M_rf M_rw]‖ = min,
+
+with ``M`` diagonal, stable and invertible (``M = I`` when that is possible; ``M_rw = 0`` when the reference has
+no noise group: noise attenuation).  With ``M_r = I`` from the faults this is H∞/H2 fault estimation.
+
+How fdikit solves it (the reference's steps, with its own tools):
+
+1. ``Q₁``: the proper nullspace basis of ``[Gu Gd; I 0]`` (:func:`~fdikit.design.nullspace.basis.left_nullspace`,
+   poles at the default stability degree), ``R = Q₁ [Gf Gw; 0 0]``; when ``R`` lacks full row rank, the first basis
+   rows (ascending degree) that keep its rank (the reference reduces to ``rdim`` rows here instead).
+2. ``R = R_o R_i`` with ``R_i`` co-inner (``R_i R_i~ = I``) and ``R_o`` (quasi-)co-outer: the co-inner factor of
+   ``T R`` after the row operations that remove the zeros at infinity and on the boundary
+   (:func:`~fdikit.design.nullspace.zero_steps.remove_boundary_zeros`; ``T R_o`` is outer, so the co-inner factor is
+   that of ``R``).  The problem is non-standard when there were such zeros.
+3. The least-distance problem ``min ‖Y R_i − F‖`` over stable ``Y``, ``F = [M_rf M_rw]`` (the reference's
+   ``glinfldp`` on ``F R_i~``; since ``R_i`` is inner the two are the same): an H∞ (or H2) model-matching problem
+   with measurement ``R_i v`` whose ``D`` has full row rank (``R_i`` is co-inner), solved by SLICOT's H∞ ``SB10AD``
+   (γ-iteration to ``reltol``) or H2 ``SB10HD`` (through slycot).  Discrete models are solved on the bilinear
+   image ``z = (1 + s)/(1 − s)``, which keeps H∞ norms.  In H2 a continuous ``F`` whose ``D`` cannot be matched
+   is first multiplied by ``M₀ = a/(s + a)``, ``a = −sdeg`` (as the reference does).
+4. ``Q`` with ``Q G_e = M [0 0 Y R_i]``: :func:`~fdikit.design.nullspace.model_matching.emmsyn` on that (stable)
+   target; in the standard case ``Q = Y R_o⁻¹ Q₁`` and ``M = I``, otherwise the least-degree ``M`` makes the
+   improper or unstable ``Y R_o⁻¹ Q₁`` proper and stable (the reference's ``glcf`` with ``mininf``, ``mindeg``).
+
+``gamma_opt0`` is the optimum of step 3, ``gamma_opt`` that of the problem with ``M F``, ``gamma_sub`` the achieved
+``‖Q G_e − M M_r‖``; ``gamma_sub = gamma_opt`` up to ``reltol`` in the standard case.
+
+Why by hand: the steps are the reference's; SLICOT solves the least-distance problem, and no Python library has
+the nullspace, factorisation and updating steps around it.
+
+References
+----------
+Varga (2017), §5.6 (AMMP, Procedure AMMS), §7.9 (co-outer–co-inner factorisation); Varga (2011) (the integrated
+H∞ algorithm, cited by the reference); fdtools (``ammsyn``, ``glinfldp``); SLICOT ``SB10AD``, ``SB10HD``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from fdikit.design.nullspace.basis import default_sdeg, denominator, left_nullspace, realize_rows
+from fdikit.design.nullspace.model_matching import (
+    ModelMatchingDesign,
+    emmsyn,
+    reference_columns,
+    reference_model,
+    updated_reference,
+)
+from fdikit.errors import DesignError, ParameterError
+from fdikit.model import FaultModel
+from fdikit.protocols import FieldReport
+from fdikit.residuals import ResidualGenerator
+
+__all__ = ["ApproximateMatchingDesign", "ammsyn", "least_distance"]
+
+_POINTS = (0.613 + 0.791j, -0.377 + 1.93j)
+
+
+@dataclass(frozen=True, eq=False)
+class ApproximateMatchingDesign(FieldReport):
+    """An approximate model-matching filter (``ammsyn``) and its report.
+
+    Attributes
+    ----------
+    generator : ResidualGenerator
+        The filter ``Q`` (inputs ``[u; y]``), one residual per output of the reference, stable and proper.
+    target : FaultModel
+        The updated reference ``M M_r``.
+    updating : tuple of (numpy.ndarray, numpy.ndarray)
+        ``M_i = num / den`` per residual (``λ``, highest power first); ``M₀`` of the H2 case included.
+    reference : FaultModel
+        ``M_r`` asked for.
+    norm : str
+        ``'inf'`` or ``'2'``.
+    nonstandard : bool
+        Whether ``R = Q₁ [Gf Gw; 0]`` had zeros at infinity or on the stability boundary.
+    gamma_opt0, gamma_opt, gamma_sub : float
+        The optimal distance of the original problem (of ``M₀ M_r`` in the H2 case with ``M₀``), that of the
+        updated problem (``M M_r``), and the distance achieved (reference ``info.gammaopt0``, ``gammaopt``,
+        ``gammasub``).
+    exact : ModelMatchingDesign
+        The ``emmsyn`` design of the last step (``Q G_e = M [0 0 Y R_i]``).
+    poles : numpy.ndarray
+        The filter eigenvalues.
+
+    Examples
+    --------
+    Estimating a sensor fault ``f`` from ``y = f + w`` (``G_f = 1``, ``G_w = 1/(s+1)``): the optimum over stable
+    ``q`` of ``‖[q − 1, q/(s+1)]‖∞`` is reached at a constant ``q``, ``γ = 1/√2`` (``q = 1/2``):
+
+    >>> m = FaultModel([[-1.0]], [[1.0]], Bw=[[1.0]], Df=[[1.0]])
+    >>> d = ammsyn(m, {"f": [[1.0]]})
+    >>> round(d.gamma_opt0, 4), d.nonstandard
+    (0.7071, False)
+
+    References
+    ----------
+    Varga (2017), §5.6, Procedure AMMS; fdtools (``ammsyn``).
+    """
+
+    generator: ResidualGenerator
+    target: FaultModel
+    updating: tuple[tuple[np.ndarray, np.ndarray], ...]
+    reference: FaultModel
+    norm: str
+    nonstandard: bool
+    gamma_opt0: float
+    gamma_opt: float
+    gamma_sub: float
+    exact: ModelMatchingDesign
+    poles: np.ndarray
+
+    REPORT = ("norm", "nonstandard", "gamma_opt0", "gamma_opt", "gamma_sub", "updating", "poles")
+
+
+def _bilinear(sys, to_continuous: bool):
+    """The bilinear image of ``(A, B, C, D)``: ``G(z)`` at ``z = (1+s)/(1−s)``, or back at ``s = (z−1)/(z+1)``."""
+    from fdikit.design.nullspace.wiener_hopf import moebius
+
+    return moebius(*sys, 1.0, 1.0, -1.0, 1.0) if to_continuous else moebius(*sys, 1.0, -1.0, 1.0, 1.0)
+
+
+def _plant(inner, F, Y0=None):
+    """Generalised plant of ``min ‖Y R_i − F‖``: inputs ``[v; Y's output]``, outputs ``[z; R_i v]``."""
+    import scipy.linalg
+
+    A1, B1, C1, D1 = inner
+    A2, B2, C2, D2 = F
+    q, r, m = D2.shape[0], D1.shape[0], D1.shape[1]
+    n1, n2 = A1.shape[0], A2.shape[0]
+    Y0 = np.zeros((q, r)) if Y0 is None else Y0
+    A = scipy.linalg.block_diag(A1, A2)
+    B = np.block([[B1, np.zeros((n1, q))], [B2, np.zeros((n2, q))]])
+    C = np.block([[Y0 @ C1, -C2], [C1, np.zeros((r, n2))]])
+    D = np.block([[Y0 @ D1 - D2, np.eye(q)], [D1, np.zeros((r, q))]])
+    return A, B.reshape(n1 + n2, m + q), C.reshape(q + r, n1 + n2), D
+
+
+def _closed_loop_norm(A, B, C, D, q: int, r: int, K) -> float:
+    """``‖Y R_i − F‖∞`` of the plant closed by ``Y`` (``P₂₂ = 0``, so the loop is open: a series connection)."""
+    from fdikit.analysis.channels import Channel, hinf_norm
+
+    Ak, Bk, Ck, Dk = K
+    n, m = A.shape[0], B.shape[1] - q
+    A1, B1, C1, D11, D12 = A, B[:, :m], C[:q], D[:q, :m], D[:q, m:]
+    C2, D21 = C[q:], D[q:, :m]
+    Acl = np.block([[A1, np.zeros((n, Ak.shape[0]))], [Bk @ C2, Ak]])
+    Bcl = np.vstack([B1, Bk @ D21])
+    Ccl = np.hstack([C1 + D12 @ Dk @ C2, D12 @ Ck])
+    Dcl = D11 + D12 @ Dk @ D21
+    return float(hinf_norm(Channel(Acl, Bcl, Ccl, Dcl, None))[0])
+
+
+def _hinf_bisection(A, B, C, D, q: int, r: int, F, reltol: float):
+    """Bisection on γ: SB10AD's suboptimal controller (``job = 4``) accepted when the loop's norm is below γ.
+
+    SB10AD's own γ-iteration (``job = 1``) stops on the closed-loop stability, which here (``B₂ = 0``, a stable
+    plant) never fails, and went below the optimum on Example 5.14 (its controller missed the γ it returned).
+    """
+    import slycot
+
+    from fdikit.analysis.channels import Channel, hinf_norm
+
+    n, m_all = A.shape[0], B.shape[1]
+    top = hinf_norm(Channel(*F, None))[0]
+    hi, floor = 1.001 * top + 1e-12, 1e-9 * top
+    K_hi = None
+    lo = 0.0
+    for _ in range(200):
+        g = 0.5 * (lo + hi) if K_hi is not None else hi
+        try:
+            K = slycot.sb10ad(n, m_all, q + r, q, r, g, A, B, C, D, job=4)[1:5]
+            ok = _closed_loop_norm(A, B, C, D, q, r, K) <= g * (1 + 1e-9)
+        except (ValueError, ArithmeticError):
+            ok = False
+        if ok:
+            hi, K_hi = g, K
+        elif K_hi is None:
+            raise DesignError(f"SB10AD found no controller at γ = {g:g} ≥ ‖F‖∞; the least-distance problem is "
+                              "ill-posed (check that the reference is stable)")
+        else:
+            lo = g
+        if K_hi is not None and (hi - lo <= reltol * hi or hi <= floor):
+            break
+    return hi, K_hi
+
+
+def least_distance(inner, F, *, norm: str = "inf", dt: float | None = None, reltol: float = 1e-4):
+    """``Y`` stable minimising ``‖Y R_i − F‖`` (H∞ or H2) for a co-inner ``R_i`` and a stable ``F``.
+
+    Parameters
+    ----------
+    inner : tuple of numpy.ndarray
+        ``(A, B, C, D)`` of ``R_i`` (``r × m``, stable, ``R_i R_i~ = I``).
+    F : tuple of numpy.ndarray
+        ``(A, B, C, D)`` of ``F`` (``q × m``, stable).
+    norm : {'inf', '2'}, default 'inf'
+        The norm; ``'2'`` needs a continuous problem with ``F`` matchable at infinity (finite H2 distance).
+    dt : float or None
+        Sample time (discrete H∞ is solved on the bilinear image).
+    reltol : float, default 1e-4
+        Relative accuracy of the H∞ γ-iteration.
+
+    Returns
+    -------
+    tuple
+        ``((A, B, C, D) of Y, γ)``: the controller and the optimal distance (H∞: SB10AD's estimate; H2: the
+        distance of ``Y``).
+
+    Raises
+    ------
+    DesignError
+        When SLICOT fails (an assumption of SB10AD/SB10HD violated, e.g. ``F`` unstable).
+
+    Examples
+    --------
+    ``R_i = [1/√2, 1/√2]`` (static), ``F = [1, 0]``: ``Y = 1/√2``, ``γ = 1/√2``.
+
+    >>> Y, g = least_distance((np.zeros((0, 0)), np.zeros((0, 2)), np.zeros((1, 0)), np.full((1, 2), 0.5 ** 0.5)),
+    ...                       (np.zeros((0, 0)), np.zeros((0, 2)), np.zeros((1, 0)), np.array([[1.0, 0.0]])))
+    >>> round(float(Y[3][0, 0]), 9), round(g, 9)
+    (0.707106781, 0.707106781)
+
+    References
+    ----------
+    Varga (2017), §5.6 (the least-distance problem of Procedure AMMS); fdtools (``glinfldp``); SLICOT ``SB10AD``,
+    ``SB10HD``.
+    """
+    import slycot
+
+    from fdikit.analysis.channels import Channel, h2_norm
+
+    inner = tuple(np.atleast_2d(np.asarray(M, dtype=float)) for M in inner)
+    F = tuple(np.atleast_2d(np.asarray(M, dtype=float)) for M in F)
+    q, r = F[3].shape[0], inner[3].shape[0]
+    Y0 = F[3] @ inner[3].T if dt is None else None
+    if dt is not None:
+        inner, F = _bilinear(inner, True), _bilinear(F, True)
+        Y0 = F[3] @ inner[3].T
+    A, B, C, D = _plant(inner, F, Y0)
+    n = A.shape[0]
+    if n == 0:        # static: Y = F Rᵢᵀ, the distance of the part of F orthogonal to the rows of Rᵢ
+        Y = (np.zeros((0, 0)), np.zeros((0, r)), np.zeros((q, 0)), Y0)
+        g = float(np.linalg.norm(D[:q, : D.shape[1] - q], 2)) if norm == "inf" else (
+            0.0 if np.allclose(D[:q, : D.shape[1] - q], 0) else float("inf"))
+        return (Y if dt is None else _bilinear(Y, False)), g
+    m_all = B.shape[1]
+    try:
+        if norm == "inf":
+            g, (Ak, Bk, Ck, Dk) = _hinf_bisection(A, B, C, D, q, r, F, reltol)
+        else:
+            if np.abs(D[:q, : m_all - q]).max(initial=0.0) > 1e-10 * max(1.0, np.abs(F[3]).max(initial=0.0)):
+                raise DesignError("the H2 distance is infinite: F is not matched at infinity; multiply it by a "
+                                  "low-pass (ammsyn does, with M₀ = a/(s + a))")
+            Ak, Bk, Ck, Dk = slycot.sb10hd(n, m_all, q + r, q, r, A, B, C, D)[:4]
+    except (ValueError, ArithmeticError) as err:
+        raise DesignError(f"SLICOT could not solve the least-distance problem: {err}") from err
+    Y = (Ak, Bk, Ck, Dk + Y0)
+    if norm != "inf":
+        from fdikit.design.nullspace.factorization import series
+
+        A2, B2, C2, D2 = series(inner, Y)
+        import scipy.linalg
+
+        Ae = scipy.linalg.block_diag(A2, F[0])
+        diff = Channel(Ae, np.vstack([B2, F[1]]), np.hstack([C2, -F[2]]), D2 - F[3], None)
+        g = float(h2_norm(diff))
+    return (Y if dt is None else _bilinear(Y, False)), float(g)
+
+
+def _basis_rows(model: FaultModel):
+    """The proper basis ``Q₁`` (the first rows, by degree, that keep the rank of ``R``) and ``R``'s minimal channel."""
+    from fdikit.analysis.channels import minimal_channel
+
+    basis = left_nullspace(model)
+    if not basis.rows:
+        raise DesignError("the nullspace of [Gu Gd; I 0] is empty: no filter decouples the controls and the "
+                          "disturbances, so no model matching is possible")
+    fw = list(model.faults) + list(model.noise)
+    if not fw:
+        raise DesignError("the model has no fault or noise inputs: nothing to match")
+    mu = len(model.controls)
+    Bfw, Dfw = np.hstack([model.b("f"), model.b("w")]), np.hstack([model.d("f"), model.d("w")])
+
+    def rank(rows, lam) -> int:
+        G = Dfw + (model.C @ np.linalg.solve(lam * np.eye(model.n) - model.A, Bfw) if model.n else 0)
+        sv = np.linalg.svd(basis.evaluate(lam, rows)[:, mu:] @ G, compute_uv=False)
+        return int(np.sum(sv > 1e-9 * max(sv[0], 1e-300)))
+
+    chosen: list[int] = []
+    for i in range(len(basis.rows)):
+        if min(rank(chosen + [i], z * basis.scale) for z in _POINTS) == len(chosen) + 1:
+            chosen.append(i)
+    if not chosen:
+        raise DesignError("no fault or noise input reaches the decoupled residuals: nothing to match")
+    dens = [denominator(basis.degrees[i], None, None, model.dt) for i in chosen]
+    A, B, C, D = realize_rows([basis.rows[i] for i in chosen], dens, basis.scale)
+    gen = ResidualGenerator(A, B, C, D, controls=model.controls, outputs=model.outputs,
+                            residuals=tuple(f"q{i}" for i in chosen), dt=model.dt)
+    return minimal_channel(gen.internal_form(model), fw)
+
+
+def _target_columns(model: FaultModel, ref: FaultModel):
+    """``F = [M_rf M_rw]`` (``M_rw = 0`` when the reference has no noise) as ``(A, B, C, D)``."""
+    B, D = reference_columns(ref, model, ("f", "w"))
+    return ref.A, B, ref.C, D
+
+
+def _low_pass(F, a: float):
+    """``M₀ F`` with ``M₀ = a/(s + a)`` on every output (continuous H2 with an unmatched ``D``)."""
+    from fdikit.design.nullspace.factorization import series
+
+    q = F[3].shape[0]
+    return series(F, (-a * np.eye(q), a * np.eye(q), np.eye(q), np.zeros((q, q))))
+
+
+def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[str] | None = None,
+           poles: Sequence[complex] | None = None, sdeg: float | None = None, smarg: float | None = None,
+           normalize: str = "infnorm", reltol: float = 1e-4, tol: float = 1e-7) -> ApproximateMatchingDesign:
+    """Approximate model matching in the H∞ or H2 norm (Procedure AMMS).
+
+    Parameters
+    ----------
+    model : FaultModel
+        The plant (continuous or discrete; H2 continuous only).
+    reference : FaultModel or mapping
+        ``M_r`` on the faults and optionally the noise (no controls or disturbances: those are decoupled exactly;
+        :func:`~fdikit.design.nullspace.model_matching.emmsyn` matches them), stable; a static ``{group: matrix}``.
+    norm : {'inf', '2'}, default 'inf'
+        H∞ (the reference's default) or H2 (``H2syn = true``).
+    names : sequence of str, optional
+        Residual names (default the reference's outputs; ``r<i>`` for a static reference).
+    poles, sdeg, smarg, normalize
+        The updating factor of the non-standard case, as in :func:`~fdikit.design.nullspace.model_matching.emmsyn`
+        (``normalize`` default ``'infnorm'``, the reference's).
+    reltol : float, default 1e-4
+        Relative accuracy of the H∞ γ-iteration.
+    tol : float, default 1e-7
+        Rank and zero decisions.
+
+    Returns
+    -------
+    ApproximateMatchingDesign
+
+    Raises
+    ------
+    DesignError
+        An empty nullspace, nothing to match, an unstable reference, a SLICOT failure.
+    ParameterError
+        A reference with controls or disturbances, discrete H2, bad options.
+
+    Examples
+    --------
+    >>> m = FaultModel([[-1.0]], [[1.0]], Bw=[[1.0]], Df=[[1.0]])
+    >>> d = ammsyn(m, {"f": [[1.0]]})
+    >>> round(d.gamma_sub, 4), round(d.gamma_opt0, 4)
+    (0.7071, 0.7071)
+
+    References
+    ----------
+    Varga (2017), §5.6, Procedure AMMS; fdtools (``ammsyn``).
+    """
+    from fdikit.analysis.performance import fdimmperf
+    from fdikit.design.nullspace.zero_steps import remove_boundary_zeros
+
+    which = {"inf": "inf", "2": "2", np.inf: "inf", 2: "2"}.get(norm.lower() if isinstance(norm, str) else norm)
+    if which is None:
+        raise ParameterError(f"norm must be 'inf' (H∞) or 2 (H2), got {norm!r}")
+    if which == "2" and model.dt is not None:
+        raise ParameterError("norm='2' needs a continuous model: discrete H2 model matching is not implemented; "
+                             "use norm='inf'")
+    if not (np.isfinite(reltol) and 0 < reltol < 1):
+        raise ParameterError(f"reltol must be in (0, 1), got {reltol}")
+    ref = reference_model(model, reference, names)
+    if len(ref.inputs["u"]) or len(ref.inputs["d"]):
+        raise ParameterError("ammsyn matches the faults and the noise and decouples the controls and the "
+                             "disturbances; give a reference without them (emmsyn matches them exactly)")
+    from fdikit.analysis.channels import minimal_channel
+
+    ev = np.linalg.eigvals(minimal_channel(ref).A)
+    if ev.size and np.max(ev.real if ref.dt is None else np.abs(ev)) >= (0.0 if ref.dt is None else 1.0):
+        raise DesignError(f"the reference model has unstable poles {np.round(ev, 6).tolist()}; the model-matching "
+                          "error has no finite norm: give a stable reference")
+    if names is None and not isinstance(reference, FaultModel):
+        names = tuple(f"r{i}" for i in range(ref.p))
+    names = tuple(ref.outputs if names is None else names)
+    ch = _basis_rows(model)
+    C1, D1, steps, g1 = remove_boundary_zeros(ch.A, ch.B, ch.C, ch.D, model.dt, tol=tol)
+    inner = g1.inner
+    F = _target_columns(model, ref)
+    s0 = default_sdeg(model.dt) if sdeg is None else float(sdeg)
+    M0 = None
+    if which == "2":
+        unmatched = F[3] - F[3] @ inner[3].T @ inner[3]
+        if np.abs(unmatched).max(initial=0.0) > tol * max(1.0, np.abs(F[3]).max(initial=0.0)):
+            M0 = (np.array([-s0]), np.array([1.0, -s0]))
+            F = _low_pass(F, -s0)
+    Y, g0 = least_distance(inner, F, norm=which, dt=model.dt, reltol=reltol)
+    from fdikit.design.nullspace.factorization import series
+
+    A, B, C, D = series(inner, Y)                                   # Y R_i on [f; w]
+    nf = len(model.faults)
+    fit = FaultModel(A, C, Bf=B[:, :nf], Df=D[:, :nf], Bw=B[:, nf:], Dw=D[:, nf:], faults=model.faults,
+                     noise=model.noise, outputs=names, dt=model.dt)
+    exact = emmsyn(model, fit, names=names, poles=poles, sdeg=sdeg, smarg=smarg, normalize=normalize, tol=tol)
+    upd = exact.updating
+    if M0 is not None:
+        upd = tuple((np.polymul(num, M0[0]), np.polymul(den, M0[1])) for num, den in upd)
+    target = updated_reference(ref, upd)
+    if any(len(den) > 1 or num.tolist() != den.tolist() for num, den in exact.updating):
+        g_opt = least_distance(inner, _target_columns(model, target), norm=which, dt=model.dt, reltol=reltol)[1]
+    else:
+        g_opt = g0
+    gen = exact.generator
+    g_sub = float(fdimmperf(gen.internal_form(model), ref=target, norm=which))
+    return ApproximateMatchingDesign(gen, target, upd, ref, which, bool(steps), float(g0), float(g_opt), g_sub,
+                                     exact, exact.poles, model=model)

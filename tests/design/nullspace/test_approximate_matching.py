@@ -1,0 +1,157 @@
+"""ammsyn against the reference's tests (FaultDetectionTools.jl test_ammsyn.jl, Examples 5.14–5.17) and hand optima.
+
+Checks, all independent of the synthesis path:
+
+* the achieved distance ``gamma_sub`` equals a dense frequency sweep of ``σ_max(Q G_e − M M_r)`` (the reference's
+  ``glinfnorm(Me − Q Ge) ≈ gammasub``) and the decoupling of the controls is exact;
+* hand optima: ``y = f + w/(s+1)`` (continuous) and its discrete analogue have ``γ = 1/√2`` (the bound at DC, reached
+  by ``q = 1/2``); Example 5.6's plant with ``M_r = [1 1]`` has ``γ = 1/√2`` (bound at DC, ``X = [1 1]``);
+* the optimum of the non-standard problems equals the limit of the standard problems regularised by a sensor
+  noise ``ε`` (solved on ``R = [G_f G_w εI]`` directly, without the co-inner factor): ``γ(ε) ≥ γ_opt0`` and
+  ``γ(10⁻⁴)`` within ``10⁻³`` of it;
+* exactly achievable references give ``γ = 0`` (``M_r = G``: ``Q = I``; Niemann with ``M_r = [1 0]``);
+* Example 5.16: ``gamma_sub − gamma_opt < 0.002`` (the reference's bound) with ``M = 10/(s + 10)``.
+"""
+
+import numpy as np
+import pytest
+from varga_examples import niemann, random_plant, response
+
+from fdikit.design.nullspace import ammsyn, least_distance
+from fdikit.errors import DesignError, ParameterError
+from fdikit.model import FaultModel
+from fdikit.protocols import DesignResult
+
+
+def sweep(design, norm="inf"):
+    """``max_ω σ_max(Q G_e − M M_r)`` on 4001 points (H∞), or the H2 integral by the trapezoid rule."""
+    form, target = design.internal_form(), design.target
+    w = np.concatenate([[0.0], np.logspace(-4, 4, 4000)])
+    vals = []
+    for x in w:
+        lam = 1j * x if form.dt is None else np.exp(1j * x * np.pi / 1e4)
+        E = np.hstack([response(form, g, lam) - (response(target, g, lam) if target.inputs[g] else 0)
+                       for g in ("f", "w") if form.inputs[g]])
+        vals.append(np.linalg.norm(E, 2) if norm == "inf" else np.linalg.norm(E, "fro") ** 2)
+    if norm == "inf":
+        return max(vals)
+    return float(np.sqrt(np.trapezoid(vals, w) / np.pi))
+
+
+def ex5_14():
+    """Varga (2017), Example 5.14: G_f = 1/(s+1), G_w = 1/(s+2), M_r = 1/(s+3)."""
+    m = FaultModel([[-1.0, 0.0], [0.0, -2.0]], [[1.0, 1.0]], Bf=[[1.0], [0.0]], Bw=[[0.0], [1.0]])
+    return m, FaultModel([[-3.0]], [[1.0]], Bf=[[1.0]])
+
+
+def ex5_16():
+    """Varga (2017), Example 5.16: three states, two controls, actuator faults, two noise inputs."""
+    A = np.array([[-0.8, 0, 0], [0, -0.5, 0.6], [0, -0.6, -0.5]])
+    Bu = np.array([[1.0, 1], [1, 0], [0, 1]])
+    Bw = 0.25 * np.array([[0.0, 0], [0, 1], [1, 0]])
+    return FaultModel(A, np.array([[0.0, 1, 1], [1, 1, 0]]), Bu=Bu, Bf=Bu, Bw=Bw)
+
+
+def regularized(m, ref, eps, norm):
+    """The optimum of ``min ‖q [G_f G_w εI] − [M_r 0 0]‖`` (p outputs, no controls): the standard problem."""
+    p, nf, nw = m.p, len(m.faults), len(m.noise)
+    R = (m.A, np.hstack([m.B, np.zeros((m.n, p))]), m.C, np.hstack([m.D, eps * np.eye(p)]))
+    F = (ref.A, np.hstack([ref.b("f"), np.zeros((ref.n, nw + p))]), ref.C,
+         np.hstack([ref.d("f"), np.zeros((ref.p, nw + p))]))
+    assert nf == ref.b("f").shape[1]
+    return least_distance(R, F, norm=norm, reltol=1e-6)[1]
+
+
+def test_hand_optimum_continuous_and_discrete():
+    m = FaultModel([[-1.0]], [[1.0]], Bw=[[1.0]], Df=[[1.0]])
+    d = ammsyn(m, {"f": [[1.0]]})
+    assert isinstance(d, DesignResult)
+    assert not d.nonstandard and d.norm == "inf"
+    assert d.gamma_opt0 == pytest.approx(2 ** -0.5, rel=2e-4)
+    assert d.gamma_sub == pytest.approx(2 ** -0.5, rel=2e-4) and d.gamma_sub <= d.gamma_opt0 * (1 + 1e-9)
+    assert sweep(d) == pytest.approx(d.gamma_sub, rel=1e-6)
+    # discrete: y = f + 0.5 w/(z − 0.5), the same bound at z = 1
+    md = FaultModel([[0.5]], [[1.0]], Bw=[[0.5]], Df=[[1.0]], dt=0.1)
+    dd = ammsyn(md, {"f": [[1.0]]})
+    assert dd.gamma_sub == pytest.approx(2 ** -0.5, rel=2e-4)
+    assert np.all(np.abs(dd.poles) < 1)
+
+
+def test_example_5_6_plant_with_controls():
+    # Gu = [(s+1)/(s+2); (s+2)/(s+3)], Gf = [(s+1)/(s+2) 0; 0 1], Gw = [1/(s+2); 0]; M_r = [1 1]
+    m = FaultModel(np.diag([-2.0, -3.0]), [[1.0, 0.0], [0.0, 1.0]], Bu=[[-1.0], [-1.0]], Du=[[1.0], [1.0]],
+                   Bf=[[-1.0, 0.0], [0.0, 0.0]], Df=[[1.0, 0.0], [0.0, 1.0]], Bw=[[1.0], [0.0]])
+    d = ammsyn(m, {"f": [[1.0, 1.0]]})
+    assert d.gamma_sub == pytest.approx(2 ** -0.5, rel=2e-4)
+    form = d.internal_form()
+    for lam in (0.3j, 2.0 + 1j):
+        assert np.abs(response(form, "u", lam)).max() < 1e-9
+    assert sweep(d) == pytest.approx(d.gamma_sub, rel=1e-6)
+
+
+@pytest.mark.parametrize("norm", ["inf", "2"])
+def test_example_5_14_nonstandard_is_the_regularised_limit(norm):
+    m, ref = ex5_14()
+    d = ammsyn(m, ref, norm=norm, sdeg=-1.0, normalize="gain", reltol=1e-5)
+    assert d.nonstandard
+    assert sweep(d, norm) == pytest.approx(d.gamma_sub, rel=1e-3 if norm == "2" else 1e-6)
+    assert d.gamma_sub <= d.gamma_opt * (1 + 1e-4)
+    g = regularized(m, ref, 1e-4, norm)       # above the infimum (reltol of the two bisections), and close to it
+    assert g >= d.gamma_opt0 * (1 - 1e-4)
+    assert g - d.gamma_opt0 <= 1e-3 * d.gamma_opt0
+
+
+def test_example_5_16_updating_factor():
+    m = ex5_16()
+    d = ammsyn(m, {"f": np.eye(2)}, sdeg=-10.0, normalize="dcgain", reltol=5e-4)
+    assert d.nonstandard
+    for num, den in d.updating:                      # M = 10/(s + 10) on both residuals
+        np.testing.assert_allclose(num, [10.0], rtol=1e-9)
+        np.testing.assert_allclose(den, [1.0, 10.0], rtol=1e-9)
+    assert d.gamma_sub - d.gamma_opt < 0.002         # the reference's check (Ex5_16.jl)
+    assert d.gamma_opt <= d.gamma_opt0
+    assert sweep(d) == pytest.approx(d.gamma_sub, rel=1e-5)
+    form = d.internal_form()
+    assert np.abs(response(form, "u", 0.7j)).max() < 1e-9
+
+
+def test_example_5_17_h2():
+    m = ex5_16()
+    ref = FaultModel(-10.0 * np.eye(2), np.eye(2), Bf=10.0 * np.eye(2))      # 10/(s+10) I
+    d = ammsyn(m, ref, norm="2", sdeg=-10.0, normalize="dcgain")
+    assert d.norm == "2"
+    assert sweep(d, "2") == pytest.approx(d.gamma_sub, rel=1e-3)
+    # with M_r = I the H2 distance is infinite, so M₀ = 10/(s+10) is applied first (the reference's Mib)
+    d0 = ammsyn(m, {"f": np.eye(2)}, norm="2", sdeg=-10.0, normalize="dcgain")
+    assert all(np.polyval(num, 0) / np.polyval(den, 0) == pytest.approx(1.0) for num, den in d0.updating)
+    assert np.isfinite(d0.gamma_sub) and sweep(d0, "2") == pytest.approx(d0.gamma_sub, rel=1e-3)
+
+
+def test_exact_references_give_zero():
+    m = random_plant(11, 1, 2, 0, 0, 2)
+    ref = FaultModel(m.A, m.C, Bf=m.b("f"), Df=m.d("f"), faults=m.faults)
+    d = ammsyn(m, ref)
+    assert d.gamma_sub < 1e-7
+    np.testing.assert_allclose(d.generator.D, np.eye(2), atol=1e-6)
+    n = niemann()
+    for row in ([[1.0, 0.0]], [[0.0, 1.0]]):
+        dn = ammsyn(n, {"f": row}, sdeg=-5.0, reltol=1e-5)
+        assert dn.gamma_sub < 1e-7 and np.all(dn.poles.real < 0)
+        lam = 0.4j
+        Rf = response(dn.internal_form(), "f", lam)
+        assert abs(Rf[0, 1 - row[0].index(1.0)]) < 1e-7 * abs(Rf[0, row[0].index(1.0)])
+
+
+def test_bad_input():
+    m, ref = ex5_14()
+    with pytest.raises(ParameterError, match="norm"):
+        ammsyn(m, ref, norm=1)
+    with pytest.raises(ParameterError, match="continuous"):
+        ammsyn(FaultModel([[0.5]], [[1.0]], Bw=[[0.5]], Df=[[1.0]], dt=0.1), {"f": [[1.0]]}, norm="2")
+    with pytest.raises(DesignError, match="unstable"):
+        ammsyn(m, FaultModel([[1.0]], [[1.0]], Bf=[[1.0]]))
+    mu = FaultModel([[-1.0]], [[1.0], [1.0]], Bu=[[1.0]], Df=np.eye(2))
+    with pytest.raises(ParameterError, match="controls"):
+        ammsyn(mu, {"u": [[1.0]]})
+    with pytest.raises(DesignError, match="empty"):
+        ammsyn(FaultModel([[-1.0]], [[1.0]], Bd=[[1.0]], Bf=[[1.0]]), {"f": [[1.0]]})
