@@ -45,8 +45,8 @@ __getattr__, __dir__, __all__ = lazy.attach(
         "model_distances": ["MODEL_DISTANCES", "ModelDistances", "check_models", "mddist", "nu_gap"],
         "model_detection": ["ModelDetectionDesign", "difference_model", "emdsyn", "mdgenspec", "mdmatch"],
         "model_matching": [
-            "ModelMatchingBankDesign", "ModelMatchingDesign", "NORMALIZE_OPTIONS", "emmsyn", "reference_columns",
-            "reference_model", "updated_reference",
+            "ModelMatchingBankDesign", "ModelMatchingDesign", "NORMALIZE_OPTIONS", "emmsyn", "reference_bank",
+            "reference_columns", "reference_model", "updated_reference",
         ],
         "approximate_matching": ["ApproximateMatchingDesign", "ammsyn", "least_distance"],
         "row_factors": ["RowSpectrum", "WIENER_HOPF_JOBS", "realize_biproper", "row_spectrum", "wiener_hopf_row"],

@@ -52,7 +52,7 @@ from fdikit.protocols import FieldReport
 from fdikit.residuals import ResidualGenerator
 
 __all__ = ["ModelMatchingDesign", "ModelMatchingBankDesign", "emmsyn", "NORMALIZE_OPTIONS", "reference_model",
-           "updated_reference", "reference_columns"]
+           "updated_reference", "reference_columns", "reference_bank"]
 
 NORMALIZE_OPTIONS = ("gain", "dcgain", "infnorm")
 _GROUP_KW = {"u": "controls", "d": "disturbances", "f": "faults", "w": "noise"}
@@ -107,14 +107,14 @@ class ModelMatchingDesign(FieldReport):
 
 @dataclass(frozen=True, eq=False)
 class ModelMatchingBankDesign(FieldReport):
-    """A bank of exact model-matching filters, one per reference model (``emmsyn`` with a sequence).
+    """A bank of model-matching filters, one per reference model (``emmsyn`` or ``ammsyn`` with a sequence).
 
     Attributes
     ----------
     generator : ResidualGenerator
         The stacked bank (``residuals.stack_generators``).
-    filters : tuple of ModelMatchingDesign
-        One design per reference.
+    filters : tuple of ModelMatchingDesign or ApproximateMatchingDesign
+        One design per reference (``emmsyn`` or ``ammsyn``).
     groups : tuple of tuple of str
         The residual names of each filter (for ``ThresholdEvaluator(groups=...)``).
     orders : tuple of int
@@ -132,7 +132,7 @@ class ModelMatchingBankDesign(FieldReport):
     """
 
     generator: ResidualGenerator
-    filters: tuple[ModelMatchingDesign, ...]
+    filters: tuple
     groups: tuple[tuple[str, ...], ...]
     orders: tuple[int, ...]
 
@@ -367,6 +367,31 @@ def updated_reference(ref: FaultModel, updating) -> FaultModel:
     return FaultModel(A, C, outputs=ref.outputs, dt=ref.dt, **kw)
 
 
+def _response(A, B, C, D, lam: complex) -> np.ndarray:
+    return D + (C @ np.linalg.solve(lam * np.eye(A.shape[0]) - A, B) if A.shape[0] else 0)
+
+
+def _check(model: FaultModel, gen: ResidualGenerator, target: FaultModel, groups) -> None:
+    """Raise when ``Q G_e − M M_r`` is not zero to rounding at three points (a rank decision failed)."""
+    alpha = max(1.0, float(np.linalg.norm(model.A, 2))) if model.n else 1.0
+    Bg, Dg = np.hstack([model.b(g) for g in groups]), np.hstack([model.d(g) for g in groups])
+    Eu = np.hstack([np.eye(len(model.controls)) if g == "u" else np.zeros((len(model.controls), len(model.inputs[g])))
+                    for g in groups])
+    Bt, Dt = reference_columns(target, model, groups)
+    worst = 0.0
+    for lam in (0.7 + 0.7j, 1j * np.sqrt(alpha), alpha * (0.6 + 0.8j)):
+        Q = _response(gen.A, gen.B, gen.C, gen.D, lam)
+        G = np.vstack([Eu, _response(model.A, Bg, model.C, Dg, lam)])    # the generator reads [u; y]
+        T = _response(target.A, Bt, target.C, Dt, lam)
+        scale = np.linalg.norm(Q, 2) * np.linalg.norm(G, 2) + np.linalg.norm(T, 2)
+        worst = max(worst, float(np.linalg.norm(Q @ G - T, 2) / max(scale, 1e-300)))
+    if worst > 1e-6:
+        raise DesignError(f"the model-matching filter fails its check: |Q G_e − M M_r| is {worst:.1e} of the terms "
+                          "(a rank decision of the least-degree solution failed, typically for a reference of high "
+                          "order or with widely spread poles; reduce the reference (minimal, balanced realisation) "
+                          "or change tol)")
+
+
 def _single(model: FaultModel, ref: FaultModel, names, poles, sdeg, smarg, normalize, tol) -> ModelMatchingDesign:
     match_noise = bool(len(ref.inputs["w"]))
     rows, Ms, orders = [], [], []
@@ -390,8 +415,59 @@ def _single(model: FaultModel, ref: FaultModel, names, poles, sdeg, smarg, norma
     gen = ResidualGenerator(A, B, C, D, controls=model.controls, outputs=model.outputs,
                             residuals=tuple(ref.outputs if names is None else names), dt=model.dt)
     matched = ("u", "d", "f", "w") if match_noise else ("u", "d", "f")
-    return ModelMatchingDesign(gen, updated_reference(ref, Ms), tuple(Ms), tuple(orders), ref, matched,
+    target = updated_reference(ref, Ms)
+    _check(model, gen, target, matched)
+    return ModelMatchingDesign(gen, target, tuple(Ms), tuple(orders), ref, matched,
                                np.linalg.eigvals(A) if A.size else np.zeros(0), model=model)
+
+
+def reference_bank(model: FaultModel, references, names, synthesize) -> ModelMatchingBankDesign:
+    """A bank: ``synthesize(reference, names)`` per reference, residual ``i`` of filter ``j`` named ``r<j>_<i>``.
+
+    Parameters
+    ----------
+    model : FaultModel
+        The plant.
+    references : sequence
+        The references (FaultModels or static mappings).
+    names : None
+        Must be None (a bank names its residuals).
+    synthesize : callable
+        ``(reference, names) -> design`` with a ``generator``.
+
+    Returns
+    -------
+    ModelMatchingBankDesign
+
+    Raises
+    ------
+    ParameterError
+        ``names`` given, or an empty bank.
+
+    Examples
+    --------
+    >>> m = FaultModel([[-1.0]], [[1.0], [1.0]], Bu=[[1.0]], Df=np.eye(2))
+    >>> bank = reference_bank(m, [{"f": [[1.0, 0.0]]}], None, lambda r, nm: emmsyn(m, r, names=nm))
+    >>> bank.groups
+    (('r0',),)
+
+    References
+    ----------
+    Varga (2017), §5.6; fdtools (``emmsyn``/``ammsyn`` with a bank of reference models).
+    """
+    from fdikit.residuals import stack_generators
+
+    if names is not None:
+        raise ParameterError("names is for one reference; a bank names residual i of filter j r<j>_<i>")
+    if not references:
+        raise ParameterError("the bank of references is empty")
+    filters = []
+    for j, r in enumerate(references):
+        p = reference_model(model, r).p
+        filters.append(synthesize(r, (f"r{j}",) if p == 1 else tuple(f"r{j}_{i}" for i in range(p))))
+    gen = stack_generators([f.generator for f in filters])
+    return ModelMatchingBankDesign(gen, tuple(filters), tuple(tuple(f.generator.residuals) for f in filters),
+                                   tuple(f.generator.n for f in filters), model=model)
 
 
 def emmsyn(model: FaultModel, reference, *, names: Sequence[str] | None = None,
@@ -456,20 +532,8 @@ def emmsyn(model: FaultModel, reference, *, names: Sequence[str] | None = None,
     denominator(1, None, default_sdeg(dt) if sdeg is None else sdeg, dt)          # checks sdeg
     opts = dict(poles=poles, sdeg=sdeg, smarg=float(smarg), normalize=normalize, tol=tol)
     if isinstance(reference, (list, tuple)):
-        if names is not None:
-            raise ParameterError("names is for one reference; a bank names residual i of filter j r<j>_<i>")
-        if not reference:
-            raise ParameterError("the bank of references is empty")
-        refs = [reference_model(model, r) for r in reference]
-        filters = []
-        for j, r in enumerate(refs):
-            nm = (f"r{j}",) if r.p == 1 else tuple(f"r{j}_{i}" for i in range(r.p))
-            filters.append(_single(model, r, nm, **opts))
-        from fdikit.residuals import stack_generators
-
-        gen = stack_generators([f.generator for f in filters])
-        return ModelMatchingBankDesign(gen, tuple(filters), tuple(tuple(f.generator.residuals) for f in filters),
-                                       tuple(f.generator.n for f in filters), model=model)
+        return reference_bank(model, reference, names,
+                              lambda r, nm: _single(model, reference_model(model, r), nm, **opts))
     ref = reference_model(model, reference, names)
     if names is None and isinstance(reference, Mapping):
         names = tuple(f"r{i}" for i in range(ref.p))
