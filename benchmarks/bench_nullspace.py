@@ -2,8 +2,9 @@
 
 Rows: the least-degree nullspace basis of the 14-state PATH model (12 outputs, 3 controls, 15 faults), the least-order
 ``efdsyn`` detector of all 15 faults, ``fdichkspec`` of the 15 single-fault rows and of 200 random rows, an ``efdisyn``
-bank of the feasible ones, and ``fdigenspec`` / ``fdichkspec`` of the Yuan et al. 1997 example (8 faults, the
-reference's own timing example).  The peer a PATH user would otherwise run is fdikit's Beard–Jones bank design
+bank of the feasible ones, ``emmsyn`` of the ``efdsyn`` detector's ``R_f`` (exact model matching), ``ammsyn`` H∞
+estimation of all 15 faults (``M_r = I``), ``ammsyn`` on Varga (2017) Example 5.16 (non-standard), and
+``fdigenspec`` / ``fdichkspec`` of the Yuan et al. 1997 example (8 faults, the reference's own timing example).  The peer a PATH user would otherwise run is fdikit's Beard–Jones bank design
 (``path_bank()``: the report's four filters); FaultDetectionTools.jl (Julia) cannot be installed on this machine and
 publishes no timings for these problems, so no reference ratio is given.
 
@@ -42,7 +43,8 @@ def median_time(fn, repeat: int = 5):
 def main() -> None:
     from varga_examples import yuan
 
-    from fdikit.design.nullspace import efdisyn, efdsyn, fdichkspec, fdigenspec, left_nullspace
+    from fdikit.design.nullspace import ammsyn, efdisyn, efdsyn, emmsyn, fdichkspec, fdigenspec, left_nullspace
+    from fdikit.model import FaultModel
     from fdikit.studies.path1996 import path_bank, path_fault_model
 
     m = path_fault_model(14)
@@ -59,6 +61,15 @@ def main() -> None:
     t_rand, chk = median_time(lambda: fdichkspec(m, rows), 3)
     feasible = rows[chk.feasible][:6]
     t_bank, bank = median_time(lambda: efdisyn(m, feasible), 3) if len(feasible) else (float("nan"), None)
+    R = d.internal_form()
+    ref = FaultModel(R.A, R.C, Bf=R.b("f"), Df=R.d("f"), faults=R.faults)
+    t_emm, mm = median_time(lambda: emmsyn(m, ref))
+    t_amm, am = median_time(lambda: ammsyn(m, {"f": np.eye(len(m.faults))}), 3)
+    A16 = np.array([[-0.8, 0, 0], [0, -0.5, 0.6], [0, -0.6, -0.5]])
+    Bu16 = np.array([[1.0, 1], [1, 0], [0, 1]])
+    m16 = FaultModel(A16, np.array([[0.0, 1, 1], [1, 1, 0]]), Bu=Bu16, Bf=Bu16,
+                     Bw=0.25 * np.array([[0.0, 0], [0, 1], [1, 0]]))
+    t_16, a16 = median_time(lambda: ammsyn(m16, {"f": np.eye(2)}, sdeg=-10.0, normalize="dcgain", reltol=5e-4), 3)
     y = yuan()
     t_gen, S = median_time(lambda: fdigenspec(y, fdtol=1e-5), 3)
     every = np.array([[c >> (7 - j) & 1 for j in range(8)] for c in range(1, 256)], dtype=bool)
@@ -78,6 +89,12 @@ def main() -> None:
     if bank is not None:
         print(f"| PATH `efdisyn`, {len(feasible)} feasible rows (orders {list(bank.orders)}) | {t_bank * 1e3:.1f} ms "
               f"| {t_bank / t_bj:.2f} |")
+    print(f"| PATH `emmsyn` of the `efdsyn` detector's R_f (orders {list(mm.orders)}) | {t_emm * 1e3:.1f} ms | "
+          f"{t_emm / t_bj:.2f} |")
+    print(f"| PATH `ammsyn` H∞, M_r = I₁₅ (γ = {am.gamma_sub:.5f}, order {am.generator.n}) | {t_amm * 1e3:.1f} ms | "
+          f"{t_amm / t_bj:.2f} |")
+    print(f"| Ex. 5.16 `ammsyn` H∞, non-standard (γ_sub = {a16.gamma_sub:.4f}) | {t_16 * 1e3:.1f} ms | "
+          f"{t_16 / t_bj:.2f} |")
     print(f"| Yuan `fdigenspec` (255 decoupled sets, {len(S)} rows) | {t_gen * 1e3:.1f} ms | {t_gen / t_bj:.2f} |")
     print(f"| Yuan `fdichkspec`, all 255 rows, least orders | {t_chk * 1e3:.1f} ms | {t_chk / t_bj:.2f} |")
 

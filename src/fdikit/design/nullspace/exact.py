@@ -143,8 +143,8 @@ class NullspaceDesign(FieldReport):
               "poles")
 
 
-def _selection(selection, q: int, k: int) -> np.ndarray:
-    """The ``(q, k)`` combination: given (checked) or a fixed generic one of orthonormal rows."""
+def _selection(selection, q: int, k: int, seed: int = 20170) -> np.ndarray:
+    """The ``(q, k)`` combination: given (checked) or a fixed generic one of orthonormal rows (from ``seed``)."""
     if selection is not None:
         H = np.atleast_2d(np.asarray(selection, dtype=float))
         if H.shape != (q, k) or not np.all(np.isfinite(H)) or np.linalg.matrix_rank(H) < q:
@@ -153,7 +153,7 @@ def _selection(selection, q: int, k: int) -> np.ndarray:
         return H
     if q == k:
         return np.eye(k)
-    G = np.random.default_rng(20170).standard_normal((k, q))
+    G = np.random.default_rng(seed).standard_normal((k, q))
     return np.linalg.qr(G)[0].T
 
 
@@ -285,28 +285,35 @@ def efdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
             used = tuple(i for i, nu in enumerate(basis.degrees) if nu <= d)
             if len(used) >= q and S_basis[list(used)].any(axis=0).all():
                 break
-        H = _selection(selection, q, len(used))
-        rows = basis.combined(H, used)
-        dens = [denominator(d, poles, sdeg, model.dt)] * q
-        A, B, C, D = realize_rows(rows, dens, basis.scale)
     else:
         used = tuple(range(k_all))
-        H = _selection(selection, q, k_all)
-        A, B, C, D = realize_rows(basis.rows, dens_own, basis.scale)
-        C, D = H @ C, H @ D
-        rows = [None] * q
-    names_default = tuple(f"r{i}" for i in range(q))
-    gen, _ = stabilize_rows(_minimal_generator(A, B, C, D, model, names_default), model, nuisance=nuisance,
-                            poles=poles, sdeg=sdeg)
-    gen = _unit_fault_gain(gen, model, targets, fdfreq)
-    gen = label_generator(gen, model, names, isolates)
     faults = targets + nuisance
-    if minimal:
-        chk = [denominator(len(dens[0]) - 1, None, None, model.dt)] * q
-        S = row_structure(model, basis, faults, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol, dens=chk, rows=rows)
+
+    def build(seed: int):
+        H = _selection(selection, q, len(used), seed)
+        if minimal:
+            rows = basis.combined(H, used)
+            d = len(rows[0]) - 1
+            A, B, C, D = realize_rows(rows, [denominator(d, poles, sdeg, model.dt)] * q, basis.scale)
+        else:
+            A, B, C, D = realize_rows(basis.rows, dens_own, basis.scale)
+            C, D = H @ C, H @ D
+        gen, _ = stabilize_rows(_minimal_generator(A, B, C, D, model, tuple(f"r{i}" for i in range(q))), model,
+                                nuisance=nuisance, poles=poles, sdeg=sdeg)
+        gen = label_generator(_unit_fault_gain(gen, model, targets, fdfreq), model, names, isolates)
+        if minimal:
+            S = row_structure(model, basis, faults, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol,
+                              dens=[denominator(d, None, None, model.dt)] * q, rows=rows)
+        else:
+            S = _combined_structure(model, basis, H, chk_own, faults, fdtol, fdfreq, fdgaintol)
+        return gen, H, S
+
+    # a generic combination can still bring a target's gain under fdtol: then the next fixed ones are tried
+    for seed in (range(20170, 20178) if minimal and selection is None else (20170,)):
+        gen, H, S = build(seed)
+        if S[:, : len(targets)].any(axis=0).all():
+            break
     else:
-        S = _combined_structure(model, basis, H, chk_own, faults, fdtol, fdfreq, fdgaintol)
-    if not S[:, : len(targets)].any(axis=0).all():
         raise DesignError(f"the selection {H.round(3).tolist()} of the basis rows {list(used)} misses a target; "
                           "give another selection=")
     return NullspaceDesign(gen, basis, basis.degrees, H, used, gen.n, S, S_basis, targets, nuisance,
