@@ -4,7 +4,8 @@ Rows: the least-degree nullspace basis of the 14-state PATH model (12 outputs, 3
 ``efdsyn`` detector of all 15 faults, ``fdichkspec`` of the 15 single-fault rows and of 200 random rows, an ``efdisyn``
 bank of the feasible ones, ``emmsyn`` of the ``efdsyn`` detector's ``R_f`` (exact model matching), ``ammsyn`` H∞
 estimation of all 15 faults (``M_r = I``), ``ammsyn`` on Varga (2017) Example 5.16 (non-standard), and
-``fdigenspec`` / ``fdichkspec`` of the Yuan et al. 1997 example (8 faults, the reference's own timing example).  The peer a PATH user would otherwise run is fdikit's Beard–Jones bank design
+``fdigenspec`` / ``fdichkspec`` of the Yuan et al. 1997 example (8 faults, the reference's own timing example).
+The peer a PATH user would otherwise run is fdikit's Beard–Jones bank design
 (``path_bank()``: the report's four filters); FaultDetectionTools.jl (Julia) cannot be installed on this machine and
 publishes no timings for these problems, so no reference ratio is given.
 
