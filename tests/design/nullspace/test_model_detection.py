@@ -119,6 +119,40 @@ def test_model_with_disturbances_is_decoupled():
     assert difference_model(m0, m1, emdtest=True).faults == ("delta_u0", "model_d0")
 
 
+def test_nu_gap_discrete():
+    # stable pair: the ν-gap is the largest chordal distance on the unit circle (brute force, 2·10⁵ points)
+    dt = 0.1
+    m1 = FaultModel([[0.5, 0.2], [0.0, -0.3]], [[1.0, 1.0]], Bu=[[1.0], [0.5]], Du=[[0.2]], dt=dt)
+    m2 = FaultModel([[0.6, 0.1], [0.0, -0.2]], [[1.0, 0.8]], Bu=[[1.0], [0.4]], Du=[[0.3]], dt=dt)
+    d = mddist([m1, m2])
+    th = np.linspace(0.0, np.pi, 200001)
+
+    def g(m, z):
+        return (m.C @ np.linalg.solve(z * np.eye(m.n) - m.A, m.b("u")) + m.d("u"))[0, 0]
+
+    z = np.exp(1j * th)
+    g1 = np.array([g(m1, x) for x in z[::20]])
+    g2 = np.array([g(m2, x) for x in z[::20]])
+    kap = np.abs(g1 - g2) / np.sqrt((1 + np.abs(g1) ** 2) * (1 + np.abs(g2) ** 2))
+    assert d.values[0, 1] == pytest.approx(kap.max(), rel=1e-6)
+    assert d.peak[0, 1] == pytest.approx(th[::20][int(np.argmax(kap))] / dt, abs=2e-3 / dt)
+    # one unstable pole each, the same: the winding condition holds; 1/(z−2) vs 1.1/(z−2) gives 1/21 (|g| = 0.9535)
+    u1 = FaultModel([[2.0]], [[1.0]], Bu=[[1.0]], dt=dt)
+    u2 = FaultModel([[2.0]], [[1.1]], Bu=[[1.0]], dt=dt)
+    x = 1.21 ** -0.25
+    assert mddist([u1, u2]).values[0, 1] == pytest.approx(0.1 * x / np.sqrt((1 + x * x) * (1 + 1.21 * x * x)),
+                                                          rel=1e-7)
+    # a small pair with different numbers of poles outside the disc: chordal distance < 0.02, but δ_ν = 1
+    s1 = FaultModel([[2.0]], [[0.01]], Bu=[[1.0]], dt=dt)
+    s2 = FaultModel([[0.5]], [[0.01]], Bu=[[1.0]], dt=dt)
+    assert mddist([s1, s2]).values[0, 1] == 1.0
+    # at given frequencies: the chordal distance there (θ = π included)
+    dm = mddist([m1, m2], mdfreq=[0.0, np.pi / dt])
+    k0 = abs(g(m1, 1.0) - g(m2, 1.0)) / np.sqrt((1 + abs(g(m1, 1.0)) ** 2) * (1 + abs(g(m2, 1.0)) ** 2))
+    kp = abs(g(m1, -1.0) - g(m2, -1.0)) / np.sqrt((1 + abs(g(m1, -1.0)) ** 2) * (1 + abs(g(m2, -1.0)) ** 2))
+    assert dm.values[0, 1] == pytest.approx(max(k0, kp), rel=1e-9)
+
+
 def test_bad_input():
     m = FaultModel([[-1.0]], [[1.0]], Bu=[[1.0]])
     with pytest.raises(ParameterError, match="outputs, controls or sample time"):
@@ -127,8 +161,8 @@ def test_bad_input():
         mddist([])
     with pytest.raises(ParameterError, match="distance"):
         mddist([m, m], distance="hinf")
-    with pytest.raises(ParameterError, match="discrete"):
-        mddist([FaultModel([[0.5]], [[1.0]], Bu=[[1.0]], dt=0.1)] * 2)
+    with pytest.raises(ParameterError, match="unit circle"):
+        mddist([FaultModel([[1.0]], [[1.0]], Bu=[[1.0]], dt=0.1)] * 2)
     with pytest.raises(ParameterError, match="mdfreq"):
         mddist([m, m], distance="2", mdfreq=1.0)
     with pytest.raises(DesignError, match="cannot be told apart"):

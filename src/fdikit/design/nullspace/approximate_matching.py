@@ -397,6 +397,8 @@ def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[s
     ----------
     Varga (2017), §5.6, Procedure AMMS; fdtools (``ammsyn``).
     """
+    from fdikit.analysis.channels import minimal_channel
+    from fdikit.design.nullspace.factorization import series
     from fdikit.design.nullspace.zero_steps import remove_boundary_zeros
 
     which = {"inf": "inf", "2": "2", np.inf: "inf", 2: "2"}.get(norm.lower() if isinstance(norm, str) else norm)
@@ -415,8 +417,6 @@ def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[s
     if len(ref.inputs["u"]) or len(ref.inputs["d"]):
         raise ParameterError("ammsyn matches the faults and the noise and decouples the controls and the "
                              "disturbances; give a reference without them (emmsyn matches them exactly)")
-    from fdikit.analysis.channels import minimal_channel
-
     ev = np.linalg.eigvals(minimal_channel(ref).A)
     if ev.size and np.max(ev.real if ref.dt is None else np.abs(ev)) >= (0.0 if ref.dt is None else 1.0):
         raise DesignError(f"the reference model has unstable poles {np.round(ev, 6).tolist()}; the model-matching "
@@ -439,8 +439,6 @@ def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[s
             M0 = (np.array([-s0]), np.array([1.0, -s0]))
             F = _low_pass(F, -s0)
     Y, g0 = least_distance(inner, F, norm=which, dt=model.dt, reltol=reltol)
-    from fdikit.design.nullspace.factorization import series
-
     q = ref.p
     if not steps:               # standard: Q = Y R_o⁻¹ Q₁, proper and stable, M = I
         Ao, Bo, Co, Do = g1.outer                 # R_o = (A, K R_h, C, R_h) on R's state space

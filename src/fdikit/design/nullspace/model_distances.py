@@ -10,15 +10,16 @@ The distance of models ``i`` and ``j`` is that of their control channels ``G_u``
   plane poles minus zeros of the determinant, from the realisation of ``I + G_j~ G_i``) — and 1 otherwise.
   The supremum is taken on a logarithmic grid spanning the models' pole magnitudes, refined around the largest
   value by a bounded scalar search; with ``mdfreq``, ``κ`` is maximised over those frequencies only (the winding
-  condition is not used, as in the reference).
+  condition is not used, as in the reference).  Discrete models: the same on their images under
+  ``z = (1 + s)/(1 − s)`` (unit circle to imaginary axis, outside of the disc to the right half plane).
 * ``"inf"``: ``‖G_i − G_j‖∞`` (python-control's ``linfnorm``, SLICOT AB13DD; with ``mdfreq`` the largest
   ``σ_max`` at those frequencies).
 * ``"2"``: ``‖G_i − G_j‖₂`` (python-control's ``norm(p=2)``; ``inf`` when the difference is unstable or, continuous,
   not strictly proper).
 
 Why partly by hand: python-control has no ν-gap; the chordal distance and the winding number are a few lines on
-its state-space objects.  Not covered: the ν-gap of discrete models and of models with poles on the imaginary axis
-(``η₀`` of the winding condition): refused with a clear error.
+its state-space objects.  Not covered: the ν-gap of models with poles on the stability boundary (``η₀`` of the
+winding condition): refused with a clear error.
 
 References
 ----------
@@ -161,8 +162,13 @@ def _winding_holds(sys1, sys2, tol: float = 1e-9) -> bool:
     return wno + eta1 - eta2 == 0
 
 
-def nu_gap(sys1, sys2, *, freqs: Sequence[float] | None = None) -> tuple[float, float]:
-    """Vinnicombe's ν-gap of two continuous systems ``(A, B, C, D)`` of equal shape, and the peak frequency.
+def nu_gap(sys1, sys2, *, freqs: Sequence[float] | None = None, dt: float | None = None) -> tuple[float, float]:
+    """Vinnicombe's ν-gap of two systems ``(A, B, C, D)`` of equal shape, and the peak frequency.
+
+    A discrete pair is mapped by ``z = (1 + s)/(1 − s)`` (:func:`~fdikit.design.nullspace.wiener_hopf.moebius`),
+    which carries the unit circle onto the imaginary axis (``e^{jθ}`` to ``j tan(θ/2)``) and the poles outside the
+    unit disc into the right half plane, so the chordal distances and the winding condition are those of the
+    continuous images; the peak is mapped back to ``ω = 2 arctan(ω_c)/dt``.
 
     Parameters
     ----------
@@ -170,6 +176,8 @@ def nu_gap(sys1, sys2, *, freqs: Sequence[float] | None = None) -> tuple[float, 
         The realisations.
     freqs : sequence of float, optional
         Evaluate the chordal distance at these frequencies only (rad/s; the winding condition is not checked).
+    dt : float, optional
+        The sample time of a discrete pair (None: continuous).
 
     Returns
     -------
@@ -179,7 +187,7 @@ def nu_gap(sys1, sys2, *, freqs: Sequence[float] | None = None) -> tuple[float, 
     Raises
     ------
     ParameterError
-        Systems of different shapes, or a pole on the imaginary axis (not covered).
+        Systems of different shapes, or a pole on the stability boundary (not covered).
 
     Examples
     --------
@@ -201,6 +209,19 @@ def nu_gap(sys1, sys2, *, freqs: Sequence[float] | None = None) -> tuple[float, 
     s1, s2 = realization(*sys1), realization(*sys2)
     if s1[3].shape != s2[3].shape:
         raise ParameterError(f"the two systems have different shapes {s1[3].shape} and {s2[3].shape}")
+    if dt is not None:
+        from fdikit.design.nullspace.wiener_hopf import moebius
+
+        for A in (s1[0], s2[0]):
+            if A.shape[0] and np.any(np.abs(np.abs(np.linalg.eigvals(A)) - 1) <= 1e-9):
+                raise ParameterError("a model has a pole on the unit circle: the ν-gap of such models (η₀ in the "
+                                     "winding condition) is not covered; use distance='inf' on a shifted model")
+        c1, c2 = moebius(*s1, 1.0, 1.0, -1.0, 1.0), moebius(*s2, 1.0, 1.0, -1.0, 1.0)
+        wc = None if freqs is None else np.tan(np.clip(np.asarray(freqs, dtype=float) * dt, 0, np.pi) / 2)
+        if wc is not None:
+            wc[np.asarray(freqs, dtype=float) * dt >= np.pi] = np.inf
+        v, w = nu_gap(c1, c2, freqs=wc)
+        return v, (float(2 * np.arctan(w) / dt) if np.isfinite(w) else (np.pi / dt if w == np.inf else w))
     for A in (s1[0], s2[0]):
         if A.shape[0] and np.any(np.abs(np.linalg.eigvals(A).real) <= 1e-9 * max(1.0, np.linalg.norm(A, 2))):
             raise ParameterError("a model has a pole on the imaginary axis: the ν-gap of such models (η₀ in the "
@@ -256,7 +277,7 @@ def mddist(models: Sequence[FaultModel], *, distance: str = "nugap", mdfreq: Seq
     Raises
     ------
     ParameterError
-        Bad models or options; ``"nugap"`` for discrete models (not covered); ``mdfreq`` with ``"2"``.
+        Bad models or options; ``mdfreq`` with ``"2"``; ``"nugap"`` with a pole on the stability boundary.
 
     Examples
     --------
@@ -278,8 +299,6 @@ def mddist(models: Sequence[FaultModel], *, distance: str = "nugap", mdfreq: Seq
     models = check_models(models)
     distance = validate.choice("distance", distance, MODEL_DISTANCES)
     dt = models[0].dt
-    if distance == "nugap" and dt is not None:
-        raise ParameterError("the ν-gap of discrete models is not covered; use distance='inf' or '2'")
     if distance == "2" and mdfreq is not None:
         raise ParameterError("mdfreq applies to distance='nugap' or 'inf', not to '2'")
     freqs = None
@@ -295,7 +314,7 @@ def mddist(models: Sequence[FaultModel], *, distance: str = "nugap", mdfreq: Seq
     for i in range(N):
         for j in range(i + 1, N):
             if distance == "nugap":
-                v, w = nu_gap(chans[i], chans[j], freqs=freqs)
+                v, w = nu_gap(chans[i], chans[j], freqs=freqs, dt=dt)
             else:
                 v, w = _difference_norm(chans[i], chans[j], distance, freqs, dt)
             vals[i, j] = vals[j, i] = v
