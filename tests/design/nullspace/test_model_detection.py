@@ -275,3 +275,28 @@ def test_rdim_and_selection():
         wn = hinf_norm(minimal_channel(g.internal_form(m), list(m.noise)))[0]
         assert a.gaps[j] == pytest.approx(np.delete(a.performance[j], j).min() / wn, rel=1e-8)
     assert np.all(np.diag(a.performance) < 1e-7)
+
+
+def test_select_designs_a_subset_of_the_filters():
+    # the reference's MDSelect (test_emdsyn.jl runs [1] and [2]): each filter is scaled on its own row, so the
+    # selected filters and their rows of MDperf are those of the full design
+    ms = _actuators()
+    full = emdsyn(ms, sdeg=-15.0, poles=[-20.0])
+    part = emdsyn(ms, sdeg=-15.0, poles=[-20.0], select=[2, 1])
+    assert part.selected == (2, 1) and part.filter_models == (2, 1) and part.performance.shape == (2, 4)
+    np.testing.assert_allclose(part.performance, full.performance[[2, 1]], rtol=1e-8, atol=1e-12)
+    assert part.generators[0].residuals == ("r2",)
+    gains, k = mdmatch(part, ms[1])
+    assert k == 1 and gains[1] < 1e-9 * gains[0]
+    ma = amdsyn(ms, sdeg=-15.0, poles=[-20.0], select=[3])
+    np.testing.assert_allclose(ma.performance, amdsyn(ms, sdeg=-15.0, poles=[-20.0]).performance[[3]], rtol=1e-8,
+                               atol=1e-12)
+    assert full.selected is None and full.filter_models == (0, 1, 2, 3)
+    with pytest.raises(ParameterError, match="start with 0"):
+        emdsyn(ms, select=[1, 0], normalize=True)
+    with pytest.raises(ParameterError, match="distinct model indices"):
+        emdsyn(ms, select=[1, 1])
+    with pytest.raises(ParameterError, match="distinct model indices"):
+        emdsyn(ms, select=[])
+    with pytest.raises(ParameterError, match="distinct model indices"):
+        emdsyn(ms, select=[4])

@@ -44,9 +44,10 @@ class ModelDetectionDesign:
     Attributes
     ----------
     generators : tuple of ResidualGenerator
-        Filter ``j`` (residual ``r<j>``, or ``r<j>_<k>`` with ``rdim > 1``), reading ``[u; y]``.
+        Filter ``j`` (residual ``r<k>``, or ``r<k>_<l>`` with ``rdim > 1``, ``k = selected[j]``), reading ``[u; y]``.
     performance : numpy.ndarray
-        ``(N, N)``: ``performance[j, i]`` the gain of filter ``j`` under model ``i`` (reference ``MDperf``).
+        ``(len(selected), N)``: ``performance[j, i]`` the gain of filter ``j`` under model ``i`` (reference
+        ``MDperf``).
     degrees : tuple of int
         The basis degree used per filter (its order).
     models : tuple of FaultModel
@@ -56,6 +57,8 @@ class ModelDetectionDesign:
         reference ``MDgap``).
     factorizations : tuple of str or None
         :func:`amdsyn`: the kind of noise factor per filter ("standard", "quasi", …; "none" without noise).
+    selected : tuple of int or None
+        The models whose filters were designed (reference ``MDSelect``); None: all, in order.
 
     Examples
     --------
@@ -75,6 +78,12 @@ class ModelDetectionDesign:
     models: tuple[FaultModel, ...]
     gaps: np.ndarray | None = None
     factorizations: tuple[str, ...] | None = None
+    selected: tuple[int, ...] | None = None
+
+    @property
+    def filter_models(self) -> tuple[int, ...]:
+        """The model index of each filter (``selected``, or all)."""
+        return tuple(range(len(self.models))) if self.selected is None else self.selected
 
     @property
     def orders(self) -> tuple[int, ...]:
@@ -226,7 +235,7 @@ def _filter_poles(model: FaultModel, degree: int, poles, sdeg, smarg) -> list[co
     return (chosen + fill + [s0] * degree)[:degree]
 
 
-def _options(models, rdim, selection, **kw) -> dict:
+def _options(models, rdim, selection, select, normalize, **kw) -> dict:
     from fdikit.errors import ParameterError
 
     if isinstance(rdim, bool) or not isinstance(rdim, int | np.integer) or rdim < 1:
@@ -234,12 +243,20 @@ def _options(models, rdim, selection, **kw) -> dict:
     if selection is not None and len(selection) != len(models):
         raise ParameterError(f"selection needs one entry (a matrix or None) per model: {len(models)}, got "
                              f"{len(selection)}")
-    return {"rdim": int(rdim), "selection": selection, **kw}
+    N = len(models)
+    sel = tuple(range(N)) if select is None else tuple(int(j) for j in np.atleast_1d(select))
+    if not sel or len(set(sel)) != len(sel) or min(sel) < 0 or max(sel) >= N:
+        raise ParameterError(f"select must be distinct model indices in 0 … {N - 1} (at least one), got {select!r}")
+    if normalize and sel[0] != 0:
+        raise ParameterError("normalize=True scales the filters against filter 0, so select must start with 0 "
+                             f"(got {list(sel)})")
+    return {"rdim": int(rdim), "selection": selection, "select": sel, "normalize": bool(normalize), **kw}
 
 
-def emdsyn(models: Sequence[FaultModel], *, rdim: int = 1, selection=None, poles: Sequence[complex] | None = None,
-           sdeg: float | None = None, smarg: float | None = None, mdtol: float = 1e-4, mdfreq=None,
-           mdgaintol: float = 0.01, emdtest: bool = False, normalize: bool = False) -> ModelDetectionDesign:
+def emdsyn(models: Sequence[FaultModel], *, rdim: int = 1, selection=None, select: Sequence[int] | None = None,
+           poles: Sequence[complex] | None = None, sdeg: float | None = None, smarg: float | None = None,
+           mdtol: float = 1e-4, mdfreq=None, mdgaintol: float = 0.01, emdtest: bool = False,
+           normalize: bool = False) -> ModelDetectionDesign:
     """Exact model detection filters of least order, one per model (Procedure EMD; reference ``emdsyn``).
 
     Parameters
@@ -252,6 +269,8 @@ def emdsyn(models: Sequence[FaultModel], *, rdim: int = 1, selection=None, poles
     selection : sequence of array_like or None, optional
         Per filter, the ``(rdim, k)`` combination of those ``k`` rows (reference ``HDesign``, in fdikit's basis
         coordinates), or None for the default: the identity when ``k = rdim``, else a fixed generic one.
+    select : sequence of int, optional
+        The models whose filters are designed, in order (reference ``MDSelect``); default all.
     poles : sequence of complex, optional
         Filter poles for the places the model's own poles do not fill (see ``smarg``); then ``sdeg``.
     sdeg : float, optional
@@ -263,7 +282,7 @@ def emdsyn(models: Sequence[FaultModel], *, rdim: int = 1, selection=None, poles
         As :func:`mdgenspec`; ``mdfreq`` also sets where ``performance`` is evaluated.
     normalize : bool, default False
         False: each filter's smallest off-diagonal gain is 1.  True: filter 0 so, and filter ``j`` such that
-        ``performance[j, 0] = performance[0, j]``.
+        ``performance[j, 0] = performance[0, j]`` (needs ``select`` to start with 0).
 
     Returns
     -------
@@ -292,11 +311,11 @@ def emdsyn(models: Sequence[FaultModel], *, rdim: int = 1, selection=None, poles
     from fdikit.design.nullspace.model_distances import check_models
 
     models = check_models(models)
-    opts = _options(models, rdim, selection, poles=poles, sdeg=sdeg, smarg=smarg, mdtol=mdtol, mdfreq=mdfreq,
-                    mdgaintol=mdgaintol, emdtest=emdtest)
-    pairs = [_exact_filter(models, j, opts) for j in range(len(models))]
-    gens, P = _scaled([g for g, _ in pairs], models, emdtest, mdfreq, normalize)
-    return ModelDetectionDesign(gens, P, tuple(d for _, d in pairs), models)
+    opts = _options(models, rdim, selection, select, normalize, poles=poles, sdeg=sdeg, smarg=smarg, mdtol=mdtol,
+                    mdfreq=mdfreq, mdgaintol=mdgaintol, emdtest=emdtest)
+    pairs = [_exact_filter(models, j, opts) for j in opts["select"]]
+    gens, P = _scaled([g for g, _ in pairs], models, opts)
+    return ModelDetectionDesign(gens, P, tuple(d for _, d in pairs), models, selected=_selected(opts, models))
 
 
 def _combination(selection, j: int, q: int, k: int) -> np.ndarray:
@@ -345,18 +364,24 @@ def _exact_filter(models, j, opts):
     return ResidualGenerator(A, B, C, D, controls=mj.controls, outputs=mj.outputs, residuals=names, dt=mj.dt), d
 
 
-def _scaled(gens, models, emdtest, mdfreq, normalize):
+def _selected(opts, models) -> tuple[int, ...] | None:
+    return None if opts["select"] == tuple(range(len(models))) else opts["select"]
+
+
+def _scaled(gens, models, opts):
     """The performance matrix and the filters scaled as the reference scales them (see :func:`emdsyn`)."""
-    N = len(models)
+    N, sel = len(models), opts["select"]
     gens = list(gens)
-    P = np.array([[_gain(gens[j], difference_model(models[j], models[i], emdtest=emdtest), mdfreq)
-                   for i in range(N)] for j in range(N)])
-    if N > 1 and np.any(P[~np.eye(N, dtype=bool)] <= 0):
+    P = np.array([[_gain(gens[r], difference_model(models[j], models[i], emdtest=opts["emdtest"]), opts["mdfreq"])
+                   for i in range(N)] for r, j in enumerate(sel)])
+    off = np.ones(P.shape, dtype=bool)
+    off[range(len(sel)), list(sel)] = False
+    if N > 1 and np.any(P[off] <= 0):
         raise DesignError("a combination of basis rows lost a model; this should not happen with the generic choice")
-    for j in range(N if N > 1 else 0):
-        sc = P[0, j] / P[j, 0] if normalize and j > 0 else 1.0 / np.delete(P[j], j).min()
-        P[j] *= sc
-        gens[j] = dataclasses.replace(gens[j], C=sc * gens[j].C, D=sc * gens[j].D)
+    for r, j in enumerate(sel if N > 1 else ()):
+        sc = P[0, j] / P[r, 0] if opts["normalize"] and r > 0 else 1.0 / np.delete(P[r], j).min()
+        P[r] *= sc
+        gens[r] = dataclasses.replace(gens[r], C=sc * gens[r].C, D=sc * gens[r].D)
     return tuple(gens), P
 
 
@@ -380,7 +405,7 @@ def mdmatch(design: ModelDetectionDesign, model: FaultModel, *, mdfreq=None,
     gains : numpy.ndarray
         ``‖Q_j [G_u G_d; I 0]‖`` per filter ``j``.
     index : int
-        ``argmin`` of the gains: the matching model.
+        The model of the filter with the smallest gain: the matching model.
 
     Examples
     --------
@@ -396,15 +421,15 @@ def mdmatch(design: ModelDetectionDesign, model: FaultModel, *, mdfreq=None,
     from fdikit.design.nullspace.model_distances import check_models
 
     check_models(list(design.models) + [model])
-    g = np.array([_gain(gen, difference_model(mj, model, emdtest=emdtest), mdfreq)
-                  for gen, mj in zip(design.generators, design.models)])
-    return g, int(np.argmin(g))
+    g = np.array([_gain(gen, difference_model(design.models[j], model, emdtest=emdtest), mdfreq)
+                  for gen, j in zip(design.generators, design.filter_models)])
+    return g, int(design.filter_models[int(np.argmin(g))])
 
 
-def amdsyn(models: Sequence[FaultModel], *, rdim: int = 1, selection=None, poles: Sequence[complex] | None = None,
-           sdeg: float | None = None, smarg: float | None = None, mdtol: float = 1e-4, mdfreq=None,
-           mdgaintol: float = 0.01, emdtest: bool = False, normalize: bool = False, nonstd: str = "quasi",
-           epsreg: float = 0.1, sdegzer: float | None = None) -> ModelDetectionDesign:
+def amdsyn(models: Sequence[FaultModel], *, rdim: int = 1, selection=None, select: Sequence[int] | None = None,
+           poles: Sequence[complex] | None = None, sdeg: float | None = None, smarg: float | None = None,
+           mdtol: float = 1e-4, mdfreq=None, mdgaintol: float = 0.01, emdtest: bool = False, normalize: bool = False,
+           nonstd: str = "quasi", epsreg: float = 0.1, sdegzer: float | None = None) -> ModelDetectionDesign:
     """Approximate model detection filters: ``emdsyn``'s filters with their own-model noise made co-inner
     (Procedure AMD; reference ``amdsyn``).
 
@@ -417,7 +442,7 @@ def amdsyn(models: Sequence[FaultModel], *, rdim: int = 1, selection=None, poles
     ----------
     models : sequence of FaultModel
         The multiple model; each model's noise inputs (group ``w``) are attenuated.
-    rdim, selection, poles, sdeg, smarg, mdtol, mdfreq, mdgaintol, emdtest, normalize
+    rdim, selection, select, poles, sdeg, smarg, mdtol, mdfreq, mdgaintol, emdtest, normalize
         As :func:`emdsyn`.
     nonstd, epsreg, sdegzer
         The non-standard noise factor, as :func:`~fdikit.design.nullspace.approximate.afdsyn`.
@@ -452,10 +477,11 @@ def amdsyn(models: Sequence[FaultModel], *, rdim: int = 1, selection=None, poles
     from fdikit.design.nullspace.noise_factors import attenuate_noise
 
     models = check_models(models)
-    opts = _options(models, rdim, selection, poles=poles, sdeg=sdeg, smarg=smarg, mdtol=mdtol, mdfreq=mdfreq,
-                    mdgaintol=mdgaintol, emdtest=emdtest)
+    opts = _options(models, rdim, selection, select, normalize, poles=poles, sdeg=sdeg, smarg=smarg, mdtol=mdtol,
+                    mdfreq=mdfreq, mdgaintol=mdgaintol, emdtest=emdtest)
     gens, kinds, degs = [], [], []
-    for j, mj in enumerate(models):
+    for j in opts["select"]:
+        mj = models[j]
         g, d = _exact_filter(models, j, opts)
         degs.append(d)
         ch = minimal_channel(g.internal_form(mj), list(mj.noise)) if mj.noise else None
@@ -467,10 +493,10 @@ def amdsyn(models: Sequence[FaultModel], *, rdim: int = 1, selection=None, poles
                                  smarg=smarg, sdegzer=sdegzer)
         gens.append(g)
         kinds.append(fac.kind)
-    gens, P = _scaled(gens, models, emdtest, mdfreq, normalize)
-    gaps = np.full(len(models), np.inf)
-    for j, (g, mj) in enumerate(zip(gens, models)):
-        if kinds[j] != "none":
-            wn = hinf_norm(minimal_channel(g.internal_form(mj), list(mj.noise)))[0]
-            gaps[j] = np.delete(P[j], j).min() / wn if len(models) > 1 else np.inf
-    return ModelDetectionDesign(gens, P, tuple(degs), models, gaps, tuple(kinds))
+    gens, P = _scaled(gens, models, opts)
+    gaps = np.full(len(gens), np.inf)
+    for r, (g, j) in enumerate(zip(gens, opts["select"])):
+        if kinds[r] != "none":
+            wn = hinf_norm(minimal_channel(g.internal_form(models[j]), list(models[j].noise)))[0]
+            gaps[r] = np.delete(P[r], j).min() / wn if len(models) > 1 else np.inf
+    return ModelDetectionDesign(gens, P, tuple(degs), models, gaps, tuple(kinds), selected=_selected(opts, models))
