@@ -128,6 +128,8 @@ def test_example_5_17_h2():
 
 
 def test_exact_references_give_zero():
+    z = ammsyn(FaultModel([[-1.0]], [[1.0]], Bw=[[1.0]], Df=[[1.0]]), {"f": [[0.0]]})   # M_r = 0: Q = 0
+    assert z.gamma_sub == 0.0 and np.abs(z.generator.D).max() == 0.0
     m = random_plant(11, 1, 2, 0, 0, 2)
     ref = FaultModel(m.A, m.C, Bf=m.b("f"), Df=m.d("f"), faults=m.faults)
     d = ammsyn(m, ref)

@@ -170,6 +170,8 @@ def _hinf_bisection(A, B, C, D, q: int, r: int, F, reltol: float):
 
     n, m_all = A.shape[0], B.shape[1]
     top = _norm(F)
+    if top == 0.0:                     # a zero reference: Y = 0 is optimal
+        return 0.0, (np.zeros((0, 0)), np.zeros((0, r)), np.zeros((q, 0)), np.zeros((q, r)))
     hi, floor = 1.001 * top + 1e-12, 1e-9 * top
     K_hi = None
     lo = 0.0
