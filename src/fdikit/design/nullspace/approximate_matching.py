@@ -306,6 +306,13 @@ def _basis_rows(model: FaultModel):
     C = np.hstack([Dqy @ model.C, Cq])
     D = np.hstack([Dq, Dqy @ Dfw])
     A, B, C, D = minimal_realization(A, B, C, D)
+    # rows of R scaled to comparable gains (a constant left factor: the co-inner factor of R and the optimum do not
+    # change); PATH's rows span six decades, which defeated the rank decisions of the zero removal
+    Br_, Dr_ = B[:, mu + p:], D[:, mu + p:]
+    gains = np.max([np.linalg.norm(Dr_ + (C @ np.linalg.solve(z * basis.scale * np.eye(A.shape[0]) - A, Br_)
+                                          if A.shape[0] else 0), axis=1) for z in _POINTS], axis=0)
+    W = np.diag(1.0 / np.maximum(gains, 1e-300))
+    C, D = W @ C, W @ D
     return A, B[:, : mu + p], B[:, mu + p:], C, D[:, : mu + p], D[:, mu + p:]
 
 
