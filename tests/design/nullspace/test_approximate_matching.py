@@ -30,8 +30,9 @@ def sweep(design, norm="inf"):
     vals = []
     for x in w:
         lam = 1j * x if form.dt is None else np.exp(1j * x * np.pi / 1e4)
+        groups = [g for g in ("u", "d") if target.inputs[g]] + ["f", "w"]
         E = np.hstack([response(form, g, lam) - (response(target, g, lam) if target.inputs[g] else 0)
-                       for g in ("f", "w") if form.inputs[g]])
+                       for g in groups if form.inputs[g]])
         vals.append(np.linalg.norm(E, 2) if norm == "inf" else np.linalg.norm(E, "fro") ** 2)
     if norm == "inf":
         return max(vals)
@@ -144,6 +145,27 @@ def test_exact_references_give_zero():
         assert abs(Rf[0, 1 - row[0].index(1.0)]) < 1e-7 * abs(Rf[0, row[0].index(1.0)])
 
 
+def test_references_on_controls_and_disturbances():
+    # the reference's weakfdi path: a group M_r has is matched approximately instead of decoupled.
+    # y = f + d/(s+1) with M_r = [M_rd M_rf] = [0 1]: no filter decouples d, the optimum is 1/√2 (q = 1/2)
+    m = FaultModel([[-1.0]], [[1.0]], Bd=[[1.0]], Df=[[1.0]])
+    with pytest.raises(DesignError, match="empty"):
+        ammsyn(m, {"f": [[1.0]]})
+    d = ammsyn(m, {"f": [[1.0]], "d": [[0.0]]})
+    assert d.gamma_sub == pytest.approx(2 ** -0.5, rel=2e-4) and sweep(d) == pytest.approx(d.gamma_sub, rel=1e-6)
+    # Example 5.3 (Gu = [(s+1)/(s+2); (s+2)/(s+3)], Gf = [Gu I], Gw = [(s−1)/(s+2); 0]) with M_ru = 0 (test_ammsyn.jl's
+    # Mre): matching u to 0 is a larger set than decoupling it, so γ is not larger; here the optimum decouples u
+    A = np.diag([-2.0, -3.0, -2.0])
+    m3 = FaultModel(A, [[1.0, 0, -3.0], [0, 1.0, 0]], Bu=[[-1.0], [-1.0], [0]], Du=[[1.0], [1.0]],
+                    Bf=[[-1.0, 0, 0], [-1.0, 0, 0], [0, 0, 0]], Df=[[1.0, 1, 0], [1.0, 0, 1]], Bw=[[0], [0], [1.0]],
+                    Dw=[[1.0], [0]])
+    e = ammsyn(m3, {"f": [[1.0, 1.0, 1.0]]})
+    a = ammsyn(m3, {"f": [[1.0, 1.0, 1.0]], "u": [[0.0]]})
+    assert a.gamma_sub <= e.gamma_sub * (1 + 2e-4)
+    assert sweep(a) == pytest.approx(a.gamma_sub, rel=1e-6)
+    assert a.generator.controls == m3.controls and a.generator.outputs == m3.outputs
+
+
 def test_bad_input():
     m, ref = ex5_14()
     with pytest.raises(ParameterError, match="norm"):
@@ -152,9 +174,6 @@ def test_bad_input():
         ammsyn(FaultModel([[0.5]], [[1.0]], Bw=[[0.5]], Df=[[1.0]], dt=0.1), {"f": [[1.0]]}, norm="2")
     with pytest.raises(DesignError, match="unstable"):
         ammsyn(m, FaultModel([[1.0]], [[1.0]], Bf=[[1.0]]))
-    mu = FaultModel([[-1.0]], [[1.0], [1.0]], Bu=[[1.0]], Df=np.eye(2))
-    with pytest.raises(ParameterError, match="controls"):
-        ammsyn(mu, {"u": [[1.0]]})
     with pytest.raises(DesignError, match="empty"):
         ammsyn(FaultModel([[-1.0]], [[1.0]], Bd=[[1.0]], Bf=[[1.0]]), {"f": [[1.0]]})
 

@@ -7,7 +7,10 @@ reference, in the H∞ or the H2 norm:
     Q [Gu Gd; I 0] = 0,     γ = ‖Q [Gf Gw; 0 0] − M [M_rf M_rw]‖ = min,
 
 with ``M`` diagonal, stable and invertible (``M = I`` when that is possible; ``M_rw = 0`` when the reference has
-no noise group: noise attenuation).  With ``M_r = I`` from the faults this is H∞/H2 fault estimation.
+no noise group: noise attenuation).  With ``M_r = I`` from the faults this is H∞/H2 fault estimation.  A reference
+with a control or disturbance group has that group matched approximately too, instead of decoupled (the
+reference's ``weakfdi`` path): the problem is solved on a model whose faults are the matched groups, with the
+controls read as outputs when they are matched.
 
 How fdikit solves it (the reference's steps, with its own tools):
 
@@ -316,10 +319,46 @@ def _basis_rows(model: FaultModel):
     return A, B[:, : mu + p], B[:, mu + p:], C, D[:, : mu + p], D[:, mu + p:]
 
 
-def _target_columns(model: FaultModel, ref: FaultModel):
-    """``F = [M_rf M_rw]`` (``M_rw = 0`` when the reference has no noise) as ``(A, B, C, D)``."""
-    B, D = reference_columns(ref, model, ("f", "w"))
+def _target_columns(model: FaultModel, ref: FaultModel, groups):
+    """``F = [M_r,g … M_rw]`` over the matched ``groups`` and the noise (zero where ``M_r`` lacks one)."""
+    B, D = reference_columns(ref, model, tuple(groups) + ("w",))
     return ref.A, B, ref.C, D
+
+
+def _matching_model(model: FaultModel, groups) -> FaultModel:
+    """The model the problem is solved on: the matched ``groups`` as its faults, the others decoupled.
+
+    Matched controls (a reference with ``M_ru``) are also measured: ``[y; u]`` become the outputs and the model has
+    no controls, so the nullspace decouples only what the reference lacks (the reference's ``weakfdi`` path).
+    """
+    if groups == ("f",):
+        return model
+    names = sum((model.inputs[g] for g in groups), ())
+    Bf, Df = np.hstack([model.b(g) for g in groups]), np.hstack([model.d(g) for g in groups])
+    A, C, dist = model.A, model.C, () if "d" in groups else model.disturbances
+    Bd, Dd = (np.zeros((model.n, 0)), np.zeros((model.p, 0))) if "d" in groups else (model.b("d"), model.d("d"))
+    Bu, Du, ctrl, outs = model.b("u"), model.d("u"), model.controls, model.outputs
+    Bw, Dw = model.b("w"), model.d("w")
+    if "u" in groups:                       # u read as outputs: [y; u] = [G; I 0 …] [u; d; f; w]
+        mu = len(model.controls)
+        C = np.vstack([C, np.zeros((mu, model.n))])
+        eye_u = np.hstack([np.eye(mu), np.zeros((mu, Bf.shape[1] - mu))])
+        Df = np.vstack([Df, eye_u])
+        Dd, Dw = np.vstack([Dd, np.zeros((mu, Dd.shape[1]))]), np.vstack([Dw, np.zeros((mu, Dw.shape[1]))])
+        Bu, Du, ctrl = np.zeros((model.n, 0)), np.zeros((model.p + mu, 0)), ()
+        outs = model.outputs + tuple(f"{c}__measured" for c in model.controls)
+    return FaultModel(A, C, Bu=Bu, Du=Du, Bd=Bd, Dd=Dd, Bf=Bf, Df=Df, Bw=Bw, Dw=Dw, controls=ctrl,
+                      disturbances=dist, faults=names, noise=model.noise, outputs=outs, dt=model.dt)
+
+
+def _on_model(gen: ResidualGenerator, model: FaultModel, groups) -> ResidualGenerator:
+    """A generator of the matching model as one of ``model`` (matched controls: its ``[y; u]`` back to ``[u; y]``)."""
+    if "u" not in groups:
+        return gen
+    p = model.p
+    B, D = np.hstack([gen.B[:, p:], gen.B[:, :p]]), np.hstack([gen.D[:, p:], gen.D[:, :p]])
+    return ResidualGenerator(gen.A, B, gen.C, D, controls=model.controls, outputs=model.outputs,
+                             residuals=gen.residuals, dt=model.dt)
 
 
 def _fw_model(sys, model: FaultModel, names) -> FaultModel:
@@ -369,9 +408,9 @@ def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[s
     model : FaultModel
         The plant (continuous or discrete; H2 continuous only).
     reference : FaultModel, mapping, or a sequence of them
-        ``M_r`` on the faults and optionally the noise (no controls or disturbances: those are decoupled exactly;
-        :func:`~fdikit.design.nullspace.model_matching.emmsyn` matches them), stable; a static ``{group: matrix}``.
-        A sequence gives a bank (``ModelMatchingBankDesign``), one filter per reference.
+        ``M_r``, stable: an internal form or a static ``{group: matrix}``.  The faults and noise are matched (a group
+        it lacks: zero); the controls and disturbances are decoupled exactly unless ``M_r`` has that group, which is
+        then matched too.  A sequence gives a bank (``ModelMatchingBankDesign``), one filter per reference.
     norm : {'inf', '2'}, default 'inf'
         H∞ (the reference's default) or H2 (``H2syn = true``).
     names : sequence of str, optional
@@ -393,7 +432,7 @@ def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[s
     DesignError
         An empty nullspace, nothing to match, an unstable reference, a SLICOT failure.
     ParameterError
-        A reference with controls or disturbances, discrete H2, bad options.
+        Discrete H2, bad options or a reference that does not fit the model.
 
     Examples
     --------
@@ -423,9 +462,8 @@ def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[s
             model, r, norm=norm, names=nm, poles=poles, sdeg=sdeg, smarg=smarg, normalize=normalize, reltol=reltol,
             tol=tol))
     ref = reference_model(model, reference, names)
-    if len(ref.inputs["u"]) or len(ref.inputs["d"]):
-        raise ParameterError("ammsyn matches the faults and the noise and decouples the controls and the "
-                             "disturbances; give a reference without them (emmsyn matches them exactly)")
+    groups = tuple(g for g in ("u", "d") if len(ref.inputs[g])) + ("f",)
+    plant = _matching_model(model, groups)
     ev = np.linalg.eigvals(minimal_channel(ref).A)
     if ev.size and np.max(ev.real if ref.dt is None else np.abs(ev)) >= (0.0 if ref.dt is None else 1.0):
         raise DesignError(f"the reference model has unstable poles {np.round(ev, 6).tolist()}; the model-matching "
@@ -433,13 +471,13 @@ def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[s
     if names is None and not isinstance(reference, FaultModel):
         names = tuple(f"r{i}" for i in range(ref.p))
     names = tuple(ref.outputs if names is None else names)
-    Aj, Bq, Br, Cj, Dq, Dr = _basis_rows(model)
+    Aj, Bq, Br, Cj, Dq, Dr = _basis_rows(plant)
     if (np.linalg.eigvals(Aj).real if model.dt is None else np.abs(np.linalg.eigvals(Aj)) - 1).max(initial=-1) >= 0:
         raise DesignError("R = Q₁ [Gf Gw; 0] is unstable: the plant has unstable modes that the faults or the noise "
                           "excite and the decoupled residuals see; stabilise them first")
     _, _, steps, g1 = remove_boundary_zeros(Aj, Br, Cj, Dr, model.dt, tol=tol)
     inner = g1.inner
-    F = _target_columns(model, ref)
+    F = _target_columns(model, ref, groups)
     s0 = default_sdeg(model.dt) if sdeg is None else float(sdeg)
     M0 = None
     if which == "2":
@@ -453,24 +491,26 @@ def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[s
         Ao, Bo, Co, Do = g1.outer                 # R_o = (A, K R_h, C, R_h) on R's state space
         K, Rhi = Bo @ np.linalg.inv(Do), np.linalg.inv(Do)
         X = (Aj - K @ Cj, Bq - K @ Dq, Rhi @ Cj, Rhi @ Dq)           # R_o⁻¹ Q₁, stable
-        gen = ResidualGenerator(*series(X, Y), controls=model.controls, outputs=model.outputs, residuals=names,
+        gen = ResidualGenerator(*series(X, Y), controls=plant.controls, outputs=plant.outputs, residuals=names,
                                 dt=model.dt)
         exact, M1 = None, ((np.ones(1), np.ones(1)),) * q
     else:                       # non-standard: Q with Q G_e = M₁ [0 0 Y R_i], M₁ of least degree
-        fit = _fw_model(minimal_realization(*series(inner, Y)), model, names)
-        exact = emmsyn(model, fit, names=names, poles=poles, sdeg=sdeg, smarg=smarg, normalize=normalize, tol=tol)
+        fit = _fw_model(minimal_realization(*series(inner, Y)), plant, names)
+        exact = emmsyn(plant, fit, names=names, poles=poles, sdeg=sdeg, smarg=smarg, normalize=normalize, tol=tol)
         gen, M1 = exact.generator, exact.updating
     upd = M1 if M0 is None else tuple((np.polymul(num, M0[0]), np.polymul(den, M0[1])) for num, den in M1)
     target = updated_reference(ref, upd)
     if all(num.tolist() == den.tolist() for num, den in M1):
         g_opt = g0
     else:
-        g_opt = least_distance(inner, _target_columns(model, target), norm=which, dt=model.dt, reltol=reltol)[1]
+        g_opt = least_distance(inner, _target_columns(model, target, groups), norm=which, dt=model.dt,
+                               reltol=reltol)[1]
     # achieved: ‖M₁ (Y R_i − F)‖ (F with M₀), since Q [Gf Gw; 0] = M₁ Y R_i exactly (by construction, or emmsyn's
     # check); evaluated on that small stable realisation, not on the internal form, whose plant modes cancel only
     # to rounding (a minimal realisation of it found a peak of 42 instead of 1.00002 on the PATH model)
-    E = _fw_model(_difference(inner, Y, F), model, names)
+    E = _fw_model(_difference(inner, Y, F), plant, names)
     T = updated_reference(E, M1)
     g_sub = _norm((T.A, T.B, T.C, T.D), which, model.dt)
+    gen = _on_model(gen, model, groups)
     return ApproximateMatchingDesign(gen, target, upd, ref, which, bool(steps), float(g0), float(g_opt), g_sub,
                                      exact, np.linalg.eigvals(gen.A) if gen.n else np.zeros(0), model=model)
