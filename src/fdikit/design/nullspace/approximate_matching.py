@@ -24,8 +24,9 @@ How fdikit solves it (the reference's steps, with its own tools):
 3. The least-distance problem ``min ‖Y R_i − F‖`` over stable ``Y``, ``F = [M_rf M_rw]`` (the reference's
    ``glinfldp`` on ``F R_i~``; since ``R_i`` is inner the two are the same): an H∞ (or H2) model-matching problem
    with measurement ``R_i v`` whose ``D`` has full row rank (``R_i`` is co-inner), solved by SLICOT's H∞ ``SB10AD``
-   (γ-iteration to ``reltol``) or H2 ``SB10HD`` (through slycot).  Discrete models are solved on the bilinear
-   image ``z = (1 + s)/(1 − s)``, which keeps H∞ norms.  In H2 a continuous ``F`` whose ``D`` cannot be matched
+   (γ-iteration to ``reltol``) or H2 ``SB10HD`` (through slycot).  Discrete H∞ problems are solved on the
+   bilinear image ``z = (1 + s)/(1 − s)``, which keeps H∞ norms; discrete H2 by the causal projection
+   ``Y = [F R_i~]₊``, which SLICOT lacks.  In H2 a continuous ``F`` whose ``D`` cannot be matched
    is first multiplied by ``M₀ = a/(s + a)``, ``a = −sdeg`` (as the reference does).
 4. ``Q`` with ``Q G_e = M [0 0 Y R_i]``: :func:`~fdikit.design.nullspace.model_matching.emmsyn` on that (stable)
    target; in the standard case ``Q = Y R_o⁻¹ Q₁`` and ``M = I``, otherwise the least-degree ``M`` makes the
@@ -197,6 +198,22 @@ def _hinf_bisection(A, B, C, D, q: int, r: int, F, reltol: float):
     return hi, K_hi
 
 
+def _causal_projection(F, inner):
+    """``[F R_i~]₊`` of two stable discrete systems: ``(A_F, B_F D_iᵀ + A_F X C_iᵀ, C_F, D_F D_iᵀ + C_F X C_iᵀ)``.
+
+    ``F(z) R_i(1/z)ᵀ`` has the coefficients ``Σ_b f[b + j] r[b]ᵀ`` at ``z⁻ʲ``; for ``j ≥ 0`` they are those of the
+    realisation above with ``X = A_F X A_iᵀ + B_F B_iᵀ`` (a Stein equation, solved on its Kronecker form).  With
+    ``R_i R_i~ = I`` it is the H2-optimal ``Y`` of ``min ‖Y R_i − F‖₂``.
+    """
+    A1, B1, C1, D1 = F
+    A2, B2, C2, D2 = inner
+    n1, n2 = A1.shape[0], A2.shape[0]
+    rhs = B1 @ B2.T
+    X = np.linalg.solve(np.eye(n1 * n2) - np.kron(A2, A1), rhs.reshape(-1, order="F")).reshape(
+        (n1, n2), order="F") if n1 and n2 else np.zeros((n1, n2))
+    return A1, B1 @ D2.T + A1 @ X @ C2.T, C1, D1 @ D2.T + C1 @ X @ C2.T
+
+
 def least_distance(inner, F, *, norm: str = "inf", dt: float | None = None, reltol: float = 1e-4):
     """``Y`` stable minimising ``‖Y R_i − F‖`` (H∞ or H2) for a co-inner ``R_i`` and a stable ``F``.
 
@@ -207,9 +224,10 @@ def least_distance(inner, F, *, norm: str = "inf", dt: float | None = None, relt
     F : tuple of numpy.ndarray
         ``(A, B, C, D)`` of ``F`` (``q × m``, stable).
     norm : {'inf', '2'}, default 'inf'
-        The norm; ``'2'`` needs a continuous problem with ``F`` matchable at infinity (finite H2 distance).
+        The norm; continuous ``'2'`` needs ``F`` matchable at infinity (a finite H2 distance).
     dt : float or None
-        Sample time (discrete H∞ is solved on the bilinear image).
+        Sample time (discrete H∞ is solved on the bilinear image, discrete H2 by the causal projection
+        ``Y = [F R_i~]₊``).
     reltol : float, default 1e-4
         Relative accuracy of the H∞ γ-iteration.
 
@@ -243,6 +261,9 @@ def least_distance(inner, F, *, norm: str = "inf", dt: float | None = None, relt
     inner = tuple(np.atleast_2d(np.asarray(M, dtype=float)) for M in inner)
     F = tuple(np.atleast_2d(np.asarray(M, dtype=float)) for M in F)
     q, r = F[3].shape[0], inner[3].shape[0]
+    if norm != "inf" and dt is not None:                  # discrete H2: Y = [F R_i~]₊, the causal projection
+        Y = _causal_projection(F, inner)
+        return Y, _norm(_difference(inner, Y, F), "2", dt)
     Y0 = F[3] @ inner[3].T if dt is None else None
     if dt is not None:
         inner, F = _bilinear(inner, True), _bilinear(F, True)
@@ -406,7 +427,7 @@ def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[s
     Parameters
     ----------
     model : FaultModel
-        The plant (continuous or discrete; H2 continuous only).
+        The plant (continuous or discrete).
     reference : FaultModel, mapping, or a sequence of them
         ``M_r``, stable: an internal form or a static ``{group: matrix}``.  The faults and noise are matched (a group
         it lacks: zero); the controls and disturbances are decoupled exactly unless ``M_r`` has that group, which is
@@ -432,7 +453,7 @@ def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[s
     DesignError
         An empty nullspace, nothing to match, an unstable reference, a SLICOT failure.
     ParameterError
-        Discrete H2, bad options or a reference that does not fit the model.
+        Bad options or a reference that does not fit the model.
 
     Examples
     --------
@@ -452,9 +473,6 @@ def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[s
     which = {"inf": "inf", "2": "2", np.inf: "inf", 2: "2"}.get(norm.lower() if isinstance(norm, str) else norm)
     if which is None:
         raise ParameterError(f"norm must be 'inf' (H∞) or 2 (H2), got {norm!r}")
-    if which == "2" and model.dt is not None:
-        raise ParameterError("norm='2' needs a continuous model: discrete H2 model matching is not implemented; "
-                             "use norm='inf'")
     if not (np.isfinite(reltol) and 0 < reltol < 1):
         raise ParameterError(f"reltol must be in (0, 1), got {reltol}")
     if isinstance(reference, (list, tuple)):
@@ -480,7 +498,7 @@ def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[s
     F = _target_columns(model, ref, groups)
     s0 = default_sdeg(model.dt) if sdeg is None else float(sdeg)
     M0 = None
-    if which == "2":
+    if which == "2" and model.dt is None:
         unmatched = F[3] - F[3] @ inner[3].T @ inner[3]
         if np.abs(unmatched).max(initial=0.0) > tol * max(1.0, np.abs(F[3]).max(initial=0.0)):
             M0 = (np.array([-s0]), np.array([1.0, -s0]))
