@@ -90,6 +90,21 @@ def test_example_5_6_plant_with_controls():
     assert sweep(d) == pytest.approx(d.gamma_sub, rel=1e-6)
 
 
+def test_selection_restricts_the_rows():
+    # HDesign: a subset of the nullspace can only do worse; the full identity selection is the default design
+    from test_approximate import example_5_6
+
+    m = example_5_6()
+    full = ammsyn(m, {"f": [[1.0, 1.0]]})
+    assert ammsyn(m, {"f": [[1.0, 1.0]]}, selection=np.eye(2)).gamma_sub == pytest.approx(full.gamma_sub, rel=1e-6)
+    for H in ([[1.0, 0.0]], [[0.0, 1.0]], [[1.0, 1.0]]):
+        d = ammsyn(m, {"f": [[1.0, 1.0]]}, selection=H)
+        assert d.gamma_sub >= full.gamma_opt0 * (1 - 1e-4)
+        assert sweep(d) == pytest.approx(d.gamma_sub, rel=1e-6)
+    with pytest.raises(ParameterError, match="selection"):
+        ammsyn(m, {"f": [[1.0, 1.0]]}, selection=[[1.0, 0.0, 0.0]])
+
+
 @pytest.mark.parametrize("norm", ["inf", "2"])
 def test_example_5_14_nonstandard_is_the_regularised_limit(norm):
     m, ref = ex5_14()

@@ -292,12 +292,13 @@ def least_distance(inner, F, *, norm: str = "inf", dt: float | None = None, relt
     return (Y if dt is None else _bilinear(Y, False)), float(g)
 
 
-def _basis_rows(model: FaultModel):
+def _basis_rows(model: FaultModel, selection=None):
     """``[Q₁ R]`` on one minimal state space: ``(A, B_q, B_r, C, D_q, D_r)``.
 
     ``Q₁`` is the proper basis (the first rows, by degree, that keep the rank of ``R``, each over its own
-    denominator); sharing ``A`` and ``C`` makes ``R_o⁻¹ Q₁`` a realisation of the same order (the reference's
-    ``[Ro Q R]``) instead of a series connection whose cancelling modes a minimal realisation must find.
+    denominator), or ``selection @ N`` over one denominator of the largest degree; sharing ``A`` and ``C`` makes
+    ``R_o⁻¹ Q₁`` a realisation of the same order (the reference's ``[Ro Q R]``) instead of a series connection whose
+    cancelling modes a minimal realisation must find.
     """
 
     basis = left_nullspace(model)
@@ -314,14 +315,24 @@ def _basis_rows(model: FaultModel):
         sv = np.linalg.svd(basis.evaluate(lam, rows)[:, mu:] @ G, compute_uv=False)
         return int(np.sum(sv > 1e-9 * max(sv[0], 1e-300)))
 
-    chosen: list[int] = []
-    for i in range(len(basis.rows)):
-        if min(rank(chosen + [i], z * basis.scale) for z in _POINTS) == len(chosen) + 1:
-            chosen.append(i)
-    if not chosen:
-        raise DesignError("no fault or noise input reaches the decoupled residuals: nothing to match")
-    dens = [denominator(basis.degrees[i], None, None, model.dt) for i in chosen]
-    Aq, Bq, Cq, Dq = realize_rows([basis.rows[i] for i in chosen], dens, basis.scale)
+    if selection is None:
+        chosen: list[int] = []
+        for i in range(len(basis.rows)):
+            if min(rank(chosen + [i], z * basis.scale) for z in _POINTS) == len(chosen) + 1:
+                chosen.append(i)
+        if not chosen:
+            raise DesignError("no fault or noise input reaches the decoupled residuals: nothing to match")
+        dens = [denominator(basis.degrees[i], None, None, model.dt) for i in chosen]
+        Aq, Bq, Cq, Dq = realize_rows([basis.rows[i] for i in chosen], dens, basis.scale)
+    else:
+        H = np.atleast_2d(np.asarray(selection, dtype=float))
+        k = len(basis.rows)
+        if H.shape[1] != k or not np.all(np.isfinite(H)) or np.linalg.matrix_rank(H) < H.shape[0]:
+            raise ParameterError(f"selection must be a finite matrix of full row rank with {k} columns (one per "
+                                 f"basis row, degrees {list(basis.degrees)}), got shape {H.shape}")
+        rows = basis.combined(H, range(k))
+        d = rows[0].shape[0] - 1
+        Aq, Bq, Cq, Dq = realize_rows(rows, [denominator(d, None, None, model.dt)] * len(rows), basis.scale)
     # [Q₁ R] on one state space (plant, then filter): Q₁ reads [u; y], R = Q₁ [Gf Gw; 0] reads [f; w]
     n, nq, p = model.n, Aq.shape[0], model.p
     Bqy, Dqy = Bq[:, mu:], Dq[:, mu:]
@@ -418,7 +429,7 @@ def _low_pass(F, a: float):
     return series(F, (-a * np.eye(q), a * np.eye(q), np.eye(q), np.zeros((q, q))))
 
 
-def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[str] | None = None,
+def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[str] | None = None, selection=None,
            poles: Sequence[complex] | None = None, sdeg: float | None = None, smarg: float | None = None,
            normalize: str = "infnorm", reltol: float = 1e-4,
            tol: float = 1e-7) -> ApproximateMatchingDesign | ModelMatchingBankDesign:
@@ -436,6 +447,9 @@ def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[s
         H∞ (the reference's default) or H2 (``H2syn = true``).
     names : sequence of str, optional
         Residual names (default the reference's outputs; ``r<i>`` for a static reference).
+    selection : array_like, optional
+        ``H``: use the rows ``H N`` of the nullspace basis only (the reference's ``HDesign``, in fdikit's basis
+        coordinates: ``(k, len(basis.rows))``, full row rank); default the basis rows that keep the rank of ``R``.
     poles, sdeg, smarg, normalize
         The updating factor of the non-standard case, as in :func:`~fdikit.design.nullspace.model_matching.emmsyn`
         (``normalize`` default ``'infnorm'``, the reference's).
@@ -477,8 +491,8 @@ def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[s
         raise ParameterError(f"reltol must be in (0, 1), got {reltol}")
     if isinstance(reference, (list, tuple)):
         return reference_bank(model, reference, names, lambda r, nm: ammsyn(
-            model, r, norm=norm, names=nm, poles=poles, sdeg=sdeg, smarg=smarg, normalize=normalize, reltol=reltol,
-            tol=tol))
+            model, r, norm=norm, names=nm, selection=selection, poles=poles, sdeg=sdeg, smarg=smarg,
+            normalize=normalize, reltol=reltol, tol=tol))
     ref = reference_model(model, reference, names)
     groups = tuple(g for g in ("u", "d") if len(ref.inputs[g])) + ("f",)
     plant = _matching_model(model, groups)
@@ -489,7 +503,7 @@ def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[s
     if names is None and not isinstance(reference, FaultModel):
         names = tuple(f"r{i}" for i in range(ref.p))
     names = tuple(ref.outputs if names is None else names)
-    Aj, Bq, Br, Cj, Dq, Dr = _basis_rows(plant)
+    Aj, Bq, Br, Cj, Dq, Dr = _basis_rows(plant, selection)
     if (np.linalg.eigvals(Aj).real if model.dt is None else np.abs(np.linalg.eigvals(Aj)) - 1).max(initial=-1) >= 0:
         raise DesignError("R = Q₁ [Gf Gw; 0] is unstable: the plant has unstable modes that the faults or the noise "
                           "excite and the decoupled residuals see; stabilise them first")
