@@ -309,7 +309,7 @@ def efdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
         return gen, H, S
 
     # a generic combination can still bring a target's gain under fdtol: then the next fixed ones are tried
-    for seed in (range(20170, 20178) if minimal and selection is None else (20170,)):
+    for seed in (range(20170, 20178) if minimal and selection is None and q < len(used) else (20170,)):
         gen, H, S = build(seed)
         if S[:, : len(targets)].any(axis=0).all():
             break
