@@ -300,3 +300,21 @@ def test_select_designs_a_subset_of_the_filters():
         emdsyn(ms, select=[])
     with pytest.raises(ParameterError, match="distinct model indices"):
         emdsyn(ms, select=[4])
+
+
+def test_full_order_filters():
+    # the reference's minimal = false: every basis row over its own denominator, rdim = all rows by default.
+    # Ex6_1c's models (C = I: four outputs, two controls): four degree-1 rows per model (degree 0 for the model
+    # without inputs); the filters keep the least-order design's checks at order 4 instead of 1
+    ms = _lateral(None)
+    d = emdsyn(ms, sdeg=-1.0, poles=[-1.0], minimal=False)
+    P = d.performance
+    assert np.all(np.diag(P) < 1e-7) and np.all(P + np.finfo(float).eps + np.eye(9) >= 1)
+    assert d.degrees == (4,) * 8 + (0,) and d.orders == (4,) * 8 + (0,)
+    assert all(g.residuals == tuple(f"r{j}_{k}" for k in range(4)) for j, g in enumerate(d.generators))
+    one = emdsyn(ms, sdeg=-1.0, poles=[-1.0], minimal=False, rdim=1)
+    # one combination of rows over equal denominators (each row gets the model's slowest pole): order 1 again
+    assert all(g.C.shape[0] == 1 for g in one.generators) and all(1 <= o <= 4 for o in one.orders[:-1])
+    assert np.all(np.diag(one.performance) < 1e-7)
+    a = amdsyn(_lateral("states"), sdeg=-1.0, poles=[-1.0], minimal=False)
+    assert np.all(np.diag(a.performance) < 1e-7) and np.all(np.isfinite(a.gaps)) and np.all(a.gaps > 0)

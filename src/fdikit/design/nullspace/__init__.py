@@ -43,7 +43,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
         "noise_factors": ["NONSTD_OPTIONS", "noise_factor"],
         "wiener_hopf": ["WIENER_HOPF_JOBS_SEVERAL", "moebius", "wiener_hopf"],
         "model_distances": ["MODEL_DISTANCES", "ModelDistances", "check_models", "mddist", "nu_gap"],
-        "model_detection": ["ModelDetectionDesign", "difference_model", "emdsyn", "mdgenspec", "mdmatch"],
+        "model_detection": ["ModelDetectionDesign", "amdsyn", "difference_model", "emdsyn", "mdgenspec", "mdmatch"],
         "model_matching": [
             "ModelMatchingBankDesign", "ModelMatchingDesign", "NORMALIZE_OPTIONS", "emmsyn", "reference_bank",
             "reference_columns", "reference_model", "updated_reference",

@@ -49,7 +49,7 @@ class ModelDetectionDesign:
         ``(len(selected), N)``: ``performance[j, i]`` the gain of filter ``j`` under model ``i`` (reference
         ``MDperf``).
     degrees : tuple of int
-        The basis degree used per filter (its order).
+        The basis degree used per filter (its order; with ``minimal=False`` the sum of the row degrees).
     models : tuple of FaultModel
         The multiple model.
     gaps : numpy.ndarray or None
@@ -238,8 +238,8 @@ def _filter_poles(model: FaultModel, degree: int, poles, sdeg, smarg) -> list[co
 def _options(models, rdim, selection, select, normalize, **kw) -> dict:
     from fdikit.errors import ParameterError
 
-    if isinstance(rdim, bool) or not isinstance(rdim, int | np.integer) or rdim < 1:
-        raise ParameterError(f"rdim must be an integer >= 1, got {rdim!r}")
+    if rdim is not None and (isinstance(rdim, bool) or not isinstance(rdim, int | np.integer) or rdim < 1):
+        raise ParameterError(f"rdim must be an integer >= 1 or None, got {rdim!r}")
     if selection is not None and len(selection) != len(models):
         raise ParameterError(f"selection needs one entry (a matrix or None) per model: {len(models)}, got "
                              f"{len(selection)}")
@@ -250,25 +250,31 @@ def _options(models, rdim, selection, select, normalize, **kw) -> dict:
     if normalize and sel[0] != 0:
         raise ParameterError("normalize=True scales the filters against filter 0, so select must start with 0 "
                              f"(got {list(sel)})")
-    return {"rdim": int(rdim), "selection": selection, "select": sel, "normalize": bool(normalize), **kw}
+    return {"rdim": None if rdim is None else int(rdim), "selection": selection, "select": sel,
+            "normalize": bool(normalize), **kw}
 
 
-def emdsyn(models: Sequence[FaultModel], *, rdim: int = 1, selection=None, select: Sequence[int] | None = None,
-           poles: Sequence[complex] | None = None, sdeg: float | None = None, smarg: float | None = None,
-           mdtol: float = 1e-4, mdfreq=None, mdgaintol: float = 0.01, emdtest: bool = False,
-           normalize: bool = False) -> ModelDetectionDesign:
+def emdsyn(models: Sequence[FaultModel], *, rdim: int | None = None, minimal: bool = True, selection=None,
+           select: Sequence[int] | None = None, poles: Sequence[complex] | None = None, sdeg: float | None = None,
+           smarg: float | None = None, mdtol: float = 1e-4, mdfreq=None, mdgaintol: float = 0.01,
+           emdtest: bool = False, normalize: bool = False) -> ModelDetectionDesign:
     """Exact model detection filters of least order, one per model (Procedure EMD; reference ``emdsyn``).
 
     Parameters
     ----------
     models : sequence of FaultModel
         The multiple model: same outputs, controls and sample time; disturbances may differ.
-    rdim : int, default 1
-        Residuals per filter (reference ``rdim``): the least degree ``d`` with at least ``rdim`` basis rows of
-        degree ``≤ d`` that together detect every other model.
+    rdim : int, optional
+        Residuals per filter (reference ``rdim``; default 1, or with ``minimal=False`` the number of basis rows): the
+        least degree ``d`` with at least ``rdim`` basis rows of degree ``≤ d`` that together detect every other
+        model.
+    minimal : bool, default True
+        Least order (the rows of degree ``≤ d`` over one denominator of degree ``d``).  False: full order (reference
+        ``minimal = false``): every basis row over its own denominator, ``rdim`` combinations of them.
     selection : sequence of array_like or None, optional
-        Per filter, the ``(rdim, k)`` combination of those ``k`` rows (reference ``HDesign``, in fdikit's basis
-        coordinates), or None for the default: the identity when ``k = rdim``, else a fixed generic one.
+        Per filter, the ``(rdim, k)`` combination of those ``k`` rows (all rows with ``minimal=False``; reference
+        ``HDesign``, in fdikit's basis coordinates), or None for the default: the identity when ``k = rdim``, else a
+        fixed generic one.
     select : sequence of int, optional
         The models whose filters are designed, in order (reference ``MDSelect``); default all.
     poles : sequence of complex, optional
@@ -312,7 +318,7 @@ def emdsyn(models: Sequence[FaultModel], *, rdim: int = 1, selection=None, selec
 
     models = check_models(models)
     opts = _options(models, rdim, selection, select, normalize, poles=poles, sdeg=sdeg, smarg=smarg, mdtol=mdtol,
-                    mdfreq=mdfreq, mdgaintol=mdgaintol, emdtest=emdtest)
+                    mdfreq=mdfreq, mdgaintol=mdgaintol, emdtest=emdtest, minimal=bool(minimal))
     pairs = [_exact_filter(models, j, opts) for j in opts["select"]]
     gens, P = _scaled([g for g, _ in pairs], models, opts)
     return ModelDetectionDesign(gens, P, tuple(d for _, d in pairs), models, selected=_selected(opts, models))
@@ -335,14 +341,15 @@ def _combination(selection, j: int, q: int, k: int) -> np.ndarray:
 
 
 def _exact_filter(models, j, opts):
-    """Filter ``j`` of Procedure EMD (unscaled) and its degree."""
+    """Filter ``j`` of Procedure EMD (unscaled) and its degree (with ``minimal=False``: the sum of the degrees)."""
     from fdikit.design.nullspace.basis import denominator, left_nullspace, minimal_realization, realize_rows
 
-    mj, q, mdfreq = models[j], opts["rdim"], opts["mdfreq"]
+    mj, mdfreq, minimal = models[j], opts["mdfreq"], opts.get("minimal", True)
     others = [i for i in range(len(models)) if i != j]
     basis = left_nullspace(mj)
     if not basis.rows:
         raise DesignError(f"model {j}: its disturbances use up the outputs; no residual decouples it")
+    q = opts["rdim"] if opts["rdim"] is not None else (1 if minimal else len(basis.rows))
     if q > len(basis.rows):
         raise DesignError(f"rdim={q}: the nullspace basis of model {j} has {len(basis.rows)} rows")
     chk = [denominator(nu, None, None, mj.dt) for nu in basis.degrees]
@@ -352,14 +359,22 @@ def _exact_filter(models, j, opts):
         raise DesignError(f"models {missing} cannot be told apart from model {j} by a filter that decouples "
                           f"model {j}{' at the frequencies ' + str(mdfreq) if mdfreq is not None else ''} "
                           "(see mdgenspec)")
-    for d in sorted(set(basis.degrees)):
-        used = [k for k, nu in enumerate(basis.degrees) if nu <= d]
-        if len(used) >= q and all(T[used, i].any() for i in others):
-            break
-    H = _combination(opts["selection"], j, q, len(used))
-    rows = basis.combined(H, used)
-    den = denominator(d, _filter_poles(mj, d, opts["poles"], opts["sdeg"], opts["smarg"]), None, mj.dt)
-    A, B, C, D = minimal_realization(*realize_rows(rows, [den] * q, basis.scale))
+
+    def den(d: int) -> np.ndarray:
+        return denominator(d, _filter_poles(mj, d, opts["poles"], opts["sdeg"], opts["smarg"]), None, mj.dt)
+
+    if minimal:
+        for d in sorted(set(basis.degrees)):
+            used = [k for k, nu in enumerate(basis.degrees) if nu <= d]
+            if len(used) >= q and all(T[used, i].any() for i in others):
+                break
+        H = _combination(opts["selection"], j, q, len(used))
+        A, B, C, D = minimal_realization(*realize_rows(basis.combined(H, used), [den(d)] * q, basis.scale))
+    else:                       # full order: every row over its own denominator, rdim combinations
+        H = _combination(opts["selection"], j, q, len(basis.rows))
+        A, B, C, D = realize_rows(basis.rows, [den(nu) for nu in basis.degrees], basis.scale)
+        A, B, C, D = minimal_realization(A, B, H @ C, H @ D)
+        d = sum(basis.degrees)
     names = (f"r{j}",) if q == 1 else tuple(f"r{j}_{k}" for k in range(q))
     return ResidualGenerator(A, B, C, D, controls=mj.controls, outputs=mj.outputs, residuals=names, dt=mj.dt), d
 
@@ -426,7 +441,8 @@ def mdmatch(design: ModelDetectionDesign, model: FaultModel, *, mdfreq=None,
     return g, int(design.filter_models[int(np.argmin(g))])
 
 
-def amdsyn(models: Sequence[FaultModel], *, rdim: int = 1, selection=None, select: Sequence[int] | None = None,
+def amdsyn(models: Sequence[FaultModel], *, rdim: int | None = None, minimal: bool = True, selection=None,
+           select: Sequence[int] | None = None,
            poles: Sequence[complex] | None = None, sdeg: float | None = None, smarg: float | None = None,
            mdtol: float = 1e-4, mdfreq=None, mdgaintol: float = 0.01, emdtest: bool = False, normalize: bool = False,
            nonstd: str = "quasi", epsreg: float = 0.1, sdegzer: float | None = None) -> ModelDetectionDesign:
@@ -442,7 +458,7 @@ def amdsyn(models: Sequence[FaultModel], *, rdim: int = 1, selection=None, selec
     ----------
     models : sequence of FaultModel
         The multiple model; each model's noise inputs (group ``w``) are attenuated.
-    rdim, selection, select, poles, sdeg, smarg, mdtol, mdfreq, mdgaintol, emdtest, normalize
+    rdim, minimal, selection, select, poles, sdeg, smarg, mdtol, mdfreq, mdgaintol, emdtest, normalize
         As :func:`emdsyn`.
     nonstd, epsreg, sdegzer
         The non-standard noise factor, as :func:`~fdikit.design.nullspace.approximate.afdsyn`.
@@ -478,7 +494,7 @@ def amdsyn(models: Sequence[FaultModel], *, rdim: int = 1, selection=None, selec
 
     models = check_models(models)
     opts = _options(models, rdim, selection, select, normalize, poles=poles, sdeg=sdeg, smarg=smarg, mdtol=mdtol,
-                    mdfreq=mdfreq, mdgaintol=mdgaintol, emdtest=emdtest)
+                    mdfreq=mdfreq, mdgaintol=mdgaintol, emdtest=emdtest, minimal=bool(minimal))
     gens, kinds, degs = [], [], []
     for j in opts["select"]:
         mj = models[j]
