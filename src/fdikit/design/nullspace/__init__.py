@@ -37,7 +37,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
         "approximate": ["ApproximateBankDesign", "ApproximateDesign", "afdisyn", "afdsyn"],
         "factorization": [
             "CoOuterFactor", "boundary_zeros", "coouter_coinner", "inverse", "quasi_coouter", "quasi_coouter_row",
-            "canonical_factor", "realization", "regularized_coouter", "series",
+            "canonical_factor", "realization", "regularized_coouter", "series", "transfer",
         ],
         "zero_steps": ["ZeroStep", "remove_boundary_zeros", "zero_steps_inverse"],
         "noise_factors": ["NONSTD_OPTIONS", "noise_factor"],

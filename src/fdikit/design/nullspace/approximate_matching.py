@@ -300,6 +300,7 @@ def _basis_rows(model: FaultModel, selection=None):
     ``R_o⁻¹ Q₁`` a realisation of the same order (the reference's ``[Ro Q R]``) instead of a series connection whose
     cancelling modes a minimal realisation must find.
     """
+    from fdikit.design.nullspace.factorization import transfer
 
     basis = left_nullspace(model)
     if not basis.rows:
@@ -311,7 +312,7 @@ def _basis_rows(model: FaultModel, selection=None):
     Bfw, Dfw = np.hstack([model.b("f"), model.b("w")]), np.hstack([model.d("f"), model.d("w")])
 
     def rank(rows, lam) -> int:
-        G = Dfw + (model.C @ np.linalg.solve(lam * np.eye(model.n) - model.A, Bfw) if model.n else 0)
+        G = transfer((model.A, Bfw, model.C, Dfw), lam)
         sv = np.linalg.svd(basis.evaluate(lam, rows)[:, mu:] @ G, compute_uv=False)
         return int(np.sum(sv > 1e-9 * max(sv[0], 1e-300)))
 
@@ -344,8 +345,7 @@ def _basis_rows(model: FaultModel, selection=None):
     # rows of R scaled to comparable gains (a constant left factor: the co-inner factor of R and the optimum do not
     # change); PATH's rows span six decades, which defeated the rank decisions of the zero removal
     Br_, Dr_ = B[:, mu + p:], D[:, mu + p:]
-    gains = np.max([np.linalg.norm(Dr_ + (C @ np.linalg.solve(z * basis.scale * np.eye(A.shape[0]) - A, Br_)
-                                          if A.shape[0] else 0), axis=1) for z in _POINTS], axis=0)
+    gains = np.max([np.linalg.norm(transfer((A, Br_, C, Dr_), z * basis.scale), axis=1) for z in _POINTS], axis=0)
     W = np.diag(1.0 / np.maximum(gains, 1e-300))
     C, D = W @ C, W @ D
     return A, B[:, : mu + p], B[:, mu + p:], C, D[:, : mu + p], D[:, mu + p:]

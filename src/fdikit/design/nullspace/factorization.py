@@ -47,7 +47,7 @@ import scipy.linalg as sla
 from fdikit.errors import DesignError, ParameterError
 
 __all__ = ["CoOuterFactor", "coouter_coinner", "regularized_coouter", "quasi_coouter_row", "quasi_coouter",
-           "boundary_zeros", "series", "inverse", "realization",
+           "boundary_zeros", "series", "inverse", "realization", "transfer",
            "canonical_factor"]
 
 
@@ -112,6 +112,33 @@ def realization(A, B, C, D) -> tuple[np.ndarray, ...]:
     n = A.shape[0] if A.size else 0
     p, m = D.shape
     return A.reshape(n, n), B.reshape(n, m), C.reshape(p, n), D
+
+
+def transfer(sys, lam: complex) -> np.ndarray:
+    """``G(λ) = D + C (λI − A)⁻¹ B`` of a realisation ``(A, B, C, D)`` at one complex point.
+
+    Parameters
+    ----------
+    sys : tuple of numpy.ndarray
+        ``(A, B, C, D)``, shaped as :func:`realization` returns them.
+    lam : complex
+        The point (not a pole).
+
+    Returns
+    -------
+    numpy.ndarray
+
+    Examples
+    --------
+    >>> transfer((np.array([[-1.0]]), np.array([[1.0]]), np.array([[2.0]]), np.array([[0.0]])), 1.0).tolist()
+    [[1.0]]
+
+    References
+    ----------
+    Varga (2017), §7.3.
+    """
+    A, B, C, D = sys
+    return D + (C @ np.linalg.solve(lam * np.eye(A.shape[0]) - A, B) if A.shape[0] else 0)
 
 
 def _sqrtm_sym(R: np.ndarray, inverse_: bool = False) -> np.ndarray:

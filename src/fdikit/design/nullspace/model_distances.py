@@ -120,11 +120,6 @@ def _channel(m: FaultModel, cdinp: bool, md: int) -> tuple[np.ndarray, ...]:
     return m.A, B, m.C, D
 
 
-def _response(sys, s: complex) -> np.ndarray:
-    A, B, C, D = sys
-    return D + (C @ np.linalg.solve(s * np.eye(A.shape[0]) - A, B) if A.shape[0] else 0.0)
-
-
 def _chordal(G1: np.ndarray, G2: np.ndarray) -> float:
     def inv_sqrt(M):
         w, V = np.linalg.eigh((M + M.conj().T) / 2)
@@ -204,7 +199,7 @@ def nu_gap(sys1, sys2, *, freqs: Sequence[float] | None = None, dt: float | None
     """
     from scipy.optimize import minimize_scalar
 
-    from fdikit.design.nullspace.factorization import realization
+    from fdikit.design.nullspace.factorization import realization, transfer
 
     s1, s2 = realization(*sys1), realization(*sys2)
     if s1[3].shape != s2[3].shape:
@@ -228,7 +223,7 @@ def nu_gap(sys1, sys2, *, freqs: Sequence[float] | None = None, dt: float | None
                                  "winding condition) is not covered; use distance='inf' on a shifted model")
 
     def kappa(w: float) -> float:
-        return _chordal(_response(s1, 1j * w), _response(s2, 1j * w))
+        return _chordal(transfer(s1, 1j * w), transfer(s2, 1j * w))
 
     if freqs is not None:
         w = np.atleast_1d(np.asarray(freqs, dtype=float))
@@ -327,11 +322,13 @@ def _difference_norm(sys1, sys2, distance: str, freqs, dt) -> tuple[float, float
     import control
     from scipy.linalg import block_diag
 
+    from fdikit.design.nullspace.factorization import transfer
+
     (A1, B1, C1, D1), (A2, B2, C2, D2) = sys1, sys2
     diff = (block_diag(A1, A2), np.vstack([B1, B2]), np.hstack([C1, -C2]), D1 - D2)
     if freqs is not None:
         pts = [1j * x if dt is None else np.exp(1j * x * dt) for x in freqs]
-        g = [np.linalg.norm(_response(diff, s), 2) if np.isfinite(s) else np.linalg.norm(diff[3], 2) for s in pts]
+        g = [np.linalg.norm(transfer(diff, s), 2) if np.isfinite(s) else np.linalg.norm(diff[3], 2) for s in pts]
         k = int(np.argmax(g))
         return float(g[k]), float(freqs[k])
     if diff[0].shape[0] == 0:

@@ -367,12 +367,10 @@ def updated_reference(ref: FaultModel, updating) -> FaultModel:
     return FaultModel(A, C, outputs=ref.outputs, dt=ref.dt, **kw)
 
 
-def _response(A, B, C, D, lam: complex) -> np.ndarray:
-    return D + (C @ np.linalg.solve(lam * np.eye(A.shape[0]) - A, B) if A.shape[0] else 0)
-
-
 def _check(model: FaultModel, gen: ResidualGenerator, target: FaultModel, groups) -> None:
     """Raise when ``Q G_e − M M_r`` is not zero to rounding at three points (a rank decision failed)."""
+    from fdikit.design.nullspace.factorization import transfer
+
     alpha = max(1.0, float(np.linalg.norm(model.A, 2))) if model.n else 1.0
     Bg, Dg = np.hstack([model.b(g) for g in groups]), np.hstack([model.d(g) for g in groups])
     Eu = np.hstack([np.eye(len(model.controls)) if g == "u" else np.zeros((len(model.controls), len(model.inputs[g])))
@@ -380,9 +378,9 @@ def _check(model: FaultModel, gen: ResidualGenerator, target: FaultModel, groups
     Bt, Dt = reference_columns(target, model, groups)
     worst = 0.0
     for lam in (0.7 + 0.7j, 1j * np.sqrt(alpha), alpha * (0.6 + 0.8j)):
-        Q = _response(gen.A, gen.B, gen.C, gen.D, lam)
-        G = np.vstack([Eu, _response(model.A, Bg, model.C, Dg, lam)])    # the generator reads [u; y]
-        T = _response(target.A, Bt, target.C, Dt, lam)
+        Q = transfer((gen.A, gen.B, gen.C, gen.D), lam)
+        G = np.vstack([Eu, transfer((model.A, Bg, model.C, Dg), lam)])    # the generator reads [u; y]
+        T = transfer((target.A, Bt, target.C, Dt), lam)
         scale = np.linalg.norm(Q, 2) * np.linalg.norm(G, 2) + np.linalg.norm(T, 2)
         worst = max(worst, float(np.linalg.norm(Q @ G - T, 2) / max(scale, 1e-300)))
     if worst > 1e-6:
