@@ -151,29 +151,17 @@ def _plant(inner, F, Y0=None):
     return A, B.reshape(n1 + n2, m + q), C.reshape(q + r, n1 + n2), D
 
 
-def _closed_loop_norm(A, B, C, D, q: int, r: int, K) -> float:
-    """``‖Y R_i − F‖∞`` of the plant closed by ``Y`` (``P₂₂ = 0``, so the loop is open: a series connection)."""
-    Ak, Bk, Ck, Dk = K
-    n, m = A.shape[0], B.shape[1] - q
-    A1, B1, C1, D11, D12 = A, B[:, :m], C[:q], D[:q, :m], D[:q, m:]
-    C2, D21 = C[q:], D[q:, :m]
-    Acl = np.block([[A1, np.zeros((n, Ak.shape[0]))], [Bk @ C2, Ak]])
-    Bcl = np.vstack([B1, Bk @ D21])
-    Ccl = np.hstack([C1 + D12 @ Dk @ C2, D12 @ Ck])
-    Dcl = D11 + D12 @ Dk @ D21
-    return _norm((Acl, Bcl, Ccl, Dcl))
-
-
-def _hinf_bisection(A, B, C, D, q: int, r: int, F, reltol: float):
-    """Bisection on γ: SB10AD's suboptimal controller (``job = 4``) accepted when the loop's norm is below γ.
+def _hinf_bisection(plant, q: int, r: int, top: float, loop_norm, reltol: float):
+    """Bisection on γ: SB10AD's suboptimal controller (``job = 4``) accepted when ``loop_norm(K)`` is below γ.
 
     SB10AD's own γ-iteration (``job = 1``) stops on the closed-loop stability, which here (``B₂ = 0``, a stable
     plant) never fails, and went below the optimum on Example 5.14 (its controller missed the γ it returned).
+    ``top = ‖F‖∞`` (``Y = 0``) starts it.
     """
     import slycot
 
+    A, B, C, D = plant
     n, m_all = A.shape[0], B.shape[1]
-    top = _norm(F)
     if top == 0.0:                     # a zero reference: Y = 0 is optimal
         return 0.0, (np.zeros((0, 0)), np.zeros((0, r)), np.zeros((q, 0)), np.zeros((q, r)))
     hi, floor = 1.001 * top + 1e-12, 1e-9 * top
@@ -183,7 +171,7 @@ def _hinf_bisection(A, B, C, D, q: int, r: int, F, reltol: float):
         g = 0.5 * (lo + hi) if K_hi is not None else hi
         try:
             K = slycot.sb10ad(n, m_all, q + r, q, r, g, A, B, C, D, job=4)[1:5]
-            ok = _closed_loop_norm(A, B, C, D, q, r, K) <= g * (1 + 1e-9)
+            ok = loop_norm(K) <= g * (1 + 1e-9)
         except (ValueError, ArithmeticError):
             ok = False
         if ok:
@@ -278,7 +266,9 @@ def least_distance(inner, F, *, norm: str = "inf", dt: float | None = None, relt
     m_all = B.shape[1]
     try:
         if norm == "inf":
-            g, (Ak, Bk, Ck, Dk) = _hinf_bisection(A, B, C, D, q, r, F, reltol)
+            # P₂₂ = 0: the loop closed by K is the series connection (K + Y₀) R_i − F
+            g, (Ak, Bk, Ck, Dk) = _hinf_bisection(
+                (A, B, C, D), q, r, _norm(F), lambda K: _norm(_difference(inner, (*K[:3], K[3] + Y0), F)), reltol)
         else:
             if np.abs(D[:q, : m_all - q]).max(initial=0.0) > 1e-10 * max(1.0, np.abs(F[3]).max(initial=0.0)):
                 raise DesignError("the H2 distance is infinite: F is not matched at infinity; multiply it by a "

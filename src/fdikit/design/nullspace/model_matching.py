@@ -308,19 +308,10 @@ def _normalizer(num: np.ndarray, den: np.ndarray, dt, normalize: str) -> float:
 
 
 def _siso(num: np.ndarray, den: np.ndarray):
-    """Controllable-canonical realisation of ``num / den`` (proper, ``den`` monic, both highest power first)."""
-    d = len(den) - 1
-    num = np.concatenate([np.zeros(d + 1 - len(num)), num])
-    D = np.array([[num[0]]])
-    if d == 0:
-        return np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), D
-    A = np.zeros((d, d))
-    A[0] = -den[1:]
-    A[1:, :-1] = np.eye(d - 1)
-    B = np.zeros((d, 1))
-    B[0, 0] = 1.0
-    C = (num[1:] - num[0] * den[1:])[None, :]
-    return A, B, C, D
+    """A realisation of ``num / den`` (proper, ``den`` monic, both highest power first): ``realize_rows`` in ``λ``."""
+    N = np.zeros((len(den), 1))
+    N[: len(num), 0] = num[::-1]
+    return realize_rows([N], [den], 1.0)
 
 
 def updated_reference(ref: FaultModel, updating) -> FaultModel:
