@@ -105,6 +105,48 @@ def test_selection_restricts_the_rows():
         ammsyn(m, {"f": [[1.0, 1.0]]}, selection=[[1.0, 0.0, 0.0]])
 
 
+def dc_distance(m, h):
+    """The distance at ω = 0 of F = [1 1 0] from the row ``h(0) [Gf Gw](0)``: a lower bound of any γ of that row."""
+    G = np.hstack([response(m, "f", 0.0), response(m, "w", 0.0)]).real
+    r = np.asarray(h, dtype=float) @ G
+    F = np.array([1.0, 1.0, 0.0])
+    return float(np.linalg.norm(F - (F @ r) / (r @ r) * r))
+
+
+def test_example_5_6c_observer_basis_and_least_degree_cover():
+    # test_ammsyn.jl, Example 5.6c: nullspace = false, HDesign = [1 1], sdeg = smarg = −3 (regmin, the default):
+    # fdimmperf(R, Mr) = 0.7385533646476293.  The least-degree cover of [1 1] [−Gu I] is X = h [−Gu I] with
+    # h = [1, (s+3)/(s+2)] (up to a stable scalar), order 1: R ∝ [s+1, s+3, 1], whose distance at DC is that number
+    from test_approximate import example_5_6
+
+    from fdikit.design.nullspace.matching_rows import matching_rows
+
+    m = example_5_6()
+    d = ammsyn(m, {"f": [[1.0, 1.0]]}, nullspace=False, selection=[[1.0, 1.0]], sdeg=-3, smarg=-3)
+    assert not d.nonstandard
+    assert d.gamma_sub == pytest.approx(0.7385533646476293, rel=1e-4)       # the reference's reltol
+    assert d.gamma_opt0 == pytest.approx(dc_distance(m, [1.0, 3.0 / 2.0]), rel=1e-4)
+    assert sweep(d) == pytest.approx(d.gamma_sub, rel=1e-6)
+    form = d.internal_form()
+    for lam in (0.3j, 2.0 + 1j):
+        assert np.abs(response(form, "u", lam)).max() < 1e-9
+    A, Bq, Br, C, Dq, Dr = matching_rows(m, [[1.0, 1.0]], nullspace=False)
+    assert A.shape == (1, 1)                                   # least degree 1 (no constant row reaches h = [1 1])
+    assert Dq[0, 1] == pytest.approx(Dq[0, 2], rel=1e-9)      # y-part at infinity ∝ H
+    # without the cover: H [−Gu I] of order 2, R = [(s+1)/(s+2), 1, 1/(s+2)], the whole nullspace's 1/√2
+    d2 = ammsyn(m, {"f": [[1.0, 1.0]]}, nullspace=False, regmin=False, selection=[[1.0, 1.0]], sdeg=-3, smarg=-3)
+    assert matching_rows(m, [[1.0, 1.0]], nullspace=False, regmin=False)[0].shape == (2, 2)
+    assert d2.gamma_sub == pytest.approx(2 ** -0.5, rel=1e-4) and dc_distance(m, [1.0, 1.0]) == pytest.approx(
+        2 ** -0.5, rel=1e-12)
+    # the observer basis rows alone (default selection): both rows keep the rank, again 1/√2
+    assert ammsyn(m, {"f": [[1.0, 1.0]]}, nullspace=False).gamma_sub == pytest.approx(2 ** -0.5, rel=1e-4)
+    with pytest.raises(ParameterError, match="observer basis"):
+        ammsyn(m, {"f": [[1.0, 1.0]]}, nullspace=False, selection=[[1.0, 1.0, 0.0]])
+    md = FaultModel(m.A, m.C, Bu=m.b("u"), Du=m.d("u"), Bd=m.b("w"), Dd=m.d("w"), Bf=m.b("f"), Df=m.d("f"))
+    with pytest.raises(ParameterError, match="without disturbances"):
+        ammsyn(md, {"f": [[1.0, 1.0]]}, nullspace=False)
+
+
 @pytest.mark.parametrize("norm", ["inf", "2"])
 def test_example_5_14_nonstandard_is_the_regularised_limit(norm):
     m, ref = ex5_14()

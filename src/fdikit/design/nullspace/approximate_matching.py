@@ -15,8 +15,10 @@ controls read as outputs when they are matched.
 How fdikit solves it (the reference's steps, with its own tools):
 
 1. ``Q₁``: the proper nullspace basis of ``[Gu Gd; I 0]`` (:func:`~fdikit.design.nullspace.basis.left_nullspace`,
-   poles at the default stability degree), ``R = Q₁ [Gf Gw; 0 0]``; when ``R`` lacks full row rank, the first basis
-   rows (ascending degree) that keep its rank (the reference reduces to ``rdim`` rows here instead).
+   poles at the default stability degree) or the observer basis ``[−Gu I]``, ``R = Q₁ [Gf Gw; 0 0]``; when ``R``
+   lacks full row rank, the first basis rows (ascending degree) that keep its rank (the reference reduces to
+   ``rdim`` rows here instead); a ``selection`` as a least-degree cover
+   (:func:`~fdikit.design.nullspace.matching_rows.matching_rows`).
 2. ``R = R_o R_i`` with ``R_i`` co-inner (``R_i R_i~ = I``) and ``R_o`` (quasi-)co-outer: the co-inner factor of
    ``T R`` after the row operations that remove the zeros at infinity and on the boundary
    (:func:`~fdikit.design.nullspace.zero_steps.remove_boundary_zeros`; ``T R_o`` is outer, so the co-inner factor is
@@ -51,7 +53,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fdikit.design.nullspace.basis import default_sdeg, denominator, left_nullspace, minimal_realization, realize_rows
+from fdikit.design.nullspace.basis import default_sdeg, minimal_realization
+from fdikit.design.nullspace.matching_rows import matching_rows
 from fdikit.design.nullspace.model_matching import (
     ModelMatchingBankDesign,
     ModelMatchingDesign,
@@ -67,9 +70,6 @@ from fdikit.protocols import FieldReport
 from fdikit.residuals import ResidualGenerator
 
 __all__ = ["ApproximateMatchingDesign", "ammsyn", "least_distance"]
-
-_POINTS = (0.613 + 0.791j, -0.377 + 1.93j)
-
 
 @dataclass(frozen=True, eq=False)
 class ApproximateMatchingDesign(FieldReport):
@@ -282,65 +282,6 @@ def least_distance(inner, F, *, norm: str = "inf", dt: float | None = None, relt
     return (Y if dt is None else _bilinear(Y, False)), float(g)
 
 
-def _basis_rows(model: FaultModel, selection=None):
-    """``[Q₁ R]`` on one minimal state space: ``(A, B_q, B_r, C, D_q, D_r)``.
-
-    ``Q₁`` is the proper basis (the first rows, by degree, that keep the rank of ``R``, each over its own
-    denominator), or ``selection @ N`` over one denominator of the largest degree; sharing ``A`` and ``C`` makes
-    ``R_o⁻¹ Q₁`` a realisation of the same order (the reference's ``[Ro Q R]``) instead of a series connection whose
-    cancelling modes a minimal realisation must find.
-    """
-    from fdikit.design.nullspace.factorization import transfer
-
-    basis = left_nullspace(model)
-    if not basis.rows:
-        raise DesignError("the nullspace of [Gu Gd; I 0] is empty: no filter decouples the controls and the "
-                          "disturbances, so no model matching is possible")
-    if not (model.faults or model.noise):
-        raise DesignError("the model has no fault or noise inputs: nothing to match")
-    mu = len(model.controls)
-    Bfw, Dfw = np.hstack([model.b("f"), model.b("w")]), np.hstack([model.d("f"), model.d("w")])
-
-    def rank(rows, lam) -> int:
-        G = transfer((model.A, Bfw, model.C, Dfw), lam)
-        sv = np.linalg.svd(basis.evaluate(lam, rows)[:, mu:] @ G, compute_uv=False)
-        return int(np.sum(sv > 1e-9 * max(sv[0], 1e-300)))
-
-    if selection is None:
-        chosen: list[int] = []
-        for i in range(len(basis.rows)):
-            if min(rank(chosen + [i], z * basis.scale) for z in _POINTS) == len(chosen) + 1:
-                chosen.append(i)
-        if not chosen:
-            raise DesignError("no fault or noise input reaches the decoupled residuals: nothing to match")
-        dens = [denominator(basis.degrees[i], None, None, model.dt) for i in chosen]
-        Aq, Bq, Cq, Dq = realize_rows([basis.rows[i] for i in chosen], dens, basis.scale)
-    else:
-        H = np.atleast_2d(np.asarray(selection, dtype=float))
-        k = len(basis.rows)
-        if H.shape[1] != k or not np.all(np.isfinite(H)) or np.linalg.matrix_rank(H) < H.shape[0]:
-            raise ParameterError(f"selection must be a finite matrix of full row rank with {k} columns (one per "
-                                 f"basis row, degrees {list(basis.degrees)}), got shape {H.shape}")
-        rows = basis.combined(H, range(k))
-        d = rows[0].shape[0] - 1
-        Aq, Bq, Cq, Dq = realize_rows(rows, [denominator(d, None, None, model.dt)] * len(rows), basis.scale)
-    # [Q₁ R] on one state space (plant, then filter): Q₁ reads [u; y], R = Q₁ [Gf Gw; 0] reads [f; w]
-    n, nq, p = model.n, Aq.shape[0], model.p
-    Bqy, Dqy = Bq[:, mu:], Dq[:, mu:]
-    A = np.block([[model.A, np.zeros((n, nq))], [Bqy @ model.C, Aq]])
-    B = np.block([[np.zeros((n, mu + p)), Bfw], [Bq, Bqy @ Dfw]])
-    C = np.hstack([Dqy @ model.C, Cq])
-    D = np.hstack([Dq, Dqy @ Dfw])
-    A, B, C, D = minimal_realization(A, B, C, D)
-    # rows of R scaled to comparable gains (a constant left factor: the co-inner factor of R and the optimum do not
-    # change); PATH's rows span six decades, which defeated the rank decisions of the zero removal
-    Br_, Dr_ = B[:, mu + p:], D[:, mu + p:]
-    gains = np.max([np.linalg.norm(transfer((A, Br_, C, Dr_), z * basis.scale), axis=1) for z in _POINTS], axis=0)
-    W = np.diag(1.0 / np.maximum(gains, 1e-300))
-    C, D = W @ C, W @ D
-    return A, B[:, : mu + p], B[:, mu + p:], C, D[:, : mu + p], D[:, mu + p:]
-
-
 def _target_columns(model: FaultModel, ref: FaultModel, groups):
     """``F = [M_r,g … M_rw]`` over the matched ``groups`` and the noise (zero where ``M_r`` lacks one)."""
     B, D = reference_columns(ref, model, tuple(groups) + ("w",))
@@ -420,7 +361,8 @@ def _low_pass(F, a: float):
 
 
 def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[str] | None = None, selection=None,
-           poles: Sequence[complex] | None = None, sdeg: float | None = None, smarg: float | None = None,
+           nullspace: bool = True, regmin: bool = True, poles: Sequence[complex] | None = None,
+           sdeg: float | None = None, smarg: float | None = None,
            normalize: str = "infnorm", reltol: float = 1e-4,
            tol: float = 1e-7) -> ApproximateMatchingDesign | ModelMatchingBankDesign:
     """Approximate model matching in the H∞ or H2 norm (Procedure AMMS).
@@ -438,8 +380,15 @@ def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[s
     names : sequence of str, optional
         Residual names (default the reference's outputs; ``r<i>`` for a static reference).
     selection : array_like, optional
-        ``H``: use the rows ``H N`` of the nullspace basis only (the reference's ``HDesign``, in fdikit's basis
-        coordinates: ``(k, len(basis.rows))``, full row rank); default the basis rows that keep the rank of ``R``.
+        ``H``: use the rows ``H N`` of the nullspace basis only (the reference's ``HDesign``): ``(k, len(basis.rows))``
+        in fdikit's minimal basis coordinates, ``(k, p)`` on the observer basis; full row rank.  Default the basis
+        rows that keep the rank of ``R``.
+    nullspace : bool, default True
+        The minimal proper nullspace basis, or (False) the observer basis ``[−Gu I]``, ``R = [Gf Gw]`` (the
+        reference's ``nullspace = false``; only when no disturbance is decoupled).
+    regmin : bool, default True
+        Least-degree annihilator ``(H + Y) N``, ``Y`` strictly proper (the reference's ``regmin`` and its
+        ``glmcover1``; :mod:`~fdikit.design.nullspace.matching_rows`); False: ``H N`` as it stands.
     poles, sdeg, smarg, normalize
         The updating factor of the non-standard case, as in :func:`~fdikit.design.nullspace.model_matching.emmsyn`
         (``normalize`` default ``'infnorm'``, the reference's).
@@ -481,7 +430,8 @@ def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[s
         raise ParameterError(f"reltol must be in (0, 1), got {reltol}")
     if isinstance(reference, (list, tuple)):
         return reference_bank(model, reference, names, lambda r, nm: ammsyn(
-            model, r, norm=norm, names=nm, selection=selection, poles=poles, sdeg=sdeg, smarg=smarg,
+            model, r, norm=norm, names=nm, selection=selection, nullspace=nullspace, regmin=regmin, poles=poles,
+            sdeg=sdeg, smarg=smarg,
             normalize=normalize, reltol=reltol, tol=tol))
     ref = reference_model(model, reference, names)
     groups = tuple(g for g in ("u", "d") if len(ref.inputs[g])) + ("f",)
@@ -493,7 +443,7 @@ def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[s
     if names is None and not isinstance(reference, FaultModel):
         names = tuple(f"r{i}" for i in range(ref.p))
     names = tuple(ref.outputs if names is None else names)
-    Aj, Bq, Br, Cj, Dq, Dr = _basis_rows(plant, selection)
+    Aj, Bq, Br, Cj, Dq, Dr = matching_rows(plant, selection, nullspace=nullspace, regmin=regmin, tol=tol)
     if (np.linalg.eigvals(Aj).real if model.dt is None else np.abs(np.linalg.eigvals(Aj)) - 1).max(initial=-1) >= 0:
         raise DesignError("R = Q₁ [Gf Gw; 0] is unstable: the plant has unstable modes that the faults or the noise "
                           "excite and the decoupled residuals see; stabilise them first")
