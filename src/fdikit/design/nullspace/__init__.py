@@ -17,7 +17,7 @@
   EMD) and ``mdmatch``.
 * :mod:`fdikit.design.nullspace.model_matching` — ``emmsyn``: exact model matching of least order (Procedures
   EMM, EMMS), by the left nullspace of the plant with the reference appended.
-* :mod:`fdikit.design.nullspace.matching_rows` — the annihilator model matching starts from: minimal or observer
+* :mod:`fdikit.design.nullspace.matching_basis` — the annihilator model matching starts from: minimal or observer
   basis, least-degree covers of a selection.
 * :mod:`fdikit.design.nullspace.approximate_matching` — ``ammsyn``: H∞/H2 model matching (Procedure AMMS), the
   least-distance problem by SLICOT.
@@ -50,7 +50,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
             "ModelMatchingBankDesign", "ModelMatchingDesign", "NORMALIZE_OPTIONS", "emmsyn", "reference_bank",
             "reference_columns", "reference_model", "updated_reference",
         ],
-        "matching_rows": ["matching_rows"],
+        "matching_basis": ["matching_rows"],
         "approximate_matching": ["ApproximateMatchingDesign", "ammsyn", "least_distance"],
         "row_factors": ["RowSpectrum", "WIENER_HOPF_JOBS", "realize_biproper", "row_spectrum", "wiener_hopf_row"],
         "exact": ["NullspaceBankDesign", "NullspaceDesign", "bank_rows", "efdisyn", "efdsyn", "split_faults"],

@@ -18,7 +18,7 @@ How fdikit solves it (the reference's steps, with its own tools):
    poles at the default stability degree) or the observer basis ``[−Gu I]``, ``R = Q₁ [Gf Gw; 0 0]``; when ``R``
    lacks full row rank, the first basis rows (ascending degree) that keep its rank (the reference reduces to
    ``rdim`` rows here instead); a ``selection`` as a least-degree cover
-   (:func:`~fdikit.design.nullspace.matching_rows.matching_rows`).
+   (:func:`~fdikit.design.nullspace.matching_basis.matching_rows`).
 2. ``R = R_o R_i`` with ``R_i`` co-inner (``R_i R_i~ = I``) and ``R_o`` (quasi-)co-outer: the co-inner factor of
    ``T R`` after the row operations that remove the zeros at infinity and on the boundary
    (:func:`~fdikit.design.nullspace.zero_steps.remove_boundary_zeros`; ``T R_o`` is outer, so the co-inner factor is
@@ -54,7 +54,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fdikit.design.nullspace.basis import default_sdeg, minimal_realization
-from fdikit.design.nullspace.matching_rows import matching_rows
+from fdikit.design.nullspace.matching_basis import matching_rows
 from fdikit.design.nullspace.model_matching import (
     ModelMatchingBankDesign,
     ModelMatchingDesign,
@@ -388,7 +388,7 @@ def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[s
         reference's ``nullspace = false``; only when no disturbance is decoupled).
     regmin : bool, default True
         Least-degree annihilator ``(H + Y) N``, ``Y`` strictly proper (the reference's ``regmin`` and its
-        ``glmcover1``; :mod:`~fdikit.design.nullspace.matching_rows`); False: ``H N`` as it stands.
+        ``glmcover1``; :mod:`~fdikit.design.nullspace.matching_basis`); False: ``H N`` as it stands.
     poles, sdeg, smarg, normalize
         The updating factor of the non-standard case, as in :func:`~fdikit.design.nullspace.model_matching.emmsyn`
         (``normalize`` default ``'infnorm'``, the reference's).

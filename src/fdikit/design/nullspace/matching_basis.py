@@ -127,7 +127,7 @@ def matching_rows(model: FaultModel, selection=None, *, nullspace: bool = True, 
 
     def basis_at(lam):                                         # N(λ) on [u; y], numerators of the minimal basis
         if nullspace:
-            return basis.evaluate(lam * basis.scale)
+            return basis.evaluate(lam)
         return np.hstack([-transfer((model.A, Bu, model.C, Du), lam), np.eye(p)])
 
     def rank(H, lam) -> int:
@@ -137,7 +137,7 @@ def matching_rows(model: FaultModel, selection=None, *, nullspace: bool = True, 
     if selection is None:
         chosen: list[int] = []
         for i in range(k_all):
-            if min(rank(np.eye(k_all)[chosen + [i]], z) for z in _POINTS) == len(chosen) + 1:
+            if min(rank(np.eye(k_all)[chosen + [i]], z * basis.scale) for z in _POINTS) == len(chosen) + 1:
                 chosen.append(i)
         if not chosen:
             raise DesignError("no fault or noise input reaches the decoupled residuals: nothing to match")
@@ -158,7 +158,7 @@ def matching_rows(model: FaultModel, selection=None, *, nullspace: bool = True, 
                 sv = np.linalg.svd(Nz @ transfer((model.A, Bfw, model.C, Dfw), z * basis.scale), compute_uv=False)
                 return int(np.sum(sv > 1e-9 * max(sv[0], 1e-300)))
 
-            target = min(rank(H, z) for z in _POINTS)
+            target = min(rank(H, z * basis.scale) for z in _POINTS)
             rows: list[np.ndarray] = []
             for h in H:
                 need = min(len(rows) + 1, target)
@@ -184,10 +184,9 @@ def matching_rows(model: FaultModel, selection=None, *, nullspace: bool = True, 
         A = np.block([[model.A, np.zeros((n, nq))], [Bqy @ model.C, Aq]])
         Bq, Br = np.vstack([np.zeros((n, mu + p)), Bq0]), np.vstack([Bfw, Bqy @ Dfw])
         C, Dq, Dr = np.hstack([Dqy @ model.C, Cq]), Dq0, Dqy @ Dfw
-    A, B, C, D = minimal_realization(A, np.hstack([Bq, Br]), C, np.hstack([Dq, Dr]))
-    # rows of R scaled to comparable gains; PATH's rows span six decades, which defeated the rank decisions of
-    # the zero removal
-    Br, Dr = B[:, mu + p:], D[:, mu + p:]
+    # rows of R scaled to comparable gains before the minimal realisation: PATH's rows span six decades, which
+    # defeated its rank decisions (a state of the weak rows dropped) and those of the zero removal
     gains = np.max([np.linalg.norm(transfer((A, Br, C, Dr), z * basis.scale), axis=1) for z in _POINTS], axis=0)
     W = np.diag(1.0 / np.maximum(gains, 1e-300))
-    return A, B[:, : mu + p], Br, W @ C, W @ D[:, : mu + p], W @ Dr
+    A, B, C, D = minimal_realization(A, np.hstack([Bq, Br]), W @ C, W @ np.hstack([Dq, Dr]))
+    return A, B[:, : mu + p], B[:, mu + p:], C, D[:, : mu + p], D[:, mu + p:]
