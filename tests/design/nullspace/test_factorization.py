@@ -66,12 +66,31 @@ def test_first_order_row_by_hand():
         np.testing.assert_allclose(_resp(q.outer, 1j * w), _resp(f.outer, 1j * w), rtol=1e-10)
 
 
+def test_square_minimum_phase_with_a_multiple_zero_is_its_own_outer_factor():
+    # G = ((s + 1)/(s + 3))² ⊗ diag(1, 10⁴): square, D invertible, zeros at −1 twice per row; G_o = G, G_i = I.
+    # B̃ = B (I − D⁻¹D) = 0, so the filter ARE has X = 0; on the whole, its Hamiltonian has defective pairs ±1
+    a = np.array([[-3.0, 1.0], [0.0, -3.0]])
+    b = np.array([[0.0], [1.0]])
+    c = np.array([[4.0, -4.0]])                      # (s+1)² / (s+3)² = 1 + (−4s − 8)/(s+3)²
+    A, B = np.kron(np.eye(2), a), np.kron(np.diag([1.0, 1e4]), b)
+    C, D = np.kron(np.eye(2), c), np.diag([1.0, 1e4])
+    f = coouter_coinner(A, B, C, D)
+    for w in (0.0, 0.4, 5.0):
+        g = ((1j * w + 1) / (1j * w + 3)) ** 2
+        np.testing.assert_allclose(_resp((A, B, C, D), 1j * w), np.diag([g, 1e4 * g]), rtol=1e-12)
+        np.testing.assert_allclose(_resp(f.outer, 1j * w), _resp((A, B, C, D), 1j * w), rtol=1e-9)
+        np.testing.assert_allclose(_resp(f.inner, 1j * w), np.eye(2), atol=1e-9)
+
+
 def test_non_standard_cases_are_refused_with_the_zeros():
     with pytest.raises(DesignError, match="zeros at infinity"):
         coouter_coinner([[-2.0]], [[1.0]], [[1.0]], [[0.0]])                 # 1/(s+2)
     with pytest.raises(DesignError, match="stability boundary"):
         coouter_coinner([[-2.0]], [[-2.0]], [[1.0]], [[1.0]])                # s/(s+2)
-    assert boundary_zeros([[-2.0]], [[-2.0]], [[1.0]], [[1.0]]).size == 2
+    np.testing.assert_allclose(boundary_zeros([[-2.0]], [[-2.0]], [[1.0]], [[1.0]]), [0.0], atol=1e-12)
+    # (z − 1)/(z − 0.5) = 1 + 0.5/(z − 0.5): its zero at 1; (z − 0.9)/(z − 0.5) none
+    np.testing.assert_allclose(boundary_zeros([[0.5]], [[-0.5]], [[1.0]], [[1.0]], 1.0), [1.0], atol=1e-12)
+    assert boundary_zeros([[0.5]], [[-0.4]], [[1.0]], [[1.0]], 1.0).size == 0
     assert boundary_zeros([[-2.0]], [[1.0]], [[1.0]], [[1.0]]).size == 0
     with pytest.raises(ParameterError, match="one row"):
         quasi_coouter_row(np.eye(1), np.ones((1, 1)), np.ones((2, 1)), np.zeros((2, 1)))

@@ -19,8 +19,10 @@
   EMM, EMMS), by the left nullspace of the plant with the reference appended.
 * :mod:`fdikit.design.nullspace.matching_basis` — the annihilator model matching starts from: minimal or observer
   basis, least-degree covers of a selection.
+* :mod:`fdikit.design.nullspace.nehari_ldp` — the H∞ least-distance problem by Chu–Doyle–Lee's γ-iteration and
+  the optimal Nehari approximation (the reference's ``glinfldp``).
 * :mod:`fdikit.design.nullspace.approximate_matching` — ``ammsyn``: H∞/H2 model matching (Procedure AMMS), the
-  least-distance problem by SLICOT.
+  least-distance problem by SLICOT or the Nehari route.
 * :mod:`fdikit.design.nullspace.approximate` — ``afdsyn`` / ``afdisyn``: the fault-to-noise gap maximised under
   ``‖R_w‖∞ = γ`` (Procedures AFD, AFDI).
 * :mod:`fdikit.design.nullspace.specs` — ``fdigenspec`` (all achievable structure matrix rows) and ``fdichkspec``
@@ -51,6 +53,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
             "reference_columns", "reference_model", "updated_reference",
         ],
         "matching_basis": ["matching_rows"],
+        "nehari_ldp": ["nehari", "two_block_distance"],
         "approximate_matching": ["ApproximateMatchingDesign", "ammsyn", "least_distance"],
         "row_factors": ["RowSpectrum", "WIENER_HOPF_JOBS", "realize_biproper", "row_spectrum", "wiener_hopf_row"],
         "exact": ["NullspaceBankDesign", "NullspaceDesign", "bank_rows", "efdisyn", "efdsyn", "split_faults"],

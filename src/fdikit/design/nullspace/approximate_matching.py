@@ -64,6 +64,7 @@ from fdikit.design.nullspace.model_matching import (
     reference_model,
     updated_reference,
 )
+from fdikit.design.nullspace.nehari_ldp import two_block_distance
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import FieldReport
@@ -202,7 +203,8 @@ def _causal_projection(F, inner):
     return A1, B1 @ D2.T + A1 @ X @ C2.T, C1, D1 @ D2.T + C1 @ X @ C2.T
 
 
-def least_distance(inner, F, *, norm: str = "inf", dt: float | None = None, reltol: float = 1e-4):
+def least_distance(inner, F, *, norm: str = "inf", dt: float | None = None, reltol: float = 1e-4,
+                   ldp: str = "central"):
     """``Y`` stable minimising ``‖Y R_i − F‖`` (H∞ or H2) for a co-inner ``R_i`` and a stable ``F``.
 
     Parameters
@@ -218,6 +220,11 @@ def least_distance(inner, F, *, norm: str = "inf", dt: float | None = None, relt
         ``Y = [F R_i~]₊``).
     reltol : float, default 1e-4
         Relative accuracy of the H∞ γ-iteration.
+    ldp : {'central', 'nehari'}, default 'central'
+        The H∞ solver: the central controller of the equivalent H∞ plant (SLICOT ``SB10AD``, bisected on the
+        achieved distance), or the reference's Chu–Doyle–Lee γ-iteration with an optimal Nehari step
+        (:func:`~fdikit.design.nullspace.nehari_ldp.two_block_distance`).  Both reach the optimal ``γ``; where the
+        optimal ``Y`` is not unique they return different ones (``'nehari'`` the reference's).
 
     Returns
     -------
@@ -249,6 +256,8 @@ def least_distance(inner, F, *, norm: str = "inf", dt: float | None = None, relt
     inner = tuple(np.atleast_2d(np.asarray(M, dtype=float)) for M in inner)
     F = tuple(np.atleast_2d(np.asarray(M, dtype=float)) for M in F)
     q, r = F[3].shape[0], inner[3].shape[0]
+    if ldp not in ("central", "nehari"):
+        raise ParameterError(f"ldp must be 'central' or 'nehari', got {ldp!r}")
     if norm != "inf" and dt is not None:                  # discrete H2: Y = [F R_i~]₊, the causal projection
         Y = _causal_projection(F, inner)
         return Y, _norm(_difference(inner, Y, F), "2", dt)
@@ -264,6 +273,9 @@ def least_distance(inner, F, *, norm: str = "inf", dt: float | None = None, relt
             0.0 if np.allclose(D[:q, : D.shape[1] - q], 0) else float("inf"))
         return (Y if dt is None else _bilinear(Y, False)), g
     m_all = B.shape[1]
+    if norm == "inf" and ldp == "nehari":
+        Y, g = two_block_distance(inner, F, reltol=reltol)
+        return (Y if dt is None else _bilinear(Y, False)), float(g)
     try:
         if norm == "inf":
             # P₂₂ = 0: the loop closed by K is the series connection (K + Y₀) R_i − F
@@ -363,7 +375,7 @@ def _low_pass(F, a: float):
 def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[str] | None = None, selection=None,
            nullspace: bool = True, regmin: bool = True, poles: Sequence[complex] | None = None,
            sdeg: float | None = None, smarg: float | None = None,
-           normalize: str = "infnorm", reltol: float = 1e-4,
+           normalize: str = "infnorm", reltol: float = 1e-4, ldp: str = "central",
            tol: float = 1e-7) -> ApproximateMatchingDesign | ModelMatchingBankDesign:
     """Approximate model matching in the H∞ or H2 norm (Procedure AMMS).
 
@@ -394,6 +406,9 @@ def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[s
         (``normalize`` default ``'infnorm'``, the reference's).
     reltol : float, default 1e-4
         Relative accuracy of the H∞ γ-iteration.
+    ldp : {'central', 'nehari'}, default 'central'
+        The H∞ least-distance solver (:func:`least_distance`): ``'nehari'`` is the reference's route, which returns
+        the reference's filter where the optimal one is not unique (Example 5.6c).
     tol : float, default 1e-7
         Rank and zero decisions.
 
@@ -431,8 +446,7 @@ def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[s
     if isinstance(reference, (list, tuple)):
         return reference_bank(model, reference, names, lambda r, nm: ammsyn(
             model, r, norm=norm, names=nm, selection=selection, nullspace=nullspace, regmin=regmin, poles=poles,
-            sdeg=sdeg, smarg=smarg,
-            normalize=normalize, reltol=reltol, tol=tol))
+            sdeg=sdeg, smarg=smarg, normalize=normalize, reltol=reltol, ldp=ldp, tol=tol))
     ref = reference_model(model, reference, names)
     groups = tuple(g for g in ("u", "d") if len(ref.inputs[g])) + ("f",)
     plant = _matching_model(model, groups)
@@ -457,7 +471,7 @@ def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[s
         if np.abs(unmatched).max(initial=0.0) > tol * max(1.0, np.abs(F[3]).max(initial=0.0)):
             M0 = (np.array([-s0]), np.array([1.0, -s0]))
             F = _low_pass(F, -s0)
-    Y, g0 = least_distance(inner, F, norm=which, dt=model.dt, reltol=reltol)
+    Y, g0 = least_distance(inner, F, norm=which, dt=model.dt, reltol=reltol, ldp=ldp)
     q = ref.p
     if not steps:               # standard: Q = Y R_o⁻¹ Q₁, proper and stable, M = I
         Ao, Bo, Co, Do = g1.outer                 # R_o = (A, K R_h, C, R_h) on R's state space
@@ -476,7 +490,7 @@ def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[s
         g_opt = g0
     else:
         g_opt = least_distance(inner, _target_columns(model, target, groups), norm=which, dt=model.dt,
-                               reltol=reltol)[1]
+                               reltol=reltol, ldp=ldp)[1]
     # achieved: ‖M₁ (Y R_i − F)‖ (F with M₀), since Q [Gf Gw; 0] = M₁ Y R_i exactly (by construction, or emmsyn's
     # check); evaluated on that small stable realisation, not on the internal form, whose plant modes cancel only
     # to rounding (a minimal realisation of it found a peak of 42 instead of 1.00002 on the PATH model)

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fdikit.design.nullspace.factorization import coouter_coinner, realization
+from fdikit.design.nullspace.factorization import boundary_zeros, coouter_coinner, realization
 from fdikit.errors import DesignError, ParameterError
 
 __all__ = ["ZeroStep", "remove_boundary_zeros", "zero_steps_inverse"]
@@ -195,13 +195,9 @@ def _boundary_zero(A, B, C, D, dt, tol):
     """A zero ``λ₀`` of ``G`` on the boundary (real ones first; complex with ``Im λ₀ > 0``), the rotation ``W`` that
     puts its left null vector on the last row (or, complex and not real up to a phase, on the last two rows), and
     the null vector's coefficients ``γ`` on those two rows (None otherwise); ``(None, None, None)`` if none."""
-    import control
-
     n = A.shape[0]
-    zs = np.asarray(control.ss(A, B, C, D, 0 if dt is None else dt).zeros(), complex) if n else np.zeros(0, complex)
-    zs = zs[np.isfinite(zs)]
-    near = np.abs(zs.real) if dt is None else np.abs(np.abs(zs) - 1.0)
-    upper = zs[(near <= tol * np.maximum(1.0, np.abs(zs))) & (zs.imag > tol * np.maximum(1.0, np.abs(zs)))]
+    zs = boundary_zeros(A, B, C, D, dt, tol=tol)
+    upper = zs[zs.imag > tol * np.maximum(1.0, np.abs(zs))]
     cands = [complex(x) for x in ([0.0] if dt is None else [1.0, -1.0])]
     cands += [complex(1j * x.imag) if dt is None else complex(x / abs(x)) for x in upper]
     for lam in cands:
