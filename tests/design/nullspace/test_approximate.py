@@ -8,7 +8,7 @@ from varga_examples import high_pass, low_pass, random_plant
 from fdikit.analysis.channels import hinf_norm, minimal_channel
 from fdikit.analysis.performance import fdif2ngap
 from fdikit.design.nullspace.approximate import afdisyn, afdsyn
-from fdikit.errors import DesignError
+from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 
 
@@ -169,3 +169,60 @@ def test_two_residuals_non_standard_quasi_gap_by_hand():
     mr = FaultModel(np.diag([-2.0, -3.0]), U @ np.diag([1.0, -3.0]), Bf=np.zeros((2, 1)), Df=U @ [[1.0], [1.0]],
                     Bw=np.eye(2), Dw=U @ np.diag([0.0, 1.0]), faults=["f"])
     assert afdsyn(mr, rdim=2, sdeg=-3.0).gap == pytest.approx(np.sqrt(2.0), rel=1e-8)
+
+
+def _three_sensors():
+    """x' = diag(−1, −2, −3) x + 1·u + [f0; f1; w0], y = x + diag noise: two basis rows decouple u and f1."""
+    return FaultModel(np.diag([-1.0, -2.0, -3.0]), np.eye(3), Bu=[[1.0], [1.0], [1.0]],
+                      Bf=[[1.0, 0], [0, 1.0], [0, 0]], Bw=[[0.0, 0], [0.0, 0], [1.0, 0]],
+                      Dw=[[0.1, 0], [0, 0.2], [0, 0.1]])
+
+
+@pytest.mark.parametrize("minimal", [True, False])
+def test_gap_selection_reaches_the_dc_optimum_over_the_nullspace(minimal):
+    import scipy.linalg as sla
+
+    m = _three_sensors()
+    kw = dict(targets="f0", nuisance="f1", sdeg=-3.0, fdfreq=0.0, minimal=minimal, rdim=1)
+    d = afdsyn(m, selection="gap", **kw)
+    # independent: at DC the rows span the left nullspace N of [Gu(0) Gf1(0); I 0] (scipy), and one residual's noise
+    # factor is a scalar, so the best gap is max over v ∈ N of |v [Gf0; 0]| / ‖v [Gw; 0]‖ (a Rayleigh quotient)
+    G0 = m.C @ np.linalg.solve(-m.A, m.B) + m.D                   # columns u, f0, f1, w0, w1
+    Ge = np.vstack([G0, np.hstack([np.eye(1), np.zeros((1, 4))])])
+    N = sla.null_space(Ge[:, [0, 2]].T).T                           # 2 × 4
+    a, W = N @ Ge[:, 1], N @ Ge[:, 3:]
+    best = np.sqrt(sla.eigh(np.outer(a, a), W @ W.T, eigvals_only=True)[-1])
+    assert d.gap == pytest.approx(best, rel=1e-8)
+    assert d.order == 1 and len(d.basis.rows) == 2
+    # every other combination of the two rows does worse (a 0.75° grid), the least-order default by far
+    grid = []
+    for th in np.linspace(0, np.pi, 240, endpoint=False):
+        try:
+            grid.append(afdsyn(m, selection=[[np.cos(th), np.sin(th)]], **kw).gap)
+        except DesignError:       # a combination that loses f0 at DC
+            pass
+    assert len(grid) > 230 and max(grid) <= d.gap * (1 + 1e-9)
+    assert afdsyn(m, **kw).gap < 1e-2 * d.gap
+    assert _decoupled(d) < 1e-9
+
+
+def test_gap_selection_at_a_frequency_and_its_refusals():
+    m = _three_sensors()
+    kw = dict(targets="f0", nuisance="f1", sdeg=-3.0, minimal=True, rdim=1)
+    d = afdsyn(m, selection="gap", fdfreq=1.5, **kw)
+    # the optimum at ω = 1.5 over real h: no angle of the two rows beats it
+    for th in np.linspace(0, np.pi, 60, endpoint=False):
+        try:
+            assert afdsyn(m, selection=[[np.cos(th), np.sin(th)]], fdfreq=1.5, **kw).gap <= d.gap * (1 + 1e-9)
+        except DesignError:
+            pass
+    with pytest.raises(ParameterError, match="one frequency"):
+        afdsyn(m, selection="gap", fdfreq=[0.0, 1.0], **kw)
+    with pytest.raises(ParameterError, match="free faults \\['f1'\\]"):
+        afdsyn(m, selection="gap", targets="f0", fdfreq=0.0, rdim=1)
+    with pytest.raises(ParameterError, match="selection"):
+        afdsyn(m, selection="best", fdfreq=0.0, **kw)
+    # one noise input: a combination of the two rows cancels it at DC, the gap is unbounded there
+    m1 = FaultModel(m.A, m.C, Bu=m.b("u"), Bf=m.b("f"), Bw=[[0.0], [0.0], [1.0]])
+    with pytest.raises(DesignError, match="decouples the noise"):
+        afdsyn(m1, selection="gap", fdfreq=0.0, **kw)

@@ -137,6 +137,38 @@ def test_noise_selection_does_not_lose_fault_to_noise_ratio(banks):
     assert max(gains) > 10.0   # the generic combination is far from the best on some rows
 
 
+def test_gap_selection_is_the_dc_gap_optimum_at_realistic_noise(banks):
+    # afdsyn(selection="gap") on each residual's design model with the sensor noise as w: its DC gap (DC gain over
+    # the noise density at DC: the efficiency of a sequential test on the whitened residual) bounds that of every
+    # exact residual from the same nullspace, the noise-weighted one of the bank included (its DC row is a
+    # combination of the same basis rows at DC)
+    from fdikit import FaultModel
+    from fdikit.design.nullspace import afdsyn
+
+    sigma = {o: NOISE_STD[o] for o in MODELS[0].outputs}
+    ratios = []
+    for name in FILTER_GROUPS:
+        m, faults = group_model(MODELS, name)
+        sig = np.array([sigma[o] for o in m.outputs])
+        mw = FaultModel(m.A, m.C, Bu=m.b("u"), Du=m.d("u"), Bf=m.b("f"), Df=m.d("f"), Bw=np.zeros((m.n, len(sig))),
+                        Dw=np.diag(sig), states=m.states, outputs=m.outputs, controls=m.controls, faults=m.faults)
+        for f in faults:
+            d = afdsyn(mw, targets=f, nuisance=[g for g in faults if g != f], selection="gap", rdim=1,
+                       minimal=False, fdfreq=0.0, fdgaintol=FDGAINTOL, poles=[-3.0] * 12)
+            form = d.internal_form()
+            rf = tf(form.A, form.b("f"), form.C, form.d("f"), 0.0)[0, form.faults.index(f)]
+            rw = tf(form.A, form.b("w"), form.C, form.d("w"), 0.0)[0]
+            assert d.gap == pytest.approx(abs(rf) / np.linalg.norm(rw), rel=1e-6)   # the noise is flat: γ = |R_w(0)|
+            gen = banks["noise"].generator
+            row = rows_of(gen, name, [f])
+            _, Rf, _ = filter_times_plant(gen, m, row, 0.0, [f])
+            Qy = tf(gen.A, gen.B, gen.C[row], gen.D[row], 0.0)[:, len(gen.controls):]
+            exact = abs(Rf[0, 0]) / np.linalg.norm(Qy[0] * sig)
+            assert d.gap >= exact * (1 - 1e-6)
+            ratios.append(d.gap / exact)
+    assert len(ratios) == 16
+
+
 def test_missing_nominal_size_is_a_parameter_error():
     nominal = nominal_fault_sizes()
     del nominal["brake_actuator"]

@@ -42,7 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fdikit.design.nullspace.basis import NullspaceBasis, denominator, left_nullspace, minimal_realization, realize_rows
-from fdikit.design.nullspace.detectability import row_structure
+from fdikit.design.nullspace.detectability import fault_response, frequency_points, row_structure
 from fdikit.design.nullspace.exact import bank_rows, efdsyn, split_faults
 from fdikit.design.nullspace.noise_factors import NONSTD_OPTIONS, attenuate_noise
 from fdikit.errors import DesignError, FdiWarning, ParameterError
@@ -190,6 +190,40 @@ def _select(model, basis, targets, q, minimal, poles, sdeg, fdtol, fdfreq, fdgai
                       f"rank {q}; lower rdim or check fdigenspec")
 
 
+def _gap_selection(model, basis, target, minimal, poles, sdeg, fdfreq) -> np.ndarray:
+    """The combination ``h`` of all basis rows with the largest gap of one residual for one target at one frequency.
+
+    For one residual the noise factor and the stabilisation are scalar factors, so the final gap at ``λ₀`` is
+    ``|h a| / ‖h W‖`` with ``a = R_f(λ₀) e_j`` and ``W = R_w(λ₀)`` of the rows as they are realised; over real ``h``
+    that is the generalised Rayleigh quotient of ``(Re a a^H, Re W W^H)``, maximised by its top eigenvector.
+    Written here: no library solves this quotient for a rank-2 numerator with real ``h``.
+    """
+    lam = frequency_points(fdfreq, model.dt)
+    if lam.size != 1:
+        raise ParameterError(f"selection='gap' optimises the gap at one frequency: give one fdfreq, got {fdfreq}")
+    k = len(basis.rows)
+    if minimal:
+        rows = basis.combined(np.eye(k), range(k))
+        dens = [denominator(max(basis.degrees), poles, sdeg, model.dt)] * k
+    else:
+        rows, dens = basis.rows, [denominator(nu, poles, sdeg, model.dt) for nu in basis.degrees]
+    form = _gen(*realize_rows(rows, dens, basis.scale), model, tuple(f"r{i}" for i in range(k))).internal_form(model)
+    cols = FaultModel(form.A, form.C, Bf=np.hstack([form.b("f")[:, [form.faults.index(target)]], form.b("w")]),
+                      Df=np.hstack([form.d("f")[:, [form.faults.index(target)]], form.d("w")]), dt=model.dt)
+    G = fault_response(cols, cols.faults, complex(lam[0]))
+    a, W = G[:, 0], G[:, 1:]
+    # Re(W W^H) = X Xᵀ, X = [Re W  Im W]; with X = U S Vᵀ and h = g S⁻¹ Uᵀ the quotient is ‖g Y‖²/‖g‖², Y = S⁻¹ Uᵀ
+    # [Re a  Im a] (an SVD, not a Cholesky of X Xᵀ: the PATH sensors' noise levels are 5 decades apart)
+    U, sv, _ = np.linalg.svd(np.hstack([W.real, W.imag]), full_matrices=False)
+    if sv.size < k or sv[-1] <= 1e-9 * sv[0]:
+        raise DesignError(f"a combination of the {k} basis rows decouples the noise at fdfreq={fdfreq}: the gap is "
+                          "unbounded there; use rdim to add the noise-free residuals, or give a selection")
+    T = U.T / sv[:, None]
+    g = np.linalg.svd(T @ np.column_stack([a.real, a.imag]))[0][:, 0]
+    h = g @ T
+    return (h / np.linalg.norm(h))[None, :]
+
+
 def _gen(A, B, C, D, model, names) -> ResidualGenerator:
     A, B, C, D = minimal_realization(A, B, C, D)
     return ResidualGenerator(A, B, C, D, controls=model.controls, outputs=model.outputs, residuals=names,
@@ -261,9 +295,12 @@ def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
         part at least ``smarg`` are moved too (by default only those on the boundary and at infinity).
     exact : bool, default False
         Solve the exact problem instead (``efdsyn`` ignoring the noise); the gap is still reported.
-    selection : array_like, optional
+    selection : array_like or "gap", optional
         ``(q_1, k)`` combination of all ``k`` basis rows for the noise-attenuating residuals (reference
-        ``HDesign``, in fdikit's basis coordinates); default the least-order search.
+        ``HDesign``, in fdikit's basis coordinates); default the least-order search.  ``"gap"`` (not in the
+        reference): for one residual and one target, the combination of all rows with the largest gap at the one
+        frequency ``fdfreq`` — the noise factor of one residual is a scalar, so the gap there is
+        ``|h a| / ‖h W‖`` (``a``, ``W``: the rows' fault and noise responses), a generalised Rayleigh quotient.
     fdtol, fdgaintol, fdfreq, tol, names, isolates
         As :func:`~fdikit.design.nullspace.exact.efdsyn`; ``fdfreq`` also sets the frequencies of ``β``.
 
@@ -342,6 +379,14 @@ def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
         if q > k:
             raise DesignError(f"rdim={q}: the nullspace basis has {k} rows, so 1 ≤ rdim ≤ {k}")
         q1, q2 = min(q, rw), q - min(q, rw)
+    if isinstance(selection, str):
+        validate.choice("selection", selection, ("gap",))
+        free = [f for f in model.faults if f not in targets and f not in nuisance]
+        if q1 != 1 or len(targets) != 1 or free:
+            raise ParameterError(f"selection='gap' designs one noise-attenuating residual for one target with every "
+                                 f"other fault decoupled; got {q1} residual(s), targets {list(targets)} and free "
+                                 f"faults {free}: give one target, the others as nuisance, and rdim=1")
+        selection = _gap_selection(model, basis, targets[0], minimal, poles, sdeg, fdfreq)
     used, H, (A, B, C, D) = _select(model, basis, targets, q1, minimal, poles, sdeg, fdtol, fdfreq, fdgaintol, Nw,
                                     wscale, selection)
     g1, _ = stabilize_rows(_gen(A, B, C, D, model, tuple(f"r{i}" for i in range(q1))), model, nuisance=nuisance,
