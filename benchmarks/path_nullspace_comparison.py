@@ -10,7 +10,8 @@ bank names.
 
 Banks: ``beard-jones`` (:func:`~fdikit.studies.path1996.bank.path_bank`), ``nullspace`` (``efdisyn`` with the
 generic combination, :func:`~fdikit.studies.path1996.nullspace_bank.path_nullspace_bank`), ``nullspace-noise``
-(the same rows combined for the best DC fault-to-noise ratio), optionally ``game`` and ``kalman``.
+(the same rows combined for the best DC fault-to-noise ratio), ``nullspace-gap`` (``afdsyn(selection="gap")`` per
+residual: all basis rows combined for the best DC gap, the noise whitened), optionally ``game`` and ``kalman``.
 
 Also per bank: filter orders; the fault-to-noise gap ``fdif2ngap`` at ω = 0 of each (filter, fault) residual
 group on the discrete linear group model (faults in nominal sizes, noise inputs ``diag(NOISE_STD)``; β = 1 for a
@@ -39,7 +40,7 @@ ROADS = ("smooth", "rough")
 ONSET = 2.0
 #: Sample time of the sensors and the generators [s] (the evaluation's).
 DT = 0.01
-BANK_NAMES = ("beard-jones", "nullspace", "nullspace-noise", "game", "kalman")
+BANK_NAMES = ("beard-jones", "nullspace", "nullspace-noise", "nullspace-gap", "game", "kalman")
 
 
 def make_setup(banks):
@@ -52,6 +53,7 @@ def make_setup(banks):
     all_banks = dict(s.banks)
     all_banks["nullspace"] = path_nullspace_bank(pair, s.nominal)
     all_banks["nullspace-noise"] = path_nullspace_bank(pair, s.nominal, noise_std=NOISE_STD, dt=DT)
+    all_banks["nullspace-gap"] = path_nullspace_bank(pair, s.nominal, noise_std=NOISE_STD, dt=DT, criterion="gap")
     chosen = {b: all_banks[b] for b in banks}
     gens = {b: (g.generator if g.generator.dt else g.generator.discretize(DT)) for b, g in chosen.items()}
     return EvaluationSetup(s.car, s.operating_point, s.models, s.nominal, chosen, gens, default=banks[0])

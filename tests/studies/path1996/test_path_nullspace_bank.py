@@ -27,7 +27,8 @@ POINTS = (0.0, 0.37 + 1.1j, 2.3j, -0.2 + 0.05j)
 def banks():
     nominal = nominal_fault_sizes()
     return {"generic": path_nullspace_bank(MODELS, nominal),
-            "noise": path_nullspace_bank(MODELS, nominal, noise_std=NOISE_STD, dt=0.01)}
+            "noise": path_nullspace_bank(MODELS, nominal, noise_std=NOISE_STD, dt=0.01),
+            "gap": path_nullspace_bank(MODELS, nominal, noise_std=NOISE_STD, dt=0.01, criterion="gap")}
 
 
 def rows_of(gen, name, faults):
@@ -52,7 +53,7 @@ def filter_times_plant(gen, model, rows, lam, faults):
     return Ru, (Q[:, mu:] @ Gf)[:, [model.faults.index(f) for f in faults]], scale
 
 
-@pytest.mark.parametrize("kind", ["generic", "noise"])
+@pytest.mark.parametrize("kind", ["generic", "noise", "gap"])
 @pytest.mark.parametrize("name", list(FILTER_GROUPS))
 def test_structure_is_the_identity_on_each_group(banks, kind, name):
     bank = banks[kind]
@@ -66,14 +67,19 @@ def test_structure_is_the_identity_on_each_group(banks, kind, name):
     nom = np.array([bank.nominal[f] for f in form.faults])
     scaled = form.replace(Bf=form.Bf * nom, Df=form.Df * nom)
     # an explicit threshold: the default is relative to the whole stacked form's ‖B_f‖₁, which the engine-speed
-    # row's large gain dominates; in nominal units the decoupled channels are ~1e-14, the detected ones ≥ 1e-2
-    assert (fditspec(scaled, tol=1e-8).matrix == want).all()
+    # row's large gain dominates; in nominal units the decoupled channels are ~1e-14, the detected ones ≥ 1e-2.
+    # The gap rows (nine basis rows combined, then the noise factor) keep states that the decoupled channels do not
+    # see but that fditspec's realisation test, at any tolerance 1e-8 … 1e-4, cannot tell from coupling (their
+    # responses at 0, j and 10j are below 1e-10 of a nominal fault): their zeros are checked as responses by
+    # test_controls_and_group_faults_are_decoupled, and here at DC by the strong structure
+    if kind != "gap":
+        assert (fditspec(scaled, tol=1e-8).matrix == want).all()
     strong = fdisspec(scaled, 0.0, gain_tol=0.01)                                           # 1 % of a nominal bias
     assert (strong.matrix == want).all()
     assert (bank.designs[name].specification == np.eye(4, dtype=bool)).all()
 
 
-@pytest.mark.parametrize("kind", ["generic", "noise"])
+@pytest.mark.parametrize("kind", ["generic", "noise", "gap"])
 @pytest.mark.parametrize("name", list(FILTER_GROUPS))
 def test_controls_and_group_faults_are_decoupled(banks, kind, name):
     bank = banks[kind]
@@ -98,7 +104,10 @@ def test_orders_are_the_least_orders_of_fdichkspec(banks, name):
     assert chk.feasible.all()
     for kind in banks:
         d = banks[kind].designs[name]
-        assert d.orders == tuple(chk.leastorders.tolist())
+        if kind == "gap":   # all rows combined and whitened: not least order, never below it
+            assert all(o >= lo for o, lo in zip(d.orders, chk.leastorders.tolist()))
+        else:
+            assert d.orders == tuple(chk.leastorders.tolist())
         assert d.generator.n == sum(d.orders)
     # the Beard–Jones filters of the report have orders 12, 12, 12, 14; the exact rows need far fewer states
     assert sum(chk.leastorders) <= 6
@@ -159,6 +168,10 @@ def test_gap_selection_is_the_dc_gap_optimum_at_realistic_noise(banks):
             rf = tf(form.A, form.b("f"), form.C, form.d("f"), 0.0)[0, form.faults.index(f)]
             rw = tf(form.A, form.b("w"), form.C, form.d("w"), 0.0)[0]
             assert d.gap == pytest.approx(abs(rf) / np.linalg.norm(rw), rel=1e-6)   # the noise is flat: γ = |R_w(0)|
+            # the controls stay decoupled through the minimal realisation of the nine combined rows (TB01PD at 1e-7
+            # once returned a filter off by 4e-4 here, the controls at 4.6e-3 on accel_y)
+            Ru, _, scale = filter_times_plant(d.generator, m, [0], 0.37 + 1.1j, [f])
+            assert np.abs(Ru).max() < 1e-9 * scale[0]
             gen = banks["noise"].generator
             row = rows_of(gen, name, [f])
             _, Rf, _ = filter_times_plant(gen, m, row, 0.0, [f])

@@ -28,7 +28,9 @@ Choices where the method leaves freedom (fdikit's, not the report's):
   ``efdsyn``'s fixed generic combination; ``"noise"`` (when ``noise_std`` is given) maximises the ratio of the
   target's squared DC gain to the residual's stationary variance under white sensor noise of ``noise_std`` per
   sample at ``dt`` — ``h ∝ Σ⁻¹ g`` over the same rows, still exact decoupling (a Rayleigh quotient, not the
-  approximate synthesis of §5.3).
+  approximate synthesis of §5.3).  With ``criterion="gap"`` each residual is instead the approximate synthesis
+  (Varga 2017, §5.3) over all basis rows, combined for the largest DC gap (``afdsyn(selection="gap")``) and
+  whitened: the best DC gain over the noise density at DC, where ``"noise"`` maximises it over the total std.
 
 References
 ----------
@@ -104,6 +106,13 @@ def _dc(form: FaultModel) -> np.ndarray:
     return (form.C @ np.linalg.solve(-form.A, form.Bf) + form.Df) if form.n else form.Df
 
 
+def _with_noise(model: FaultModel, sigma: np.ndarray) -> FaultModel:
+    """``model`` with white sensor noise ``w`` of levels ``sigma`` on its outputs (``B_w = 0``, ``D_w = diag(σ)``)."""
+    return FaultModel(model.A, model.C, Bu=model.b("u"), Du=model.d("u"), Bf=model.b("f"), Df=model.d("f"),
+                      Bw=np.zeros((model.n, len(sigma))), Dw=np.diag(sigma), states=model.states,
+                      outputs=model.outputs, controls=model.controls, faults=model.faults)
+
+
 def _noise_selection(model: FaultModel, fault: str, nuisance, sigma: np.ndarray, dt: float, kw: dict) -> np.ndarray:
     """``h ∝ Σ⁻¹ g`` over the least-degree rows: the best DC fault-to-noise ratio of one exact residual."""
     from scipy.linalg import solve_discrete_lyapunov
@@ -127,7 +136,7 @@ def _noise_selection(model: FaultModel, fault: str, nuisance, sigma: np.ndarray,
 
 def path_nullspace_bank(models: tuple[FaultModel, FaultModel], nominal: Mapping[str, float], *,
                         noise_std: Mapping[str, float] | None = None, dt: float = 0.01, poles=POLES,
-                        fdgaintol: float = FDGAINTOL):
+                        fdgaintol: float = FDGAINTOL, criterion: str = "variance"):
     """Design the exact nullspace PATH bank: per group, one residual per fault decoupling the group's others.
 
     Parameters
@@ -145,6 +154,11 @@ def path_nullspace_bank(models: tuple[FaultModel, FaultModel], nominal: Mapping[
         Filter poles (the first ``d`` for order ``d``).
     fdgaintol : float, default :data:`FDGAINTOL`
         Strong-detectability gain threshold at ω = 0.
+    criterion : {"variance", "gap"}, default "variance"
+        With ``noise_std``: ``"variance"`` combines the least-degree rows for the best DC gain over the stationary
+        residual std at ``dt`` (module docstring); ``"gap"`` designs each residual by ``afdsyn(selection="gap")``
+        on the group model with the noise as ``w`` (``D_w = diag(σ)``): all basis rows combined for the largest
+        DC gap, the noise part then whitened (co-inner), exact decoupling still.
 
     Returns
     -------
@@ -174,7 +188,7 @@ def path_nullspace_bank(models: tuple[FaultModel, FaultModel], nominal: Mapping[
     ('filter1:engine_speed_sensor[0]', 16)
     """
     from fdikit import validate
-    from fdikit.design.nullspace import efdisyn, efdsyn
+    from fdikit.design.nullspace import afdsyn, efdisyn, efdsyn
     from fdikit.design.nullspace.exact import NullspaceBankDesign
     from fdikit.errors import DesignError, ParameterError
     from fdikit.residuals import stack_generators
@@ -186,6 +200,7 @@ def path_nullspace_bank(models: tuple[FaultModel, FaultModel], nominal: Mapping[
     if missing:
         raise ParameterError(f"nominal: no size for {missing}; give all 15 fault sizes")
     fdgaintol = validate.positive("fdgaintol", fdgaintol)
+    criterion = validate.choice("criterion", criterion, ("variance", "gap"))
     sigma = None
     if noise_std is not None:
         dt = validate.positive("dt", dt)
@@ -206,10 +221,14 @@ def path_nullspace_bank(models: tuple[FaultModel, FaultModel], nominal: Mapping[
                 filters = []
                 for i, f in enumerate(faults):
                     nz = tuple(g for g in faults if g != f)
-                    H = _noise_selection(model, f, nz, sigma[iy], dt, kw)
-                    # the optimum nearly cancels the rows' generic-point responses, so efdsyn's weak test
-                    # (relative to the coefficient norm) is relaxed; the unit DC gain is checked at fdgaintol
-                    d = efdsyn(model, targets=f, nuisance=nz, selection=H, fdtol=1e-12, **kw)
+                    if criterion == "gap":
+                        d = afdsyn(_with_noise(model, sigma[iy]), targets=f, nuisance=nz, selection="gap",
+                                   rdim=1, minimal=True, fdtol=1e-12, **kw)
+                    else:
+                        H = _noise_selection(model, f, nz, sigma[iy], dt, kw)
+                        # the optimum nearly cancels the rows' generic-point responses, so efdsyn's weak test
+                        # (relative to the coefficient norm) is relaxed; the unit DC gain is checked at fdgaintol
+                        d = efdsyn(model, targets=f, nuisance=nz, selection=H, fdtol=1e-12, **kw)
                     filters.append(dataclasses.replace(d, generator=dataclasses.replace(
                         d.generator, residuals=(f"r{i}",), isolates=(f,))))
                 bank = NullspaceBankDesign(stack_generators([d.generator for d in filters]), tuple(filters), S,
