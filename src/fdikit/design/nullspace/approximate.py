@@ -404,6 +404,10 @@ def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
                                  f"other fault decoupled; got {q1} residual(s), targets {list(targets)} and free "
                                  f"faults {free}: give one target, the others as nuisance, and rdim=1")
         selection = _gap_selection(model, basis, targets[0], minimal, poles, sdeg, fdfreq)
+        # the optimum nearly cancels the noise away from fdfreq (PATH's wheel speeds: |h N_w| = 1e-7 against rows of
+        # 2e-4 … 2e-3 at the test frequency): its rank is judged relative to the rows' own noise there, not in the
+        # model's units (it is not decoupled at fdfreq, to 1e-9, by the selection's own test)
+        wscale = float(np.linalg.norm(Nw, 2))
     used, H, (A, B, C, D) = _select(model, basis, targets, q1, minimal, poles, sdeg, fdtol, fdfreq, fdgaintol, Nw,
                                     wscale, selection)
     g1, _ = stabilize_rows(_gen(A, B, C, D, model, tuple(f"r{i}" for i in range(q1))), model, nuisance=nuisance,

@@ -25,7 +25,9 @@ Design kinds: ``beard-jones`` (the four-filter bank, :func:`~fdikit.studies.path
 designed for the plant's noise), ``game`` (the game-theoretic bank,
 :func:`~fdikit.studies.path1996.game_bank.path_game_bank`, weights in ``params``: ``gamma``, ``M``, ``Q``),
 ``nullspace`` (the exact ``efdisyn`` bank, :func:`~fdikit.studies.path1996.nullspace_bank.path_nullspace_bank`; with
-``noise_weighted`` (default true) its basis rows are combined for the plant's noise).
+``noise_weighted`` (default true) its basis rows are combined for the plant's noise, by ``criterion``:
+``variance`` (default, the DC gain over the stationary std) or ``gap`` (``afdsyn(selection="gap")``: the DC gap,
+the noise whitened)).
 Evaluators: every kind of :mod:`fdikit.campaign.evaluation` but ``mhsprt-whitened`` (fitted on runs with the
 fault from 2 s, the nonlinear study's); ``glr`` … ``bnn`` are those of ``fdikit compare-evaluators``
 (:mod:`fdikit.studies.path1996.compare`, Douglas et al. 1996, Ch. 6–7), fitted exactly as it fits them.
@@ -48,7 +50,7 @@ __all__ = ["PathLinearStudy", "PATH_LINEAR", "DESIGN_KINDS", "FAULT_KINDS", "NOI
 
 #: Design kind → its parameters and defaults.
 DESIGN_KINDS = {"beard-jones": {}, "kalman": {}, "game": {"gamma": 1e-6, "M": 0.01, "Q": 1e-6},
-                "nullspace": {"noise_weighted": True}}
+                "nullspace": {"noise_weighted": True, "criterion": "variance"}}
 #: Fault kinds.
 FAULT_KINDS = ("bias", "drift")
 #: Named noise levels of the plant's ``noise`` parameter.
@@ -172,8 +174,9 @@ class PathLinearStudy:
                 elif kind == "kalman":
                     bank = path_kalman_bank(models[1], std, dt=dt)
                 elif kind == "nullspace":       # designed on the fault-free App. D models, as the study does
-                    weighted = {**DESIGN_KINDS["nullspace"], **d.params}["noise_weighted"]
-                    bank = path_nullspace_bank(plain, nominal, noise_std=std if weighted else None, dt=dt)
+                    par = {**DESIGN_KINDS["nullspace"], **d.params}
+                    bank = path_nullspace_bank(plain, nominal, noise_std=std if par["noise_weighted"] else None,
+                                               dt=dt, criterion=par["criterion"])
                 else:
                     bank = path_game_bank(models, nominal, std, dt=dt, **{**DESIGN_KINDS["game"], **d.params})
                 gen = bank.generator if bank.generator.dt == dt else bank.generator.discretize(dt)

@@ -158,7 +158,9 @@ def path_nullspace_bank(models: tuple[FaultModel, FaultModel], nominal: Mapping[
         With ``noise_std``: ``"variance"`` combines the least-degree rows for the best DC gain over the stationary
         residual std at ``dt`` (module docstring); ``"gap"`` designs each residual by ``afdsyn(selection="gap")``
         on the group model with the noise as ``w`` (``D_w = diag(σ)``): all basis rows combined for the largest
-        DC gap, the noise part then whitened (co-inner), exact decoupling still.
+        DC gap, the noise part then whitened (co-inner), exact decoupling still.  It needs noise that
+        ``afdsyn``'s rank test sees (``1e-7`` in the model's units): at the report's levels (1e-4 of a nominal
+        fault) the yaw-rate residual is refused (``DesignError``).
 
     Returns
     -------
