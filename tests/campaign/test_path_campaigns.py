@@ -181,44 +181,27 @@ def test_shipped_specs_load():
     assert len(plan_runs(nonlinear)) == 2 * (180 + 15) and nonlinear.healthy * nonlinear.duration == 3600.0
 
 
-def test_linear_campaign_runs_the_nullspace_bank():
-    # the efdisyn bank as a design kind: the set-up's generator is path_nullspace_bank's for the plant's noise
+@pytest.mark.parametrize("criterion, noise", [(None, "report"), ("gap", "realistic")])
+def test_linear_campaign_runs_the_nullspace_bank(criterion, noise):
+    # the efdisyn bank as a design kind: the set-up's generator is path_nullspace_bank's for the plant's noise.
+    # criterion 'gap' at realistic noise (at the report's 1e-4 of a nominal fault afdsyn's rank test, 1e-7 in the
+    # model's units, counts the yaw-rate row's noise as absent and the gap design is refused)
+    from fdikit.plants.path_vehicle import path_vehicle_12, path_vehicle_14
     from fdikit.studies.path1996.nullspace_bank import path_nullspace_bank
 
-    spec = load_campaign({**LINEAR, "designs": [{"name": "ns", "kind": "nullspace"}],
+    design = {"name": "ns", "kind": "nullspace", **({"params": {"criterion": criterion}} if criterion else {})}
+    spec = load_campaign({**LINEAR, "plants": [{"name": "p", "params": {"noise": noise}}], "designs": [design],
                           "evaluators": [{"name": "glr", "kind": "glr", "params": {"calibration": 60.0}}]})
     study = get_study("path-linear")
     assert study.check(spec) == []
     setup = study.setup(spec)
-    plant = setup["plants"]["report"]
+    plant = setup["plants"]["p"]
     gen, groups = plant.designs["ns"]
-    from fdikit.plants.path_vehicle import path_vehicle_12, path_vehicle_14
-
     std = dict(zip(plant.model.outputs, plant.noise))
     ref = path_nullspace_bank((path_vehicle_12("midpoint"), path_vehicle_14("midpoint")), setup["nominal"],
-                              noise_std=std, dt=0.01)
+                              noise_std=std, dt=0.01, criterion=criterion or "variance")
     assert gen.residuals == ref.generator.residuals and groups == ref.groups
     np.testing.assert_allclose(gen.D, ref.generator.discretize(0.01).D, rtol=1e-12, atol=1e-12)
-    rows = study.run_chunk(setup, spec, plan_runs(spec), sweep_levels(spec.sweep))
-    assert len(rows) == 2 and all(r["design"] == "ns" for r in rows)
-
-
-def test_linear_campaign_nullspace_gap_criterion():
-    from fdikit.plants.path_vehicle import path_vehicle_12, path_vehicle_14
-    from fdikit.studies.path1996.nullspace_bank import path_nullspace_bank
-
-    # at realistic noise (at the report's 1e-4 of a nominal fault afdsyn's rank test, 1e-7 in the model's units,
-    # counts the yaw-rate row's noise as absent and the gap design is refused)
-    spec = load_campaign({**LINEAR, "plants": [{"name": "real", "params": {"noise": "realistic"}}],
-                          "designs": [{"name": "gap", "kind": "nullspace", "params": {"criterion": "gap"}}],
-                          "evaluators": [{"name": "glr", "kind": "glr", "params": {"calibration": 60.0}}]})
-    study = get_study("path-linear")
-    assert study.check(spec) == []
-    setup = study.setup(spec)
-    plant = setup["plants"]["real"]
-    gen, _ = plant.designs["gap"]
-    std = dict(zip(plant.model.outputs, plant.noise))
-    ref = path_nullspace_bank((path_vehicle_12("midpoint"), path_vehicle_14("midpoint")), setup["nominal"],
-                              noise_std=std, dt=0.01, criterion="gap")
-    assert gen.residuals == ref.generator.residuals
-    np.testing.assert_allclose(gen.D, ref.generator.discretize(0.01).D, rtol=1e-12, atol=1e-12)
+    if criterion is None:
+        rows = study.run_chunk(setup, spec, plan_runs(spec), sweep_levels(spec.sweep))
+        assert len(rows) == 2 and all(r["design"] == "ns" for r in rows)
