@@ -6,7 +6,8 @@ the Kronecker structure of their pencils.
 * :mod:`fdikit.descriptor.reduction` — removal of non-dynamic modes (``gir``-like) and minimal realisations
   (``gminreal``-like: uncontrollable/unobservable finite and infinite eigenvalues).
 * :mod:`fdikit.descriptor.staircase` — Kronecker structure of a pencil by orthogonal staircase reductions
-  (finite eigenvalues, Jordan blocks at infinity, left/right Kronecker indices, normal rank).
+  (finite eigenvalues, Jordan blocks at infinity, left/right Kronecker indices, normal rank), and the
+  controllability staircase of a pair ``(A, B)``.
 * :mod:`fdikit.descriptor.zeros` — the system pencil ``[[A − λE, B], [C, D]]``: zeros, normal rank, indices.
 """
 
@@ -17,7 +18,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
     submod_attrs={
         "model": ["DescriptorModel", "DESCRIPTOR_GROUPS"],
         "reduction": ["remove_nondynamic", "minimal_realization", "nondynamic_count"],
-        "staircase": ["KroneckerStructure", "pencil_structure", "split_infinite"],
+        "staircase": ["KroneckerStructure", "controllability_staircase", "pencil_structure", "split_infinite"],
         "zeros": ["system_pencil", "system_structure", "system_zeros", "normal_rank"],
     },
 )

@@ -19,6 +19,10 @@ finite (Smith) zeros of the system, its normal rank is the normal rank of the tr
 ``k − 1``, and its left / right Kronecker indices are the left / right minimal indices of the transfer matrix
 (SLICOT ``AG08BD`` computes the same quantities).
 
+:func:`controllability_staircase` is the same kind of reduction on a pair ``(A, B)`` with an absolute threshold
+(slycot's ``AB01ND`` decides rank relative to each block, which counts a ``B`` that is zero to rounding as full
+rank).
+
 References
 ----------
 Van Dooren (1979), "The computation of Kronecker's canonical form of a singular pencil", Linear Algebra Appl. 27.
@@ -36,7 +40,7 @@ import scipy.linalg
 from fdikit import validate
 from fdikit.errors import ParameterError
 
-__all__ = ["KroneckerStructure", "pencil_structure", "split_infinite"]
+__all__ = ["KroneckerStructure", "controllability_staircase", "pencil_structure", "split_infinite"]
 
 _EPS = float(np.finfo(float).eps)
 
@@ -257,3 +261,52 @@ def split_infinite(A, E, *, tol: float | None = None) -> tuple[np.ndarray, np.nd
         raise ParameterError("the pencil A − λE is singular (det(λE − A) ≡ 0): it has right Kronecker indices "
                              f"{_indices(s_list, r_list)[0]}")
     return Q, Z, int(sum(s_list))
+
+
+def controllability_staircase(A, B, thresh: float) -> tuple[np.ndarray, int]:
+    """Orthogonal ``Q`` and ``k`` with ``QᵀAQ = [[A11, A12], [0, A22]]``, ``QᵀB = [[B1], [0]]``, (A11, B1) controllable.
+
+    The controllability staircase: a rank decision by SVD at each step, singular values at or below the absolute
+    threshold ``thresh`` counted as zero (callers scale it to their problem).
+
+    Parameters
+    ----------
+    A : array_like
+        ``(n, n)``.
+    B : array_like
+        ``(n, m)``.
+    thresh : float
+        Absolute rank threshold.
+
+    Returns
+    -------
+    Q : numpy.ndarray
+        ``(n, n)`` orthogonal; its first ``k`` columns span the controllable subspace.
+    k : int
+        The dimension of the controllable subspace.
+
+    Examples
+    --------
+    The second state of ``diag(−1, −2)`` is not reached from ``B = [1; 0]``:
+
+    >>> Q, k = controllability_staircase(np.diag([-1.0, -2.0]), np.array([[1.0], [0.0]]), 1e-12)
+    >>> k, np.round(np.abs(Q[:, 0]), 12).tolist()
+    (1, [1.0, 0.0])
+
+    References
+    ----------
+    Van Dooren (1981); Varga (2017), §7.3 (the controllability staircase form).
+    """
+    At, block = np.array(A, dtype=float), np.array(B, dtype=float)
+    n = At.shape[0]
+    Q, k = np.eye(n), 0
+    while k < n and block.size:
+        U, s, _ = np.linalg.svd(block)
+        rank = int(np.sum(s > thresh))
+        if rank == 0:
+            break
+        T = np.eye(n)
+        T[k:, k:] = U
+        At, Q = T.T @ At @ T, Q @ T
+        block, k = At[k + rank:, k:k + rank], k + rank
+    return Q, k

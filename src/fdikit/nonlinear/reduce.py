@@ -62,30 +62,13 @@ def _z_names(r: int) -> list[str]:
 def _staircase(A: np.ndarray, B: np.ndarray, rtol: float) -> tuple[np.ndarray, int]:
     """Orthogonal ``Q`` and ``r`` with ``QᵀAQ = [[A11, A12], [0, A22]]``, ``QᵀB = [[B1], [0]]``, (A11, B1) controllable.
 
-    The controllability staircase (Van Dooren 1981): a rank decision by SVD at each step, with singular values
-    below ``rtol · max(‖A‖₂, ‖B‖₂)`` counted as zero.
+    The controllability staircase (Van Dooren 1981) with singular values below ``rtol · max(‖A‖₂, ‖B‖₂)`` counted
+    as zero.
     """
-    n = A.shape[0]
-    Q = np.eye(n)
-    scale = max(np.linalg.norm(A, 2) if n else 0.0, np.linalg.norm(B, 2) if B.size else 0.0)
-    if n == 0 or scale == 0.0:
-        return Q, 0
-    At = A.copy()
-    block = B.copy()
-    k = 0
-    while k < n and block.size:
-        U, s, _ = np.linalg.svd(block)
-        rank = int(np.sum(s > rtol * scale))
-        if rank == 0:
-            break
-        T = np.eye(n)
-        T[k:, k:] = U
-        At = T.T @ At @ T
-        Q = Q @ T
-        k_new = k + rank
-        block = At[k_new:, k:k_new]
-        k = k_new
-    return Q, k
+    from fdikit.descriptor.staircase import controllability_staircase
+
+    scale = max(np.linalg.norm(A, 2) if A.shape[0] else 0.0, np.linalg.norm(B, 2) if B.size else 0.0)
+    return controllability_staircase(A, B, rtol * scale)
 
 
 def _ordered_schur(A: np.ndarray, slow: np.ndarray, dt) -> tuple[np.ndarray, np.ndarray, int]:

@@ -53,7 +53,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
             "reference_columns", "reference_model", "updated_reference",
         ],
         "matching_basis": ["matching_rows"],
-        "nehari_ldp": ["nehari", "two_block_distance"],
+        "nehari_ldp": ["distance_error", "nehari", "two_block_distance"],
         "approximate_matching": ["ApproximateMatchingDesign", "ammsyn", "least_distance"],
         "row_factors": ["RowSpectrum", "WIENER_HOPF_JOBS", "realize_biproper", "row_spectrum", "wiener_hopf_row"],
         "exact": ["NullspaceBankDesign", "NullspaceDesign", "bank_rows", "efdisyn", "efdsyn", "split_faults"],

@@ -44,6 +44,7 @@ import numpy as np
 from fdikit.design.nullspace.basis import NullspaceBasis, denominator, left_nullspace, minimal_realization, realize_rows
 from fdikit.design.nullspace.detectability import fault_response, frequency_points, row_structure
 from fdikit.design.nullspace.exact import bank_rows, efdsyn, split_faults
+from fdikit.design.nullspace.factorization import transfer
 from fdikit.design.nullspace.noise_factors import NONSTD_OPTIONS, attenuate_noise
 from fdikit.errors import DesignError, FdiWarning, ParameterError
 from fdikit.model import FaultModel
@@ -241,8 +242,8 @@ def _same_response(full, red, dt) -> bool:
     """Whether ``red`` has the response of ``full`` to 1e-9 (relative) at two points of the boundary (both stable)."""
     for w in (0.7, 3.1):
         lam = 1j * w if dt is None else np.exp(1j * w * min(dt, 1.0))
-        g = [D + (C @ np.linalg.solve(lam * np.eye(A.shape[0]) - A, B) if A.size else 0) for A, B, C, D in (full, red)]
-        if np.linalg.norm(g[0] - g[1]) > 1e-9 * max(np.linalg.norm(g[0]), 1e-300):
+        g0, g1 = transfer(full, lam), transfer(red, lam)
+        if np.linalg.norm(g0 - g1) > 1e-9 * max(np.linalg.norm(g0), 1e-300):
             return False
     return True
 

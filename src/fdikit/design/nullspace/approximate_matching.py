@@ -64,7 +64,7 @@ from fdikit.design.nullspace.model_matching import (
     reference_model,
     updated_reference,
 )
-from fdikit.design.nullspace.nehari_ldp import two_block_distance
+from fdikit.design.nullspace.nehari_ldp import distance_error, two_block_distance
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import FieldReport
@@ -260,7 +260,7 @@ def least_distance(inner, F, *, norm: str = "inf", dt: float | None = None, relt
         raise ParameterError(f"ldp must be 'central' or 'nehari', got {ldp!r}")
     if norm != "inf" and dt is not None:                  # discrete H2: Y = [F R_i~]₊, the causal projection
         Y = _causal_projection(F, inner)
-        return Y, _norm(_difference(inner, Y, F), "2", dt)
+        return Y, _norm(distance_error(inner, Y, F), "2", dt)
     Y0 = F[3] @ inner[3].T if dt is None else None
     if dt is not None:
         inner, F = _bilinear(inner, True), _bilinear(F, True)
@@ -280,7 +280,7 @@ def least_distance(inner, F, *, norm: str = "inf", dt: float | None = None, relt
         if norm == "inf":
             # P₂₂ = 0: the loop closed by K is the series connection (K + Y₀) R_i − F
             g, (Ak, Bk, Ck, Dk) = _hinf_bisection(
-                (A, B, C, D), q, r, _norm(F), lambda K: _norm(_difference(inner, (*K[:3], K[3] + Y0), F)), reltol)
+                (A, B, C, D), q, r, _norm(F), lambda K: _norm(distance_error(inner, (*K[:3], K[3] + Y0), F)), reltol)
         else:
             if np.abs(D[:q, : m_all - q]).max(initial=0.0) > 1e-10 * max(1.0, np.abs(F[3]).max(initial=0.0)):
                 raise DesignError("the H2 distance is infinite: F is not matched at infinity; multiply it by a "
@@ -290,7 +290,7 @@ def least_distance(inner, F, *, norm: str = "inf", dt: float | None = None, relt
         raise DesignError(f"SLICOT could not solve the least-distance problem: {err}") from err
     Y = (Ak, Bk, Ck, Dk + Y0)
     if norm != "inf":
-        g = _norm(_difference(inner, Y, F), "2")
+        g = _norm(distance_error(inner, Y, F), "2")
     return (Y if dt is None else _bilinear(Y, False)), float(g)
 
 
@@ -344,16 +344,6 @@ def _fw_model(sys, model: FaultModel, names) -> FaultModel:
     nf = len(model.faults)
     return FaultModel(A, C, Bf=B[:, :nf], Df=D[:, :nf], Bw=B[:, nf:], Dw=D[:, nf:], faults=model.faults,
                       noise=model.noise, outputs=names, dt=model.dt)
-
-
-def _difference(inner, Y, F):
-    """``Y R_i − F`` as one stable realisation (states of ``R_i``, ``Y``, ``F``)."""
-    import scipy.linalg
-
-    from fdikit.design.nullspace.factorization import series
-
-    A1, B1, C1, D1 = series(inner, Y)
-    return scipy.linalg.block_diag(A1, F[0]), np.vstack([B1, F[1]]), np.hstack([C1, -F[2]]), D1 - F[3]
 
 
 def _norm(sys, which: str = "inf", dt: float | None = None) -> float:
@@ -494,7 +484,7 @@ def ammsyn(model: FaultModel, reference, *, norm: str = "inf", names: Sequence[s
     # achieved: ‖M₁ (Y R_i − F)‖ (F with M₀), since Q [Gf Gw; 0] = M₁ Y R_i exactly (by construction, or emmsyn's
     # check); evaluated on that small stable realisation, not on the internal form, whose plant modes cancel only
     # to rounding (a minimal realisation of it found a peak of 42 instead of 1.00002 on the PATH model)
-    E = _fw_model(_difference(inner, Y, F), plant, names)
+    E = _fw_model(distance_error(inner, Y, F), plant, names)
     T = updated_reference(E, M1)
     g_sub = _norm((T.A, T.B, T.C, T.D), which, model.dt)
     gen = _on_model(gen, model, groups)

@@ -252,13 +252,10 @@ def inverse(A, B, C, D):
 def boundary_zeros(A, B, C, D, dt: float | None = None, *, tol: float = 1e-7) -> np.ndarray:
     """Zeros of a full-row-rank ``G`` on the stability boundary (imaginary axis or unit circle).
 
-    The zeros of ``G`` on the boundary are those of the spectral density ``G G~`` there, and the ones that make the
-    filter Riccati equation of :func:`coouter_coinner` lose its stabilising solution.  They are taken from the
-    invariant zeros of ``G`` (SLICOT ``AB08ND`` through python-control), not from the boundary eigenvalues of the
-    Hamiltonian: a multiple zero of ``G`` off the boundary is a defective eigenvalue pair ``±z`` of the Hamiltonian,
-    and rounding of order ``ε^{1/k}`` moved such a pair (PATH's three actuator faults: ``G`` with all four zeros at
-    ``−0.05``) onto the imaginary axis at ``±0.0655 j`` under some BLAS kernels, while ``AB08ND`` returned the four
-    zeros at ``−0.05`` under all of them.
+    They are those of ``G G~`` there, where the filter Riccati equation of :func:`coouter_coinner` loses its
+    stabilising solution; taken from the invariant zeros (SLICOT ``AB08ND``), not from the Hamiltonian, whose
+    defective pairs ``±z`` of a multiple zero rounding moved onto the axis under some BLAS kernels (PATH's three
+    actuator faults: four zeros at ``−0.05``, on the axis at ``±0.0655 j``).
 
     Parameters
     ----------
@@ -379,31 +376,20 @@ def coouter_coinner(A, B, C, D, dt: float | None = None, *, tol: float = 1e-7) -
 def _filter_riccati(A, B, C, D, dt, tol):
     """The stabilising ``X`` of the filter ARE with ``D Dᵀ > 0``, solved on the part controllable from the noise.
 
-    With ``F = A − B D⁺ C`` and ``B̃ = B (I − D⁺ D)`` the ARE is ``F X + X Fᵀ − X Cᵀ R⁻¹ C X + B̃ B̃ᵀ = 0`` (discrete
-    alike); in the controllability staircase of ``(F, B̃)`` ``X = diag(X₁, 0)`` when the uncontrollable part — the
-    zeros of ``G`` — is stable, and ``X₁`` solves the ARE of the controllable part.  A square ``G`` with ``D``
-    invertible has ``B̃ = 0`` and ``X = 0``: solved on the whole, its Hamiltonian carries each multiple zero as a
-    defective eigenvalue pair, which SciPy's solver refused as too close to the axis under some BLAS kernels (PATH's
-    three actuator faults, four zeros at ``−0.05``).  The staircase is written here with an absolute rank threshold
-    ``tol·max(1, ‖[A B]‖)``: SLICOT's ``AB01ND`` (slycot) decides rank relative to each block, and counted the
-    ``B̃ = B (I − D⁻¹D)`` of that case (norm 1.6e-10, rounding) as rank 3.
+    With ``F = A − B D⁺ C``, ``B̃ = B (I − D⁺ D)``: ``F X + X Fᵀ − X Cᵀ R⁻¹ C X + B̃ B̃ᵀ = 0`` (discrete alike), and
+    in the controllability staircase of ``(F, B̃)`` (absolute threshold ``tol·max(1, ‖[A B]‖)``) ``X = diag(X₁, 0)``
+    when the uncontrollable part, the zeros of ``G``, is stable.  A square ``G`` with ``D`` invertible has ``X = 0``;
+    solved on the whole, the Hamiltonian's defective pairs of a multiple zero made SciPy refuse it under some BLAS
+    kernels (PATH's three actuator faults).
     """
-    n, m = B.shape
+    from fdikit.descriptor.staircase import controllability_staircase
+
+    n = A.shape[0]
     R = D @ D.T
     Dp = D.T @ np.linalg.inv(R)
-    F, blk = A - B @ Dp @ C, B - B @ Dp @ D
-    thr = tol * max(1.0, np.linalg.norm(np.hstack([A, B]), 2))
-    Z, Fz, nc = np.eye(n), F, 0
-    while nc < n and blk.size:
-        U, sv, _ = np.linalg.svd(blk)
-        r = int(np.sum(sv > thr))
-        if not r:
-            break
-        T = np.eye(n)
-        T[nc:, nc:] = U
-        Z, Fz = Z @ T, T.T @ Fz @ T
-        blk, nc = Fz[nc + r:, nc:nc + r], nc + r
-    ev = np.linalg.eigvals(Fz[nc:, nc:])
+    F = A - B @ Dp @ C
+    Z, nc = controllability_staircase(F, B - B @ Dp @ D, tol * max(1.0, np.linalg.norm(np.hstack([A, B]), 2)))
+    ev = np.linalg.eigvals((Z.T @ F @ Z)[nc:, nc:])
     if ev.size and (np.max(ev.real) >= 0 if dt is None else np.max(np.abs(ev)) >= 1):
         Z, nc = np.eye(n), n                        # an unstable zero: X is not zero on it, solve on the whole
     X = np.zeros((n, n))

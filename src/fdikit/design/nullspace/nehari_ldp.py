@@ -33,15 +33,47 @@ from __future__ import annotations
 
 import numpy as np
 
+from fdikit.design.nullspace.factorization import inverse, realization, series
 from fdikit.errors import DesignError
 
-__all__ = ["nehari", "two_block_distance"]
+__all__ = ["distance_error", "nehari", "two_block_distance"]
 
 
-def _sys(sys):
-    A, B, C, D = (np.atleast_2d(np.asarray(M, dtype=float)) for M in sys)
-    n = A.shape[0] if A.size else 0
-    return A.reshape(n, n), B.reshape(n, D.shape[1]), C.reshape(D.shape[0], n), D
+def _difference(first, second):
+    """``first − second`` on the states of both."""
+    A1, B1, C1, D1 = first
+    A2, B2, C2, D2 = second
+    n1, n2 = A1.shape[0], A2.shape[0]
+    A = np.block([[A1, np.zeros((n1, n2))], [np.zeros((n2, n1)), A2]])
+    return A, np.vstack([B1, B2]), np.hstack([C1, -C2]), D1 - D2
+
+
+def distance_error(inner, Y, F):
+    """``Y R_i − F`` as one realisation (states of ``R_i``, ``Y``, then ``F``): the error of a least-distance ``Y``.
+
+    Parameters
+    ----------
+    inner, Y, F : tuple of numpy.ndarray
+        ``(A, B, C, D)`` of ``R_i``, ``Y`` and ``F``.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+
+    Examples
+    --------
+    ``R_i = 1``, ``Y = 2`` and ``F = 1/(s+1) + 0.5``:
+
+    >>> static = lambda d: (np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), [[d]])
+    >>> A, B, C, D = distance_error(static(1.0), static(2.0), ([[-1.0]], [[1.0]], [[1.0]], [[0.5]]))
+    >>> A.shape, C.tolist(), D.tolist()
+    ((1, 1), [[-1.0]], [[1.5]])
+
+    References
+    ----------
+    Varga (2017), §7.10 (the least-distance problem).
+    """
+    return _difference(series(inner, Y), realization(*F))
 
 
 def _split(A, B, C, D, margin: float = 0.0):
@@ -119,7 +151,7 @@ def nehari(A, B, C, D):
     ----------
     Glover (1984); Varga (2017), §7.10; fdtools (``gnehari``).
     """
-    A, B, C, D = _sys((A, B, C, D))
+    A, B, C, D = realization(A, B, C, D)
     if A.shape[0] and np.min(np.abs(np.linalg.eigvals(A).real)) <= 1e-10 * max(1.0, np.linalg.norm(A, 1)):
         raise DesignError("the Nehari approximation needs a system without poles on the imaginary axis")
     (As, Bs, Cs, Ds), (Au, Bu, Cu, _) = _split(A, B, C, D)
@@ -219,19 +251,16 @@ def two_block_distance(inner, F, *, reltol: float = 1e-4):
     """
     from fdikit.analysis.channels import Channel, hinf_norm
     from fdikit.design.nullspace.basis import minimal_realization
-    from fdikit.design.nullspace.factorization import inverse, series
 
-    Ri, F = _sys(inner), _sys(F)
+    Ri, F = realization(*inner), realization(*F)
     q = F[3].shape[0]
     F1 = series(_conjugate(*Ri), F)                       # F R_i~ (q × r)
     # F₁F₁~ − F F~ and its stable part Z (D_Z = 0); Φ_γ(∞) = γ² I + D₁D₁ᵀ − D Dᵀ
     Pf = series(_conjugate(*F1), F1)
     Pg = series(_conjugate(*F), F)
-    n1, n2 = Pf[0].shape[0], Pg[0].shape[0]
-    Aphi = np.block([[Pf[0], np.zeros((n1, n2))], [np.zeros((n2, n1)), Pg[0]]])
-    stable, _ = _split(Aphi, np.vstack([Pf[1], Pg[1]]), np.hstack([Pf[2], -Pg[2]]), np.zeros((q, q)))
-    Z = stable          # not reduced: a rank tolerance of 1e-7 dropped modes worth 4e-4 of Φ on PATH
-    D0 = F1[3] @ F1[3].T - F[3] @ F[3].T
+    Aphi, Bphi, Cphi, D0 = _difference(Pf, Pg)
+    Z, _ = _split(Aphi, Bphi, Cphi, np.zeros((q, q)))    # not reduced: a rank tolerance of 1e-7 dropped modes
+    #                                                       worth 4e-4 of Φ on PATH
 
     def attempt(g):
         V = _spectral_factor(Z, g * g * np.eye(q) + D0)
@@ -248,11 +277,7 @@ def two_block_distance(inner, F, *, reltol: float = 1e-4):
             return None
         # accepted only if Y achieves γ: the test above is exact in exact arithmetic, but rounding in V near the
         # boundary has let it pass below the optimum (a random 3-state problem: bracket 1.5830, achieved 1.7308)
-        A1, B1, C1, D1 = series(Ri, Y)
-        n1 = A1.shape[0]
-        diff = Channel(np.block([[A1, np.zeros((n1, F[0].shape[0]))], [np.zeros((F[0].shape[0], n1)), F[0]]]),
-                       np.vstack([B1, F[1]]), np.hstack([C1, -F[2]]), D1 - F[3], None)
-        return Y if float(hinf_norm(diff)[0]) <= g * (1 + 1e-9) else None
+        return Y if float(hinf_norm(Channel(*distance_error(Ri, Y, F), None))[0]) <= g * (1 + 1e-9) else None
 
     top = float(hinf_norm(Channel(*F, None))[0])
     if top == 0.0:
