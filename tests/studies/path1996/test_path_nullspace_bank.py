@@ -187,3 +187,10 @@ def test_missing_nominal_size_is_a_parameter_error():
     del nominal["brake_actuator"]
     with pytest.raises(ParameterError, match="brake_actuator"):
         path_nullspace_bank(MODELS, nominal)
+
+
+def test_gap_criterion_without_noise_is_a_parameter_error():
+    with pytest.raises(ParameterError, match="noise_std"):
+        path_nullspace_bank(MODELS, nominal_fault_sizes(), criterion="gap")
+    with pytest.raises(ParameterError, match="criterion"):
+        path_nullspace_bank(MODELS, nominal_fault_sizes(), noise_std=NOISE_STD, criterion="best")

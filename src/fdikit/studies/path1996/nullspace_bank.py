@@ -108,9 +108,10 @@ def _dc(form: FaultModel) -> np.ndarray:
 
 def _with_noise(model: FaultModel, sigma: np.ndarray) -> FaultModel:
     """``model`` with white sensor noise ``w`` of levels ``sigma`` on its outputs (``B_w = 0``, ``D_w = diag(σ)``)."""
-    return FaultModel(model.A, model.C, Bu=model.b("u"), Du=model.d("u"), Bf=model.b("f"), Df=model.d("f"),
-                      Bw=np.zeros((model.n, len(sigma))), Dw=np.diag(sigma), states=model.states,
-                      outputs=model.outputs, controls=model.controls, faults=model.faults)
+    return FaultModel(model.A, model.C, Bu=model.b("u"), Du=model.d("u"), Bd=model.b("d"), Dd=model.d("d"),
+                      Bf=model.b("f"), Df=model.d("f"), Bw=np.zeros((model.n, len(sigma))), Dw=np.diag(sigma),
+                      states=model.states, outputs=model.outputs, controls=model.controls,
+                      disturbances=model.disturbances, faults=model.faults)
 
 
 def _noise_selection(model: FaultModel, fault: str, nuisance, sigma: np.ndarray, dt: float, kw: dict) -> np.ndarray:
@@ -174,7 +175,7 @@ def path_nullspace_bank(models: tuple[FaultModel, FaultModel], nominal: Mapping[
     DesignError
         When a row is not achievable on these models (the message names the filter and row).
     ParameterError
-        For a missing nominal size or noise level.
+        For a missing nominal size or noise level, or ``criterion="gap"`` without ``noise_std``.
 
     References
     ----------
@@ -203,6 +204,8 @@ def path_nullspace_bank(models: tuple[FaultModel, FaultModel], nominal: Mapping[
         raise ParameterError(f"nominal: no size for {missing}; give all 15 fault sizes")
     fdgaintol = validate.positive("fdgaintol", fdgaintol)
     criterion = validate.choice("criterion", criterion, ("variance", "gap"))
+    if criterion == "gap" and noise_std is None:
+        raise ParameterError("criterion='gap' weighs the basis rows by the sensor noise: give noise_std")
     sigma = None
     if noise_std is not None:
         dt = validate.positive("dt", dt)
