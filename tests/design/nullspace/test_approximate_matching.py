@@ -173,7 +173,7 @@ def test_example_5_6c_reference_ldp_gives_the_reference_filter():
 @pytest.mark.parametrize("seed", range(8))
 def test_nehari_ldp_reaches_the_central_optimum(seed):
     # two solvers of min ‖Y R_i − F‖∞: the optimal γ is unique, so both brackets agree to their reltol
-    from fdikit.design.nullspace.factorization import coouter_coinner
+    from fdikit.design.nullspace.factorization import coouter_coinner, transfer
 
     rng = np.random.default_rng(seed)
     n, r, m_in, q = 3, 2, 3, 2
@@ -187,8 +187,6 @@ def test_nehari_ldp_reaches_the_central_optimum(seed):
     # both are achieved distances, so above the optimum; the Nehari bracket is never worse than the central one
     # beyond its reltol, and they agree to the default reltol (SB10AD's bisection stopped 6e-6 above on seed 4)
     assert gn <= gc * (1 + 2e-6) and gn == pytest.approx(gc, rel=1e-4)
-    from fdikit.design.nullspace.factorization import transfer
-
     err = max(np.linalg.norm(transfer(Yn, 1j * w) @ transfer(Ri, 1j * w) - transfer(F, 1j * w), 2)
               for w in np.concatenate([[0.0], np.logspace(-3, 3, 601)]))
     assert err <= gn * (1 + 1e-6)          # Y achieves the bracket's upper end (a grid is below the peak)

@@ -88,7 +88,7 @@ def test_non_standard_cases_are_refused_with_the_zeros():
     with pytest.raises(DesignError, match="stability boundary"):
         coouter_coinner([[-2.0]], [[-2.0]], [[1.0]], [[1.0]])                # s/(s+2)
     np.testing.assert_allclose(boundary_zeros([[-2.0]], [[-2.0]], [[1.0]], [[1.0]]), [0.0], atol=1e-12)
-    # (z − 1)/(z − 0.5) = 1 + 0.5/(z − 0.5): its zero at 1; (z − 0.9)/(z − 0.5) none
+    # (z − 1)/(z − 0.5) = 1 − 0.5/(z − 0.5): its zero at 1; (z − 0.9)/(z − 0.5) = 1 − 0.4/(z − 0.5): none
     np.testing.assert_allclose(boundary_zeros([[0.5]], [[-0.5]], [[1.0]], [[1.0]], 1.0), [1.0], atol=1e-12)
     assert boundary_zeros([[0.5]], [[-0.4]], [[1.0]], [[1.0]], 1.0).size == 0
     assert boundary_zeros([[-2.0]], [[1.0]], [[1.0]], [[1.0]]).size == 0
