@@ -181,7 +181,12 @@ def fditspec(sysr, freqs=None, *, block: bool = False, tol: float | None = None,
     to ``1e-4 max(1, ‖B_f‖₁, ‖D_f‖₁)`` of the filter's fault channel.  Strong (``freqs`` given): True when
     the system matrix ``[A − λ_k I, b; c, d]`` of that minimal realisation has full column rank at every
     ``λ_k``, i.e. its smallest singular value exceeds ``stol`` (``FDStol``, default
-    ``ε max(1, ‖A‖₁, ‖B‖₁, ‖C‖∞, ‖D‖₁)``).
+    ``100 (n + 1) ε max(1, ‖A‖₁, ‖B‖₁, ‖C‖∞, ‖D‖₁)``, ``n`` the element's order).  The reference's default
+    ``ε max(…)`` sits at the rounding level of the element's minimal realisation, so a zero exactly at ``λ_k``
+    could be missed: ``s/(s + 1)`` of test_efdsyn.jl's ``G_f = [s/(s+1) 0; (s²+4)/(s+3)² 1]``, realised and
+    reduced, gave ``σ_min = 2e-15`` at ``λ = 0`` against ``ε max(…) = 3.3e-16`` (True instead of the reference's
+    False); the factor ``100 (n + 1)`` is the usual margin of a backward-stable reduction and SVD of an
+    ``(n + 1)``-dimensional pencil.
 
     Parameters
     ----------
@@ -240,7 +245,7 @@ def _no_zero(ch, omega: np.ndarray, stol: float | None, fault: str) -> bool:
     n = ch.n
     scale = max(1.0, np.linalg.norm(ch.D, 1), *(
         (np.linalg.norm(ch.A, 1), np.linalg.norm(ch.B, 1), np.linalg.norm(ch.C, np.inf)) if n else ()))
-    t2 = _EPS * scale if stol is None else stol
+    t2 = 100 * (n + 1) * _EPS * scale if stol is None else stol
     for w in omega:
         if n and not np.isinf(w):
             lam = np.exp(1j * w * ch.dt) if ch.dt is not None else 1j * w

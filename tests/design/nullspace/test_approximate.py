@@ -222,6 +222,8 @@ def test_gap_selection_at_a_frequency_and_its_refusals():
         afdsyn(m, selection="gap", targets="f0", fdfreq=0.0, rdim=1)
     with pytest.raises(ParameterError, match="selection"):
         afdsyn(m, selection="best", fdfreq=0.0, **kw)
+    with pytest.raises(ParameterError, match="weighs the noise"):      # the exact design has no noise to weigh
+        afdsyn(m, selection="gap", fdfreq=0.0, exact=True, **kw)
     # one noise input: a combination of the two rows cancels it at DC, the gap is unbounded there
     m1 = FaultModel(m.A, m.C, Bu=m.b("u"), Bf=m.b("f"), Bw=[[0.0], [0.0], [1.0]])
     with pytest.raises(DesignError, match="decouples the noise"):

@@ -37,7 +37,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
         "basis": [
             "NullspaceBasis", "default_sdeg", "denominator", "left_nullspace", "minimal_realization", "realize_rows",
         ],
-        "detectability": ["fault_response", "frequency_points", "row_structure"],
+        "detectability": ["covered", "fault_response", "frequency_points", "row_structure"],
         "approximate": ["ApproximateBankDesign", "ApproximateDesign", "afdisyn", "afdsyn"],
         "factorization": [
             "CoOuterFactor", "boundary_zeros", "coouter_coinner", "inverse", "quasi_coouter", "quasi_coouter_row",

@@ -42,7 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fdikit.design.nullspace.basis import NullspaceBasis, denominator, left_nullspace, minimal_realization, realize_rows
-from fdikit.design.nullspace.detectability import fault_response, frequency_points, row_structure
+from fdikit.design.nullspace.detectability import covered, fault_response, frequency_points, row_structure
 from fdikit.design.nullspace.exact import bank_rows, efdsyn, split_faults
 from fdikit.design.nullspace.factorization import transfer
 from fdikit.design.nullspace.noise_factors import NONSTD_OPTIONS, attenuate_noise
@@ -176,13 +176,14 @@ def _select(model, basis, targets, q, minimal, poles, sdeg, fdtol, fdfreq, fdgai
             # strong detectability over the default denominators, not the design's poles (the reference's sdegNS)
             chk = [denominator(d, None, None, model.dt)] * q
             S = row_structure(model, basis, targets, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol, dens=chk,
-                              rows=rows)
-            if not S.any(axis=0).all():
+                              rows=rows, by_frequency=True)
+            if not covered(S).all():
                 continue
             return used, H, realize_rows(rows, dens, basis.scale)
         chk_own = [denominator(nu, None, None, model.dt) for nu in basis.degrees]
-        S = row_structure(model, basis, targets, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol, dens=chk_own)
-        if not S[list(used)].any(axis=0).all():
+        S = row_structure(model, basis, targets, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol, dens=chk_own,
+                          by_frequency=True)
+        if not covered(S, used).all():
             continue
         A, B, C, D = realize_rows([basis.rows[i] for i in used], [dens_own[i] for i in used], basis.scale)
         return used, H, (A, B, H @ C, H @ D)
@@ -387,8 +388,11 @@ def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
                                  np.linalg.eigvals(gen.A) if gen.n else np.zeros(0, complex), model=model)
 
     if rw == 0 or exact:
+        if isinstance(selection, str):
+            raise ParameterError(f"selection={selection!r} weighs the noise; the design is exact here (no noise "
+                                 "reaches the residuals, or exact=True): give a matrix or None")
         d = efdsyn(model, targets=targets, nuisance=nuisance, rdim=rdim, minimal=minimal, poles=poles, sdeg=sdeg,
-                   fdtol=fdtol, fdgaintol=fdgaintol, fdfreq=fdfreq, tol=tol)
+                   fdtol=fdtol, fdgaintol=fdgaintol, fdfreq=fdfreq, selection=selection, tol=tol)
         return finish(d.generator, d.used, d.selection, "none", 0)
     if rdim is None:
         q1, q2 = (1, 0) if minimal else (rw, k - rw)
@@ -483,7 +487,8 @@ class ApproximateBankDesign(FieldReport):
     REPORT = ("specification", "faults", "groups", "orders", "gaps", "weak")
 
 
-def afdisyn(model: FaultModel, structure, *, faults=None, rdim: int | None = None, weak_fallback: bool = True,
+def afdisyn(model: FaultModel, structure, *, faults=None, rdim: int | Sequence[int] | None = None,
+            weak_fallback: bool = True,
             **options) -> ApproximateBankDesign:
     """A bank of approximate fault detection filters for the structure matrix ``structure`` (Procedure AFDI).
 
@@ -496,8 +501,8 @@ def afdisyn(model: FaultModel, structure, *, faults=None, rdim: int | None = Non
         exactly and attenuates the noise.
     faults : sequence of str, optional
         The columns of ``S`` (default the model's fault inputs).
-    rdim : int, optional
-        Residuals per filter.
+    rdim : int or sequence of int, optional
+        Residuals per filter, or one number per row.
     weak_fallback : bool, default True
         When a row's strong design fails (its zeros cannot be decoupled, or a target is then not detected),
         design it again with the row's zeros as noise, with a :class:`~fdikit.errors.FdiWarning` (as the reference
@@ -538,7 +543,7 @@ def afdisyn(model: FaultModel, structure, *, faults=None, rdim: int | None = Non
         raise ParameterError(f"unknown option(s) {bad}; afdisyn takes {sorted(allowed)}")
     weak = []
 
-    def design(tg, nz):
+    def design(tg, nz, rdim):
         try:
             d = afdsyn(model, targets=tg, nuisance=nz, rdim=rdim, **options)
         except DesignError as err:
@@ -551,7 +556,7 @@ def afdisyn(model: FaultModel, structure, *, faults=None, rdim: int | None = Non
         weak.append(False)
         return d
 
-    S, faults, filters, gen = bank_rows(model, structure, faults, design)
+    S, faults, filters, gen = bank_rows(model, structure, faults, design, rdim=rdim)
     return ApproximateBankDesign(gen, filters, S, faults, tuple(tuple(f.generator.residuals) for f in filters),
                                  tuple(f.order for f in filters), np.array([f.gap for f in filters]), tuple(weak),
                                  model=model)

@@ -246,11 +246,15 @@ def _canonical(V: np.ndarray) -> np.ndarray:
     The new rows of one degree span a unique space, but the SVD returns them in a rotation that rounding (and so the
     BLAS kernel) decides when their singular values are equal.  Projecting fixed vectors ``Z`` onto the space and
     orthonormalising them (QR with a positive diagonal) gives the same rows for every rotation, continuously in the
-    space, so ``selection=`` means the same filter on every machine.
+    space, so ``selection=`` means the same filter on every machine.  When the space is all of ``R^L`` (degree 0
+    without decoupled inputs) the rows are the unit vectors: the residuals are the outputs, in order, as the
+    reference's basis ``I`` has them.
     """
     q, L = V.shape
     if q <= 1:
         return V
+    if q == L:               # the whole space (no decoupled input reaches the outputs): the outputs themselves
+        return np.eye(L)
     Z = np.random.default_rng(20170).standard_normal((L, q))
     Qx, Rx = np.linalg.qr(V.T @ (V @ Z))
     return (Qx * np.sign(np.diag(Rx))).T

@@ -21,7 +21,7 @@ import numpy as np
 from fdikit.errors import ParameterError
 from fdikit.model import FaultModel
 
-__all__ = ["fault_response", "row_structure", "frequency_points"]
+__all__ = ["fault_response", "row_structure", "frequency_points", "covered"]
 
 _GENERIC = (0.613 + 0.791j, -0.377 + 1.93j)
 
@@ -107,8 +107,11 @@ def _response(model: FaultModel, faults: Sequence[str], lam: complex) -> tuple[n
 
 def row_structure(model: FaultModel, basis, faults: Sequence[str], *, fdtol: float = 1e-4,
                   fdfreq=None, fdgaintol: float = 0.01, dens: Sequence[np.ndarray] | None = None,
-                  rows: Sequence[np.ndarray] | None = None) -> np.ndarray:
+                  rows: Sequence[np.ndarray] | None = None, by_frequency: bool = False) -> np.ndarray:
     """Which faults each row detects: ``(q, len(faults))`` booleans, weak or (with ``fdfreq``) strong.
+
+    A row is strong for a fault when it detects it at every frequency of ``fdfreq``; ``by_frequency`` keeps the
+    frequencies apart, ``(q, len(faults), len(fdfreq))``, which is what feasibility needs (:func:`covered`).
 
     Parameters
     ----------
@@ -128,11 +131,13 @@ def row_structure(model: FaultModel, basis, faults: Sequence[str], *, fdtol: flo
         The denominators ``φ_i`` (highest power first); required with ``fdfreq``.
     rows : sequence of numpy.ndarray, optional
         Coefficient rows to test instead of the basis rows (e.g. combined rows).
+    by_frequency : bool, default False
+        One boolean matrix per frequency (a trailing axis; one entry for the weak structure).
 
     Returns
     -------
     numpy.ndarray
-        Boolean matrix.
+        Boolean matrix (``by_frequency``: a stack of them).
 
     Raises
     ------
@@ -152,9 +157,10 @@ def row_structure(model: FaultModel, basis, faults: Sequence[str], *, fdtol: flo
     """
     coeffs = list(basis.rows if rows is None else rows)
     faults = tuple(faults)
+    pts = frequency_points(fdfreq, model.dt)
     S = np.zeros((len(coeffs), len(faults)), dtype=bool)
     if not coeffs or not faults:
-        return S
+        return np.zeros((*S.shape, max(pts.size, 1)), dtype=bool) if by_frequency else S
     mu = len(model.controls)
     poly = np.polynomial.polynomial.polyval
     for z in _GENERIC:
@@ -164,15 +170,50 @@ def row_structure(model: FaultModel, basis, faults: Sequence[str], *, fdtol: flo
             Ny = poly(lam / basis.scale, N)[mu:]
             val = np.abs(Ny @ G)
             S[i] |= val > fdtol * np.linalg.norm(Ny) * Gn
-    pts = frequency_points(fdfreq, model.dt)
+    S = np.repeat(S[:, :, None], max(pts.size, 1), axis=2)
     if pts.size:
         if dens is None:
             raise ParameterError("strong detectability (fdfreq) needs the filter denominators")
-        for lam0 in pts:
+        for k, lam0 in enumerate(pts):
             G, lam = _response(model, faults, lam0)
             for i, N in enumerate(coeffs):
                 # the realised row is N(λ/α) / φ'(λ/α) with the monic φ'(μ) = φ(αμ) / α^d (basis.realize_rows)
                 d = len(dens[i]) - 1
                 gain = np.abs(poly(lam / basis.scale, N)[mu:] @ G) * basis.scale ** d / abs(np.polyval(dens[i], lam))
-                S[i] &= gain > fdgaintol
-    return S
+                S[i, :, k] &= gain > fdgaintol
+    return S if by_frequency else S.all(axis=2)
+
+
+def covered(S: np.ndarray, used: Sequence[int] | None = None) -> np.ndarray:
+    """Per fault: do the rows ``used`` (default all) detect it, at every frequency by some row?
+
+    The reference's feasibility test (``efdbasesel``, ``fdigenspec``): a combination of rows detects a fault
+    strongly at every frequency when, at each frequency, one of its rows does; no single row need detect it at all
+    of them (``[s/(s+1); (s²+4)/(s+3)²]`` at 0 and 2 rad/s).
+
+    Parameters
+    ----------
+    S : numpy.ndarray
+        ``row_structure(..., by_frequency=True)``, or a 2-D matrix (one frequency).
+    used : sequence of int, optional
+        The rows of ``S`` to combine.
+
+    Returns
+    -------
+    numpy.ndarray
+        One boolean per fault.
+
+    Examples
+    --------
+    >>> S = np.array([[[False, True]], [[True, False]]])    # two rows, one fault, two frequencies
+    >>> covered(S).tolist(), covered(S, [0]).tolist(), covered(S.all(axis=2)).tolist()
+    ([True], [False], [False])
+
+    References
+    ----------
+    Varga (2017), §5.2 (Procedure EFD, step 2); fdtools (``efdbasesel``).
+    """
+    S3 = S[:, :, None] if S.ndim == 2 else S
+    if used is not None:
+        S3 = S3[list(used)]
+    return S3.any(axis=0).all(axis=-1)

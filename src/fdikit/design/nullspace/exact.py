@@ -23,8 +23,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fdikit import validate
 from fdikit.design.nullspace.basis import NullspaceBasis, denominator, left_nullspace, minimal_realization, realize_rows
-from fdikit.design.nullspace.detectability import row_structure
+from fdikit.design.nullspace.detectability import covered, row_structure
 from fdikit.errors import DesignError, ParameterError
 from fdikit.model import FaultModel
 from fdikit.protocols import FieldReport
@@ -273,8 +274,10 @@ def efdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
     dens_own = [denominator(nu, poles, sdeg, model.dt) for nu in basis.degrees]
     # strong detectability is judged over the default denominators, not the design's poles (the reference's sdegNS)
     chk_own = [denominator(nu, None, None, model.dt) for nu in basis.degrees]
-    S_basis = row_structure(model, basis, targets, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol, dens=chk_own)
-    missing = [f for f, hit in zip(targets, S_basis.any(axis=0)) if not hit]
+    S_freq = row_structure(model, basis, targets, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol, dens=chk_own,
+                           by_frequency=True)
+    S_basis = S_freq.all(axis=2)
+    missing = [f for f, hit in zip(targets, covered(S_freq)) if not hit]
     if missing:
         kind = f"strongly at {np.atleast_1d(fdfreq).tolist()} rad/s" if fdfreq is not None else "weakly"
         raise DesignError(f"faults {missing} cannot be detected {kind} once the controls, disturbances and nuisance "
@@ -283,7 +286,7 @@ def efdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
     if minimal:
         for d in sorted(set(basis.degrees)):
             used = tuple(i for i, nu in enumerate(basis.degrees) if nu <= d)
-            if len(used) >= q and S_basis[list(used)].any(axis=0).all():
+            if len(used) >= q and covered(S_freq, used).all():
                 break
     else:
         used = tuple(range(k_all))
@@ -303,7 +306,7 @@ def efdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
         gen = label_generator(_unit_fault_gain(gen, model, targets, fdfreq), model, names, isolates)
         if minimal:
             S = row_structure(model, basis, faults, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol,
-                              dens=[denominator(d, None, None, model.dt)] * q, rows=rows)
+                              dens=[denominator(d, None, None, model.dt)] * q, rows=rows, by_frequency=True)
         else:
             S = _combined_structure(model, basis, H, chk_own, faults, fdtol, fdfreq, fdgaintol)
         return gen, H, S
@@ -311,20 +314,22 @@ def efdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
     # a generic combination can still bring a target's gain under fdtol: then the next fixed ones are tried
     for seed in (range(20170, 20178) if minimal and selection is None and q < len(used) else (20170,)):
         gen, H, S = build(seed)
-        if S[:, : len(targets)].any(axis=0).all():
+        if covered(S[:, : len(targets)]).all():
             break
     else:
         raise DesignError(f"the selection {H.round(3).tolist()} of the basis rows {list(used)} misses a target; "
                           "give another selection=")
-    return NullspaceDesign(gen, basis, basis.degrees, H, used, gen.n, S, S_basis, targets, nuisance,
+    return NullspaceDesign(gen, basis, basis.degrees, H, used, gen.n, S.all(axis=2), S_basis, targets, nuisance,
                            np.linalg.eigvals(gen.A) if gen.n else np.zeros(0, complex), model=model)
 
 
 def _combined_structure(model, basis, H, dens, faults, fdtol, fdfreq, fdgaintol) -> np.ndarray:
-    """Structure of ``H · diag(N_i / φ_i)``: a residual detects what its nonzero-weighted rows detect, generically."""
-    S_rows = row_structure(model, basis, faults, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol, dens=dens)
+    """Structure of ``H · diag(N_i / φ_i)`` per frequency: a residual detects what its nonzero-weighted rows detect,
+    generically."""
+    S_rows = row_structure(model, basis, faults, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol, dens=dens,
+                           by_frequency=True)
     weights = np.abs(H) > 1e-12 * np.max(np.abs(H))
-    return (weights.astype(int) @ S_rows.astype(int)) > 0
+    return np.einsum("ij,jfk->ifk", weights.astype(int), S_rows.astype(int)) > 0
 
 
 @dataclass(frozen=True, eq=False)
@@ -367,7 +372,8 @@ class NullspaceBankDesign(FieldReport):
     REPORT = ("specification", "faults", "groups", "orders")
 
 
-def bank_rows(model: FaultModel, structure, faults, design) -> tuple[np.ndarray, tuple[str, ...], tuple, object]:
+def bank_rows(model: FaultModel, structure, faults, design, rdim=None
+              ) -> tuple[np.ndarray, tuple[str, ...], tuple, object]:
     """One filter per row of a structure matrix, named and stacked: the loop of ``efdisyn`` and ``afdisyn``.
 
     Parameters
@@ -380,8 +386,10 @@ def bank_rows(model: FaultModel, structure, faults, design) -> tuple[np.ndarray,
     faults : sequence of str or None
         The columns of ``S`` (default the model's fault inputs).
     design : callable
-        ``design(targets, nuisance)`` returning a design with a ``generator`` (``efdsyn`` or ``afdsyn`` with the
-        caller's options).
+        ``design(targets, nuisance, rdim)`` returning a design with a ``generator`` (``efdsyn`` or ``afdsyn`` with
+        the caller's options).
+    rdim : int or sequence of int, optional
+        The number of residuals of every filter, or one per row (the reference's vector ``rdim``); passed on.
 
     Returns
     -------
@@ -404,7 +412,7 @@ def bank_rows(model: FaultModel, structure, faults, design) -> tuple[np.ndarray,
     Examples
     --------
     >>> m = FaultModel([[-1.0]], [[1.0], [1.0]], Bu=[[1.0]], Df=np.eye(2))
-    >>> S, faults, filters, gen = bank_rows(m, np.eye(2), None, lambda t, n: efdsyn(m, targets=t, nuisance=n))
+    >>> S, faults, filters, gen = bank_rows(m, np.eye(2), None, lambda t, n, q: efdsyn(m, targets=t, nuisance=n))
     >>> gen.residuals, gen.isolates
     (('r0', 'r1'), ('f0', 'f1'))
 
@@ -421,6 +429,13 @@ def bank_rows(model: FaultModel, structure, faults, design) -> tuple[np.ndarray,
         raise ParameterError(f"structure must be a 0/1 matrix with one column per fault {list(faults)}, got shape "
                              f"{S.shape}")
     S = S.astype(bool)
+    if rdim is None or np.ndim(rdim) == 0:
+        rdims = [rdim] * len(S)
+    else:
+        rdims = [validate.integer("rdim", r, minimum=1) for r in rdim]
+        if len(rdims) != len(S):
+            raise ParameterError(f"rdim has {len(rdims)} entries; give one per row of the structure ({len(S)}) or "
+                                 "one number for all")
     filters = []
     for i, row in enumerate(S):
         tg = tuple(f for f, s in zip(faults, row) if s)
@@ -428,7 +443,7 @@ def bank_rows(model: FaultModel, structure, faults, design) -> tuple[np.ndarray,
         if not tg:
             raise ParameterError(f"row {i} of the structure has no fault to detect")
         try:
-            d = design(tg, nz)
+            d = design(tg, nz, rdims[i])
         except DesignError as err:
             raise DesignError(f"row {i} of the structure ({row.astype(int).tolist()}) is not achievable: {err}"
                               ) from err
@@ -440,7 +455,8 @@ def bank_rows(model: FaultModel, structure, faults, design) -> tuple[np.ndarray,
     return S, faults, tuple(filters), stack_generators([f.generator for f in filters])
 
 
-def efdisyn(model: FaultModel, structure, *, faults=None, rdim: int | None = None, minimal: bool = True,
+def efdisyn(model: FaultModel, structure, *, faults=None, rdim: int | Sequence[int] | None = None,
+            minimal: bool = True,
             poles=None, sdeg: float | None = None, fdtol: float = 1e-4, fdgaintol: float = 0.01, fdfreq=None,
             tol: float = 1e-9) -> NullspaceBankDesign:
     """A bank of exact fault detection filters achieving the structure matrix ``structure`` (Procedure EFDI).
@@ -453,7 +469,9 @@ def efdisyn(model: FaultModel, structure, *, faults=None, rdim: int | None = Non
         ``S``: row ``i`` asks for a filter that detects the faults of its ones and decouples those of its zeros.
     faults : sequence of str, optional
         The columns of ``S`` (default the model's fault inputs, in order).
-    rdim, minimal, poles, sdeg, fdtol, fdgaintol, fdfreq, tol
+    rdim : int or sequence of int, optional
+        As :func:`efdsyn`, for every row, or one per row.
+    minimal, poles, sdeg, fdtol, fdgaintol, fdfreq, tol
         As :func:`efdsyn`, for every row.
 
     Returns
@@ -482,7 +500,7 @@ def efdisyn(model: FaultModel, structure, *, faults=None, rdim: int | None = Non
     """
     S, faults, filters, gen = bank_rows(
         model, structure, faults,
-        lambda tg, nz: efdsyn(model, targets=tg, nuisance=nz, rdim=rdim, minimal=minimal, poles=poles, sdeg=sdeg,
-                              fdtol=fdtol, fdgaintol=fdgaintol, fdfreq=fdfreq, tol=tol))
+        lambda tg, nz, q: efdsyn(model, targets=tg, nuisance=nz, rdim=q, minimal=minimal, poles=poles, sdeg=sdeg,
+                                 fdtol=fdtol, fdgaintol=fdgaintol, fdfreq=fdfreq, tol=tol), rdim=rdim)
     groups = tuple(tuple(f.generator.residuals) for f in filters)
     return NullspaceBankDesign(gen, filters, S, faults, groups, tuple(f.order for f in filters), model=model)

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fdikit.design.nullspace.basis import denominator, left_nullspace, minimal_realization
-from fdikit.design.nullspace.detectability import row_structure
+from fdikit.design.nullspace.detectability import covered, row_structure
 from fdikit.errors import ParameterError
 from fdikit.model import FaultModel
 
@@ -36,8 +36,9 @@ def _detected(model: FaultModel, zeros: tuple[str, ...], ones: tuple[str, ...], 
     if not basis.rows:
         return basis, np.zeros(len(ones), dtype=bool)
     dens = [denominator(nu, None, sdeg, model.dt) for nu in basis.degrees]
-    S = row_structure(model, basis, ones, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol, dens=dens)
-    return basis, S.any(axis=0)
+    S = row_structure(model, basis, ones, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol, dens=dens,
+                      by_frequency=True)
+    return basis, covered(S)
 
 
 def fdigenspec(model: FaultModel, *, fdtol: float = 1e-4, fdgaintol: float = 0.01, fdfreq=None,
