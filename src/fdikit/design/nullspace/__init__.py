@@ -53,6 +53,7 @@ __getattr__, __dir__, __all__ = lazy.attach(
             "reference_columns", "reference_model", "updated_reference",
         ],
         "matching_basis": ["matching_rows"],
+        "observer_basis": ["ObserverReduction", "observer_reduction"],
         "nehari_ldp": ["distance_error", "nehari", "two_block_distance"],
         "approximate_matching": ["ApproximateMatchingDesign", "ammsyn", "least_distance"],
         "row_factors": ["RowSpectrum", "WIENER_HOPF_JOBS", "realize_biproper", "row_spectrum", "wiener_hopf_row"],

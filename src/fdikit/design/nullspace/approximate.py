@@ -258,6 +258,14 @@ def _noise_free(model: FaultModel) -> FaultModel:
                       dt=model.dt)
 
 
+def _detectable(model: FaultModel, targets, nuisance, fdtol, fdfreq, fdgaintol, tol) -> tuple[str, ...]:
+    """The targets some row of the basis decoupling ``nuisance`` detects (at each of ``fdfreq``)."""
+    basis = left_nullspace(model, nuisance, tol=tol)
+    S = row_structure(model, basis, targets, fdtol=fdtol, fdfreq=fdfreq, fdgaintol=fdgaintol, by_frequency=True,
+                      dens=[denominator(nu, None, None, model.dt) for nu in basis.degrees])
+    return tuple(t for t, hit in zip(targets, covered(S)) if hit)
+
+
 def _nuisance_as_noise(model: FaultModel, nuisance) -> FaultModel:
     """The model with the fault inputs ``nuisance`` moved to the noise (the weak design of a structure row)."""
     keep = [i for i, f in enumerate(model.faults) if f not in nuisance]
@@ -274,8 +282,8 @@ def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
            poles: Sequence[complex] | None = None, sdeg: float | None = None, gamma: float = 1.0,
            nonstd: str = "quasi", epsreg: float = 0.1, sdegzer: float | None = None, smarg: float | None = None,
            exact: bool = False, fdtol: float = 1e-4,
-           fdgaintol: float = 0.01, fdfreq=None, selection=None, tol: float = 1e-9, names=None,
-           isolates=None) -> ApproximateDesign:
+           fdgaintol: float = 0.01, fdfreq=None, selection=None, nullspace: bool = True, tol: float = 1e-9,
+           names=None, isolates=None) -> ApproximateDesign:
     """Approximate fault detection filter by the nullspace method (Procedure AFD).
 
     Parameters
@@ -286,7 +294,7 @@ def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
         As :func:`~fdikit.design.nullspace.exact.efdsyn` (nuisance faults are decoupled exactly).
     rdim : int, optional
         Number of residuals (default 1 when ``minimal``, else all basis rows); the first ``min(rdim, rank R_w)``
-        attenuate the noise, the others decouple it.
+        attenuate the noise and detect every target, the others decouple the noise and detect the targets they can.
     minimal : bool, default True
         Least order selection of the basis rows (as ``efdsyn``).
     poles, sdeg : optional
@@ -320,8 +328,9 @@ def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
         reference): for one residual and one target, the combination of all rows with the largest gap at the one
         frequency ``fdfreq`` — the noise factor of one residual is a scalar, so the gap there is
         ``|h a| / ‖h W‖`` (``a``, ``W``: the rows' fault and noise responses), a generalised Rayleigh quotient.
-    fdtol, fdgaintol, fdfreq, tol, names, isolates
-        As :func:`~fdikit.design.nullspace.exact.efdsyn`; ``fdfreq`` also sets the frequencies of ``β``.
+    fdtol, fdgaintol, fdfreq, nullspace, tol, names, isolates
+        As :func:`~fdikit.design.nullspace.exact.efdsyn`; ``fdfreq`` also sets the frequencies of ``β``; with
+        ``nullspace=False`` the plant poles at or beyond ``smarg`` are moved to ``poles``/``sdeg`` by the observer.
 
     Returns
     -------
@@ -363,6 +372,15 @@ def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
 
     gamma = validate.positive("gamma", gamma)
     nonstd = validate.choice("nonstd", nonstd, NONSTD_OPTIONS)
+    if not nullspace:
+        from fdikit.design.nullspace.observer_basis import observer_reduction
+
+        obs = observer_reduction(model, poles=poles, sdeg=sdeg, smarg=smarg)
+        return obs.compose(afdsyn(obs.reduced, targets=targets, nuisance=nuisance, rdim=rdim, minimal=minimal,
+                                  poles=poles, sdeg=sdeg, gamma=gamma, nonstd=nonstd, epsreg=epsreg,
+                                  sdegzer=sdegzer, smarg=smarg, exact=exact, fdtol=fdtol, fdgaintol=fdgaintol,
+                                  fdfreq=fdfreq, selection=selection, tol=tol, names=names, isolates=isolates),
+                           model)
     targets, nuisance = split_faults(model, targets, nuisance)
     basis = left_nullspace(model, nuisance, tol=tol)
     k = len(basis.rows)
@@ -426,8 +444,10 @@ def afdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
     gen = g1
     if q2:
         beta1 = float(fdhinfminus(g1.internal_form(model), fdfreq, inputs=list(targets)).value)
+        # the noise-free residuals need not see every target (the first ones do): those they can (Example 5.9)
+        t2 = _detectable(_noise_free(model), targets, nuisance, fdtol, fdfreq, fdgaintol, tol) or targets
         try:
-            d2 = efdsyn(_noise_free(model), targets=targets, nuisance=nuisance, rdim=q2, minimal=minimal,
+            d2 = efdsyn(_noise_free(model), targets=t2, nuisance=nuisance, rdim=q2, minimal=minimal,
                         poles=poles, sdeg=sdeg, fdtol=fdtol, fdgaintol=fdgaintol, fdfreq=fdfreq, tol=tol)
         except DesignError as err:
             raise DesignError(f"rdim={q1 + q2}: the {q2} residual(s) that decouple the noise are not available: "
@@ -509,7 +529,7 @@ def afdisyn(model: FaultModel, structure, *, faults=None, rdim: int | Sequence[i
         does; its ``R_f`` columns of those faults are then attenuated, not zero).  False: raise instead.
     **options
         ``minimal``, ``poles``, ``sdeg``, ``gamma``, ``nonstd``, ``epsreg``, ``sdegzer``, ``smarg``, ``exact``,
-        ``fdtol``, ``fdgaintol``, ``fdfreq``, ``tol``: as :func:`afdsyn`, for every row.
+        ``fdtol``, ``fdgaintol``, ``fdfreq``, ``nullspace``, ``tol``: as :func:`afdsyn`, for every row.
 
     Returns
     -------
@@ -537,7 +557,7 @@ def afdisyn(model: FaultModel, structure, *, faults=None, rdim: int | Sequence[i
     Varga (2017), §5.5, Procedure AFDI; fdtools (``afdisyn``).
     """
     allowed = {"minimal", "poles", "sdeg", "gamma", "nonstd", "epsreg", "sdegzer", "smarg", "exact", "fdtol",
-               "fdgaintol", "fdfreq", "tol"}
+               "fdgaintol", "fdfreq", "nullspace", "tol"}
     bad = sorted(set(options) - allowed)
     if bad:
         raise ParameterError(f"unknown option(s) {bad}; afdisyn takes {sorted(allowed)}")

@@ -192,8 +192,8 @@ def _unit_fault_gain(gen: ResidualGenerator, model: FaultModel, targets, fdfreq)
 
 def efdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = None, minimal: bool = True,
            poles: Sequence[complex] | None = None, sdeg: float | None = None, fdtol: float = 1e-4,
-           fdgaintol: float = 0.01, fdfreq=None, selection=None, tol: float = 1e-9, names=None,
-           isolates=None) -> NullspaceDesign:
+           fdgaintol: float = 0.01, fdfreq=None, selection=None, nullspace: bool = True, tol: float = 1e-9,
+           names=None, isolates=None) -> NullspaceDesign:
     """Exact fault detection filter by the nullspace method (Procedure EFD).
 
     Parameters
@@ -225,6 +225,11 @@ def efdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
     selection : array_like, optional
         The ``(q, k)`` combination of the ``k`` selected basis rows (reference ``HDesign``); default a fixed
         generic one (identity when ``q = k``).
+    nullspace : bool, default True
+        The minimal proper basis (True) or the observer basis ``[−Gu I]`` (False, the reference's
+        ``nullspace = false``; no disturbances): the synthesis then runs on the observer's residuals, whose rows
+        ``selection`` combines, and the filter keeps the plant's order
+        (:mod:`~fdikit.design.nullspace.observer_basis`).
     tol : float, default 1e-9
         Relative rank tolerance of the nullspace computation.
     names, isolates : optional
@@ -262,6 +267,13 @@ def efdsyn(model: FaultModel, *, targets=None, nuisance=(), rdim: int | None = N
     from fdikit.design.labels import label_generator
     from fdikit.design.nullspace.stabilization import stabilize_rows
 
+    if not nullspace:
+        from fdikit.design.nullspace.observer_basis import observer_reduction
+
+        obs = observer_reduction(model, poles=poles, sdeg=sdeg)
+        return obs.compose(efdsyn(obs.reduced, targets=targets, nuisance=nuisance, rdim=rdim, minimal=minimal,
+                                  poles=poles, sdeg=sdeg, fdtol=fdtol, fdgaintol=fdgaintol, fdfreq=fdfreq,
+                                  selection=selection, tol=tol, names=names, isolates=isolates), model)
     targets, nuisance = split_faults(model, targets, nuisance)
     basis = left_nullspace(model, nuisance, tol=tol)
     k_all = len(basis.rows)
@@ -458,7 +470,7 @@ def bank_rows(model: FaultModel, structure, faults, design, rdim=None
 def efdisyn(model: FaultModel, structure, *, faults=None, rdim: int | Sequence[int] | None = None,
             minimal: bool = True,
             poles=None, sdeg: float | None = None, fdtol: float = 1e-4, fdgaintol: float = 0.01, fdfreq=None,
-            tol: float = 1e-9) -> NullspaceBankDesign:
+            nullspace: bool = True, tol: float = 1e-9) -> NullspaceBankDesign:
     """A bank of exact fault detection filters achieving the structure matrix ``structure`` (Procedure EFDI).
 
     Parameters
@@ -471,7 +483,7 @@ def efdisyn(model: FaultModel, structure, *, faults=None, rdim: int | Sequence[i
         The columns of ``S`` (default the model's fault inputs, in order).
     rdim : int or sequence of int, optional
         As :func:`efdsyn`, for every row, or one per row.
-    minimal, poles, sdeg, fdtol, fdgaintol, fdfreq, tol
+    minimal, poles, sdeg, fdtol, fdgaintol, fdfreq, nullspace, tol
         As :func:`efdsyn`, for every row.
 
     Returns
@@ -501,6 +513,7 @@ def efdisyn(model: FaultModel, structure, *, faults=None, rdim: int | Sequence[i
     S, faults, filters, gen = bank_rows(
         model, structure, faults,
         lambda tg, nz, q: efdsyn(model, targets=tg, nuisance=nz, rdim=q, minimal=minimal, poles=poles, sdeg=sdeg,
-                                 fdtol=fdtol, fdgaintol=fdgaintol, fdfreq=fdfreq, tol=tol), rdim=rdim)
+                                 fdtol=fdtol, fdgaintol=fdgaintol, fdfreq=fdfreq, nullspace=nullspace, tol=tol),
+        rdim=rdim)
     groups = tuple(tuple(f.generator.residuals) for f in filters)
     return NullspaceBankDesign(gen, filters, S, faults, groups, tuple(f.order for f in filters), model=model)
